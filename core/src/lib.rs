@@ -1,0 +1,28 @@
+//! # nuld-core
+//!
+//! The vocabulary that the build tool and the runtime must agree on bit for bit,
+//! written once:
+//!
+//! * [`sphere`]: the equal-area maps between the unit square and the sphere
+//!   (octahedral, Clarberg 2008) and the hemisphere (concentric disk lifted to the
+//!   hemisphere), with their inverses and the edge wrapping used by optimizers;
+//! * [`quantize`]: the u16 unorm and f16 codecs blobs store values with;
+//! * [`blob`]: the byte layout of a `.nuld` blob (format v1): header, section table,
+//!   checksum, metadata, and a writer that fills a caller-provided buffer.
+//!
+//! The crate is `#![no_std]` and needs no allocator. Nothing in it panics on any
+//! input; functions that can fail return a [`blob::BlobError`].
+//!
+//! ```
+//! use nuld_core::sphere::{square_to_sphere, sphere_to_square};
+//! let d = square_to_sphere(glam::DVec2::new(0.75, 0.5));
+//! assert!((d - glam::DVec3::new(0.661437828, 0.0, 0.75)).length() < 1e-8);
+//! let p = sphere_to_square(d);
+//! assert!((p - glam::DVec2::new(0.75, 0.5)).length() < 1e-12);
+//! ```
+#![no_std]
+#![deny(missing_docs)]
+
+pub mod blob;
+pub mod quantize;
+pub mod sphere;

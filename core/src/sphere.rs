@@ -1,0 +1,296 @@
+//! Equal-area maps between the unit square and the sphere or the upper hemisphere.
+//!
+//! Directions are stored and optimized as points of the unit square; these maps turn
+//! them into unit vectors. Both maps preserve area up to a constant factor, so a
+//! uniform density on the square becomes a uniform density on the (hemi)sphere:
+//!
+//! * [`square_to_sphere`]: `pdf_sphere = pdf_square / (4 pi)`;
+//! * [`square_to_hemisphere`]: `pdf_hemisphere = pdf_square / (2 pi)`.
+//!
+//! Everything is computed in `f64`; the runtime converts the result to `f32` once.
+
+use core::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+use glam::{DVec2, DVec3};
+
+/// `sqrt(max(x, 0))`: rounding can push an argument that is mathematically
+/// non-negative slightly below zero.
+#[inline]
+fn safe_sqrt(x: f64) -> f64 {
+    libm::sqrt(x.max(0.0))
+}
+
+/// Equal-area octahedral map from `[0,1]^2` to the unit sphere (Clarberg 2008, as
+/// pbrt-v4's `EqualAreaSquareToSphere`).
+///
+/// The square's centre `(0.5, 0.5)` maps to `+z`, its four corners to `-z`, and the
+/// edge midpoints to the equator's `-y`, `+x`, `+y`, `-x` (bottom, right, top, left).
+/// Inputs outside `[0,1]^2` are not wrapped; call [`wrap_octahedral`] first.
+///
+/// ```
+/// # use nuld_core::sphere::square_to_sphere; use glam::{DVec2, DVec3};
+/// assert_eq!(square_to_sphere(DVec2::new(0.5, 0.5)), DVec3::Z);
+/// ```
+pub fn square_to_sphere(p: DVec2) -> DVec3 {
+    let u = 2.0 * p.x - 1.0;
+    let v = 2.0 * p.y - 1.0;
+    let up = u.abs();
+    let vp = v.abs();
+    let signed_distance = 1.0 - (up + vp);
+    let d = signed_distance.abs();
+    let r = 1.0 - d;
+    let phi = if r == 0.0 { 1.0 } else { (vp - up) / r + 1.0 } * FRAC_PI_4;
+    let z = libm::copysign(1.0 - r * r, signed_distance);
+    let cos_phi = libm::copysign(libm::cos(phi), u);
+    let sin_phi = libm::copysign(libm::sin(phi), v);
+    let s = r * safe_sqrt(2.0 - r * r);
+    DVec3::new(cos_phi * s, sin_phi * s, z)
+}
+
+/// Inverse of [`square_to_sphere`]: a unit vector to its point in `[0,1]^2`.
+///
+/// Uses the exact `atan` (pbrt-v4 uses a polynomial approximation), so that
+/// `sphere_to_square(square_to_sphere(p)) == p` up to rounding. The input should be
+/// unit length; it is not normalized here.
+pub fn sphere_to_square(d: DVec3) -> DVec2 {
+    let x = d.x.abs();
+    let y = d.y.abs();
+    let z = d.z.abs();
+    let r = safe_sqrt(1.0 - z);
+    let a = x.max(y);
+    let b = x.min(y);
+    let ratio = if a == 0.0 { 0.0 } else { b / a };
+    let mut phi = libm::atan(ratio) / FRAC_PI_2;
+    if x < y {
+        phi = 1.0 - phi;
+    }
+    let mut v = phi * r;
+    let mut u = r - v;
+    if d.z < 0.0 {
+        core::mem::swap(&mut u, &mut v);
+        u = 1.0 - u;
+        v = 1.0 - v;
+    }
+    u = libm::copysign(u, d.x);
+    v = libm::copysign(v, d.y);
+    DVec2::new(0.5 * (u + 1.0), 0.5 * (v + 1.0))
+}
+
+/// Folds a point that left `[0,1]^2` back in, so that it lands on the square point
+/// of the *same* direction neighbourhood across the octahedral seam.
+///
+/// The octahedral layout is continuous across its edges when each edge is glued to
+/// itself mirrored about its midpoint: `u<0 -> (-u, 1-v)`, `u>1 -> (2-u, 1-v)`,
+/// `v<0 -> (1-u, -v)`, `v>1 -> (1-u, 2-v)`. An optimizer that steps a point across
+/// an edge calls this to continue on the other side. Points further than one unit
+/// outside, and non-finite inputs, are clamped into the square afterwards so the
+/// result is always in `[0,1]^2`.
+///
+/// ```
+/// # use nuld_core::sphere::wrap_octahedral; use glam::DVec2;
+/// let p = wrap_octahedral(DVec2::new(-0.01, 0.66));
+/// assert!((p - DVec2::new(0.01, 0.34)).length() < 1e-12);
+/// ```
+pub fn wrap_octahedral(mut p: DVec2) -> DVec2 {
+    // Each fold moves a coordinate that is within one unit of the square inside it,
+    // and may push the other one outside by mirroring; two rounds settle both.
+    for _ in 0..2 {
+        if p.x < 0.0 {
+            p = DVec2::new(-p.x, 1.0 - p.y);
+        } else if p.x > 1.0 {
+            p = DVec2::new(2.0 - p.x, 1.0 - p.y);
+        }
+        if p.y < 0.0 {
+            p = DVec2::new(1.0 - p.x, -p.y);
+        } else if p.y > 1.0 {
+            p = DVec2::new(1.0 - p.x, 2.0 - p.y);
+        }
+    }
+    let clamp = |x: f64| if x.is_nan() { 0.5 } else { x.clamp(0.0, 1.0) };
+    DVec2::new(clamp(p.x), clamp(p.y))
+}
+
+/// Equal-area map from `[0,1]^2` to the upper hemisphere `z >= 0`.
+///
+/// Shirley–Chiu's concentric map takes the square to the unit disk preserving area
+/// (up to the factor `pi`); the lift `(x, y) -> (x s, y s, 1 - r^2)` with
+/// `s = sqrt(2 - r^2)` takes the disk to the hemisphere preserving area (factor 2).
+/// The square's centre maps to `+z`, its boundary to the equator.
+///
+/// ```
+/// # use nuld_core::sphere::square_to_hemisphere; use glam::{DVec2, DVec3};
+/// assert_eq!(square_to_hemisphere(DVec2::new(0.5, 0.5)), DVec3::Z);
+/// let e = square_to_hemisphere(DVec2::new(1.0, 0.5));
+/// assert!((e - DVec3::X).length() < 1e-12);
+/// ```
+pub fn square_to_hemisphere(p: DVec2) -> DVec3 {
+    let a = 2.0 * p.x - 1.0;
+    let b = 2.0 * p.y - 1.0;
+    if a == 0.0 && b == 0.0 {
+        return DVec3::Z;
+    }
+    let (r, theta) = if a.abs() > b.abs() {
+        (a, FRAC_PI_4 * (b / a))
+    } else {
+        (b, FRAC_PI_2 - FRAC_PI_4 * (a / b))
+    };
+    let r2 = r * r;
+    let s = r * safe_sqrt(2.0 - r2);
+    DVec3::new(s * libm::cos(theta), s * libm::sin(theta), 1.0 - r2)
+}
+
+/// Inverse of [`square_to_hemisphere`]. Directions below the horizon are mirrored
+/// to `z >= 0` first (`z` is replaced by `|z|`).
+pub fn hemisphere_to_square(d: DVec3) -> DVec2 {
+    let r2 = (1.0 - d.z.abs()).clamp(0.0, 1.0);
+    let r = libm::sqrt(r2);
+    let planar = libm::sqrt(d.x * d.x + d.y * d.y);
+    if r == 0.0 || planar == 0.0 {
+        return DVec2::splat(0.5);
+    }
+    let mut phi = libm::atan2(d.y, d.x);
+    if phi < -FRAC_PI_4 {
+        phi += 2.0 * PI;
+    }
+    let (a, b) = if phi < FRAC_PI_4 {
+        (r, phi * r / FRAC_PI_4)
+    } else if phi < 3.0 * FRAC_PI_4 {
+        (-(phi - FRAC_PI_2) * r / FRAC_PI_4, r)
+    } else if phi < 5.0 * FRAC_PI_4 {
+        (-r, -(phi - PI) * r / FRAC_PI_4)
+    } else {
+        ((phi - 3.0 * FRAC_PI_2) * r / FRAC_PI_4, -r)
+    };
+    DVec2::new(0.5 * (a + 1.0), 0.5 * (b + 1.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const REFERENCE: [([f64; 2], [f64; 3]); 12] = [
+        ([0.5, 0.5], [0.0, 0.0, 1.0]),
+        ([0.0, 0.0], [0.0, 0.0, -1.0]),
+        ([1.0, 1.0], [0.0, 0.0, -1.0]),
+        ([0.0, 1.0], [0.0, 0.0, -1.0]),
+        ([1.0, 0.0], [0.0, 0.0, -1.0]),
+        ([0.5, 0.0], [0.0, -1.0, 0.0]),
+        ([1.0, 0.5], [1.0, 0.0, 0.0]),
+        ([0.75, 0.5], [0.661437828, 0.0, 0.75]),
+        ([0.75, 0.75], [0.707106781, 0.707106781, 0.0]),
+        ([0.6, 0.7], [0.384187454, 0.665432190, 0.64]),
+        ([0.1, 0.2], [-0.665432190, -0.384187454, -0.64]),
+        ([0.9, 0.35], [0.922575265, -0.335789935, -0.19]),
+    ];
+
+    /// A deterministic low-discrepancy-ish grid of interior test points.
+    fn grid(n: usize) -> impl Iterator<Item = DVec2> {
+        (0..n).flat_map(move |i| {
+            (0..n).map(move |j| {
+                DVec2::new(
+                    (i as f64 + 0.37) / n as f64,
+                    (j as f64 + 0.61) / n as f64,
+                )
+            })
+        })
+    }
+
+    #[test]
+    fn sphere_map_matches_design_reference_vectors() {
+        for (p, d) in REFERENCE {
+            let got = square_to_sphere(DVec2::from(p));
+            assert!(
+                (got - DVec3::from(d)).length() < 2e-9,
+                "{p:?} -> {got:?}, want {d:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn inverse_sphere_map_matches_design_reference() {
+        let d = DVec3::splat(1.0 / 3f64.sqrt());
+        let p = sphere_to_square(d);
+        assert!((p - DVec2::splat(0.662528792)).length() < 1e-9, "{p:?}");
+    }
+
+    #[test]
+    fn sphere_map_round_trips() {
+        for p in grid(97) {
+            let d = square_to_sphere(p);
+            assert!((d.length() - 1.0).abs() < 1e-14);
+            let q = sphere_to_square(d);
+            assert!((p - q).length() < 1e-12, "{p:?} -> {d:?} -> {q:?}");
+        }
+    }
+
+    /// Area of the image of a small square: |d/du x d/dv| * h^2 by central differences.
+    fn area_element(f: impl Fn(DVec2) -> DVec3, p: DVec2) -> f64 {
+        let h = 1e-6;
+        let du = (f(p + DVec2::X * h) - f(p - DVec2::X * h)) / (2.0 * h);
+        let dv = (f(p + DVec2::Y * h) - f(p - DVec2::Y * h)) / (2.0 * h);
+        du.cross(dv).length()
+    }
+
+    #[test]
+    fn sphere_map_has_constant_area_element() {
+        for p in grid(41) {
+            // Central differences straddling the creases |u|+|v|=1 or u,v=0.5 are not
+            // smooth; the grid offsets keep every point at least 1e-3 away.
+            let a = area_element(square_to_sphere, p);
+            assert!((a - 4.0 * PI).abs() < 1e-5 * 4.0 * PI, "{p:?}: {a}");
+        }
+    }
+
+    #[test]
+    fn hemisphere_map_has_constant_area_element_and_round_trips() {
+        for p in grid(41) {
+            let a = area_element(square_to_hemisphere, p);
+            assert!((a - 2.0 * PI).abs() < 1e-5 * 2.0 * PI, "{p:?}: {a}");
+            let d = square_to_hemisphere(p);
+            assert!((d.length() - 1.0).abs() < 1e-14 && d.z >= 0.0);
+            let q = hemisphere_to_square(d);
+            assert!((p - q).length() < 1e-12, "{p:?} -> {d:?} -> {q:?}");
+        }
+    }
+
+    #[test]
+    fn hemisphere_map_reference_points() {
+        let cases = [
+            ([0.5, 0.5], [0.0, 0.0, 1.0]),
+            ([1.0, 0.5], [1.0, 0.0, 0.0]),
+            ([0.5, 1.0], [0.0, 1.0, 0.0]),
+            ([0.0, 0.5], [-1.0, 0.0, 0.0]),
+            ([0.5, 0.0], [0.0, -1.0, 0.0]),
+            // r = 1/2 on the +x axis: z = 1 - 1/4, planar radius 0.5 * sqrt(1.75).
+            ([0.75, 0.5], [0.5 * 1.75f64.sqrt(), 0.0, 0.75]),
+        ];
+        for (p, d) in cases {
+            let got = square_to_hemisphere(DVec2::from(p));
+            assert!((got - DVec3::from(d)).length() < 1e-12, "{p:?} -> {got:?}");
+        }
+    }
+
+    #[test]
+    fn octahedral_wrap_matches_design_examples_and_is_continuous() {
+        let cases = [([-0.01, 0.66], [0.01, 0.34]), ([1.01, 1.01], [0.01, 0.01])];
+        for (p, want) in cases {
+            let got = wrap_octahedral(DVec2::from(p));
+            assert!((got - DVec2::from(want)).length() < 1e-12, "{p:?} -> {got:?}");
+        }
+        // A point just outside an edge maps to a direction next to the one just inside:
+        // the glued edges are the same curve on the sphere.
+        for t in [0.05, 0.3, 0.5, 0.81] {
+            for (inside, outside) in [
+                ([1e-7, t], [-1e-7, t]),
+                ([1.0 - 1e-7, t], [1.0 + 1e-7, t]),
+                ([t, 1e-7], [t, -1e-7]),
+                ([t, 1.0 - 1e-7], [t, 1.0 + 1e-7]),
+            ] {
+                let a = square_to_sphere(DVec2::from(inside));
+                let b = square_to_sphere(wrap_octahedral(DVec2::from(outside)));
+                assert!((a - b).length() < 1e-6, "{inside:?} vs {outside:?}");
+            }
+        }
+        let p = wrap_octahedral(DVec2::new(f64::NAN, 7.5));
+        assert!((0.0..=1.0).contains(&p.x) && (0.0..=1.0).contains(&p.y));
+    }
+}
