@@ -1,1 +1,13 @@
+//! # nuld-build-tool
+//!
+//! The offline half of nuld: target densities, discrepancy estimators and exact
+//! metrics, the optimizer, baselines, blob writing and the `build-tool` CLI.
+#![deny(missing_docs)]
 
+pub mod baselines;
+pub mod cli;
+pub mod density;
+pub mod metrics;
+pub mod output;
+pub mod pointset;
+pub mod seeding;

@@ -1,1 +1,32 @@
+//! Cross-crate conformance tests for nuld (see `tests/tests/`): the runtime returns
+//! what the build tool wrote, hostile bytes never make it panic, and it builds
+//! without `std` or an allocator.
+//!
+//! This library holds the fixtures those tests share.
 
+use nuld_build_tool::pointset::{AlignedBytes, PointSets};
+use nuld_core::blob::{Domain, Metadata};
+
+/// Metadata used by the fixtures.
+pub const META: Metadata<'static> = Metadata {
+    generator: "conformance-test",
+    target: "uniform",
+    seed: 42,
+};
+
+/// Owen-scrambled Sobol sets as the build tool makes them, encoded as a blob.
+pub fn sobol_blob(domain: Domain, n: usize, sets: usize, seed: u64) -> (PointSets, AlignedBytes) {
+    let ps = PointSets {
+        domain,
+        sets: (0..sets)
+            .map(|s| {
+                nuld_build_tool::baselines::owen_sobol(
+                    n,
+                    nuld_build_tool::seeding::derive_seed(seed, s as u64) as u32,
+                )
+            })
+            .collect(),
+    };
+    let bytes = ps.to_blob(&META).expect("encodable point sets");
+    (ps, bytes)
+}
