@@ -7,7 +7,10 @@
 pub mod baselines;
 pub mod cli;
 pub mod density;
+pub mod discrepancy;
 pub mod metrics;
+pub mod optimize;
 pub mod output;
+pub mod plot;
 pub mod pointset;
 pub mod seeding;

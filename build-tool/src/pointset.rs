@@ -121,7 +121,8 @@ impl AlignedBytes {
 
     /// Reads a whole file into an aligned buffer.
     pub fn read(path: &Path) -> Result<Self> {
-        let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+        let bytes =
+            std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
         Ok(Self::copy_from(&bytes))
     }
 

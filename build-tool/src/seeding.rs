@@ -20,5 +20,7 @@ pub fn derive_seed(seed: u64, stream: u64) -> u64 {
 
 /// A fast PRNG for sub-stream `stream` of `seed`.
 pub fn rng(seed: u64, stream: u64) -> Pcg64Mcg {
-    Pcg64Mcg::new(derive_seed(seed, stream) as u128 | 1 | ((derive_seed(seed, !stream) as u128) << 64))
+    Pcg64Mcg::new(
+        derive_seed(seed, stream) as u128 | 1 | ((derive_seed(seed, !stream) as u128) << 64),
+    )
 }

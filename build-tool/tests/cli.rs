@@ -27,7 +27,9 @@ fn sobol_then_export_prints_what_the_runtime_reads() {
     ] {
         let file = dir.join(format!("{domain}.nuld"));
         let st = build_tool()
-            .args(["sobol", "--domain", domain, "--n", "37", "--sets", "2", "--seed", "11"])
+            .args([
+                "sobol", "--domain", domain, "--n", "37", "--sets", "2", "--seed", "11",
+            ])
             .arg("--out")
             .arg(&file)
             .status()
@@ -50,7 +52,11 @@ fn sobol_then_export_prints_what_the_runtime_reads() {
             let want: Vec<f32> = if domain == "square" {
                 blob.point_set_2d().unwrap().point(s, i).to_array().to_vec()
             } else {
-                blob.direction_set().unwrap().direction(s, i).to_array().to_vec()
+                blob.direction_set()
+                    .unwrap()
+                    .direction(s, i)
+                    .to_array()
+                    .to_vec()
             };
             assert_eq!(&row[2..], &want[..], "{domain} row {s},{i}");
         }
@@ -69,7 +75,11 @@ fn bad_input_gives_one_line_errors_and_writes_nothing() {
     assert!(err.contains("nope.nuld"), "{err}");
 
     let junk = dir.join("junk.nuld");
-    std::fs::write(&junk, b"definitely not a blob: a text file that is long enough to hold a header.").unwrap();
+    std::fs::write(
+        &junk,
+        b"definitely not a blob: a text file that is long enough to hold a header.",
+    )
+    .unwrap();
     let out = build_tool().arg("export").arg(&junk).output().unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8(out.stderr).unwrap();
@@ -86,5 +96,120 @@ fn bad_input_gives_one_line_errors_and_writes_nothing() {
     assert!(!target.exists());
     let leftovers: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
     assert_eq!(leftovers.len(), 1, "only the junk input remains");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn optimize_writes_blob_report_and_picture() {
+    let dir = scratch("optimize");
+    let out = dir.join("run");
+    let st = build_tool()
+        .args([
+            "optimize",
+            "--density",
+            "quarter-disc",
+            "--n",
+            "64",
+            "--sets",
+            "2",
+        ])
+        .args([
+            "--epochs",
+            "200",
+            "--seed",
+            "5",
+            "--baseline-sets",
+            "4",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let bytes = AlignedBytes::read(&out.join("set.nuld")).unwrap();
+    let blob = Blob::parse(bytes.as_slice()).unwrap();
+    let pts = blob.point_set_2d().unwrap();
+    assert_eq!((pts.len(), pts.set_count()), (64, 2));
+    assert_eq!(blob.metadata().target, "quarter-disc");
+    // Optimized through the inverse CDF: every point inside the quarter disc.
+    let r2 = 2.0 / std::f32::consts::PI;
+    for s in 0..2 {
+        for i in 0..64 {
+            let p = pts.point(s, i);
+            assert!(p.x * p.x + p.y * p.y < r2 * 1.0001, "{p:?}");
+        }
+    }
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["n"], 64);
+    assert_eq!(report["per_set"].as_array().unwrap().len(), 2);
+    for key in ["asd", "l2_star", "star"] {
+        let v = report["optimized_mean"][key].as_f64().unwrap();
+        let b = report["baseline_warped_owen_sobol_mean"][key]
+            .as_f64()
+            .unwrap();
+        assert!(v > 0.0 && b > 0.0, "{key}");
+    }
+    let png = image::open(out.join("set.png")).unwrap();
+    assert!(png.width() >= 800 && png.height() >= 800);
+    // Exactly the three outputs, no temporaries.
+    let mut names: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["report.json", "set.nuld", "set.png"]);
+
+    // `metrics` reads the blob back and agrees with the report's numbers up to
+    // quantization.
+    let m = build_tool()
+        .arg("metrics")
+        .arg(out.join("set.nuld"))
+        .args(["--density", "quarter-disc", "--json"])
+        .output()
+        .unwrap();
+    assert!(m.status.success(), "{}", String::from_utf8_lossy(&m.stderr));
+    let m: serde_json::Value = serde_json::from_slice(&m.stdout).unwrap();
+    let a = m["mean"]["asd"].as_f64().unwrap();
+    let b = report["optimized_mean"]["asd"].as_f64().unwrap();
+    assert!((a - b).abs() < 0.02 * b, "{a} vs {b}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn optimize_rejects_bad_input_with_one_line_and_writes_nothing() {
+    let dir = scratch("optimize-bad");
+    for (args, needle) in [
+        (vec!["--density", "nonsense:1"], "nonsense"),
+        (vec!["--density", "gaussian:0.5,0.5"], "gaussian"),
+        (
+            vec!["--density", "image:/definitely/missing.png"],
+            "missing.png",
+        ),
+        (vec!["--density", "uniform", "--n", "0"], "--n"),
+        (vec!["--density", "bilinear:0,0,0,0"], "bilinear"),
+        (vec!["--density", "uniform", "--domain", "sphere"], "sphere"),
+    ] {
+        let out = dir.join("never");
+        let o = build_tool()
+            .arg("optimize")
+            .args(&args)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(!o.status.success(), "{args:?}");
+        let err = String::from_utf8(o.stderr).unwrap();
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(
+            err.to_lowercase().contains(&needle.to_lowercase()),
+            "{args:?}: {err}"
+        );
+        assert!(!out.exists(), "{args:?} left {out:?} behind");
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -224,7 +224,10 @@ impl core::fmt::Display for BlobError {
             Self::Misaligned => write!(f, "blob bytes are not 16-byte aligned"),
             Self::BadMagic => write!(f, "not a nuld blob (bad magic)"),
             Self::UnsupportedVersion(v) => {
-                write!(f, "unsupported blob format version {v} (reader knows {FORMAT_VERSION})")
+                write!(
+                    f,
+                    "unsupported blob format version {v} (reader knows {FORMAT_VERSION})"
+                )
             }
             Self::ChecksumMismatch { stored, computed } => write!(
                 f,
@@ -429,7 +432,9 @@ impl<'a> Layout<'a> {
                 return Err(BlobError::BadSection("section offset not 16-byte aligned"));
             }
             if e.elem_size == 0 || e.len % e.elem_size as u64 != 0 {
-                return Err(BlobError::BadSection("length not a whole number of elements"));
+                return Err(BlobError::BadSection(
+                    "length not a whole number of elements",
+                ));
             }
             for j in 0..k {
                 let o = layout.entry(j);

@@ -188,10 +188,7 @@ mod tests {
     fn grid(n: usize) -> impl Iterator<Item = DVec2> {
         (0..n).flat_map(move |i| {
             (0..n).map(move |j| {
-                DVec2::new(
-                    (i as f64 + 0.37) / n as f64,
-                    (j as f64 + 0.61) / n as f64,
-                )
+                DVec2::new((i as f64 + 0.37) / n as f64, (j as f64 + 0.61) / n as f64)
             })
         })
     }
@@ -276,7 +273,10 @@ mod tests {
         let cases = [([-0.01, 0.66], [0.01, 0.34]), ([1.01, 1.01], [0.01, 0.01])];
         for (p, want) in cases {
             let got = wrap_octahedral(DVec2::from(p));
-            assert!((got - DVec2::from(want)).length() < 1e-12, "{p:?} -> {got:?}");
+            assert!(
+                (got - DVec2::from(want)).length() < 1e-12,
+                "{p:?} -> {got:?}"
+            );
         }
         // A point just outside an edge maps to a direction next to the one just inside:
         // the glued edges are the same curve on the sphere.

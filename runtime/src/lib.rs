@@ -154,7 +154,9 @@ impl<'a> Blob<'a> {
         }
         let expected = (info.len as u64) * (info.set_count as u64) * 4;
         if bytes.len() as u64 != expected {
-            return Err(BlobError::OutOfRange("points section does not match the counts"));
+            return Err(BlobError::OutOfRange(
+                "points section does not match the counts",
+            ));
         }
         let coords: &[[u16; 2]] = bytemuck::try_cast_slice(bytes)
             .map_err(|_| BlobError::BadSection("points section is misaligned"))?;
@@ -174,7 +176,9 @@ pub fn doc_example_blob() -> Aligned<[u8; 160]> {
     };
     let pts: [[u16; 2]; 4] = [[0, 0], [32768, 16384], [16384, 49152], [49152, 32768]];
     // Metadata { generator: "doc", target: "uniform", seed: 0 } in postcard.
-    let meta = [3, b'd', b'o', b'c', 7, b'u', b'n', b'i', b'f', b'o', b'r', b'm', 0];
+    let meta = [
+        3, b'd', b'o', b'c', 7, b'u', b'n', b'i', b'f', b'o', b'r', b'm', 0,
+    ];
     let sections = [
         SectionSpec {
             tag: SectionTag::PointSetInfo,

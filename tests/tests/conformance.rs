@@ -32,7 +32,10 @@ fn point_sets_round_trip_to_the_quantization_step() {
         }
         // Indices wrap modulo the counts.
         assert_eq!(pts.point(sets, n + 3 % n), pts.point(0, 3 % n));
-        assert!(matches!(blob.direction_set(), Err(BlobError::WrongKind { .. })));
+        assert!(matches!(
+            blob.direction_set(),
+            Err(BlobError::WrongKind { .. })
+        ));
     }
 }
 
@@ -44,7 +47,10 @@ fn direction_sets_round_trip_through_the_equal_area_maps() {
             let blob = Blob::parse(bytes.as_slice()).unwrap();
             assert_eq!(blob.kind(), BlobKind::DirectionSet);
             let dirs = blob.direction_set().unwrap();
-            assert_eq!((dirs.len(), dirs.set_count(), dirs.domain()), (n, sets, domain));
+            assert_eq!(
+                (dirs.len(), dirs.set_count(), dirs.domain()),
+                (n, sets, domain)
+            );
             for (s, set) in ps.sets.iter().enumerate() {
                 for (i, p) in set.iter().enumerate() {
                     let got = dirs.direction(s, i).as_dvec3();
@@ -65,7 +71,10 @@ fn direction_sets_round_trip_through_the_equal_area_maps() {
                     assert!((got - exact).length() < 1e-4, "{domain:?} {s} {i}");
                 }
             }
-            assert!(matches!(blob.point_set_2d(), Err(BlobError::WrongKind { .. })));
+            assert!(matches!(
+                blob.point_set_2d(),
+                Err(BlobError::WrongKind { .. })
+            ));
         }
     }
 }
@@ -82,7 +91,10 @@ fn embedded_blob_through_the_aligned_helper() {
     let (ps, fresh) = sobol_blob(Domain::Sphere, 64, 2, 3);
     // The committed file is what today's tool writes for the same arguments (bar
     // the metadata), so the format has not drifted.
-    let fresh = Blob::parse(fresh.as_slice()).unwrap().direction_set().unwrap();
+    let fresh = Blob::parse(fresh.as_slice())
+        .unwrap()
+        .direction_set()
+        .unwrap();
     assert_eq!(dirs.len(), 64);
     for s in 0..2 {
         for i in 0..64 {

@@ -64,7 +64,10 @@ fn every_truncation_and_extension_is_rejected() {
         parse_and_touch(bytes).unwrap();
         for cut in 0..bytes.len() {
             let err = parse_and_touch(&bytes[..cut]).unwrap_err();
-            assert!(matches!(err, BlobError::Truncated { .. }), "cut {cut}: {err:?}");
+            assert!(
+                matches!(err, BlobError::Truncated { .. }),
+                "cut {cut}: {err:?}"
+            );
         }
         let mut longer = AlignedBytes::zeroed(bytes.len() + 16);
         longer.as_mut_slice()[..bytes.len()].copy_from_slice(bytes);
@@ -81,7 +84,10 @@ fn every_single_bit_flip_is_rejected() {
         let mut copy = blob.clone();
         for bit in 0..copy.as_slice().len() * 8 {
             copy.as_mut_slice()[bit / 8] ^= 1 << (bit % 8);
-            assert!(parse_and_touch(copy.as_slice()).is_err(), "bit {bit} accepted");
+            assert!(
+                parse_and_touch(copy.as_slice()).is_err(),
+                "bit {bit} accepted"
+            );
             copy.as_mut_slice()[bit / 8] ^= 1 << (bit % 8);
         }
         parse_and_touch(copy.as_slice()).unwrap();

@@ -20,7 +20,10 @@ fn build_proof(feature: Option<&str>) -> Output {
     cmd.current_dir(workspace_root())
         .args(["build", "--profile", "nostd-check", "--manifest-path"])
         .arg(workspace_root().join("tests/no-std-check/Cargo.toml"))
-        .env("CARGO_TARGET_DIR", workspace_root().join("target/nostd-check"))
+        .env(
+            "CARGO_TARGET_DIR",
+            workspace_root().join("target/nostd-check"),
+        )
         .env_remove("RUSTFLAGS");
     if let Some(f) = feature {
         cmd.args(["--features", f]);
@@ -32,7 +35,10 @@ fn build_proof(feature: Option<&str>) -> Output {
 fn runtime_links_without_std_or_alloc_and_leaks_are_caught() {
     let ok = build_proof(None);
     let stderr = String::from_utf8_lossy(&ok.stderr);
-    assert!(ok.status.success(), "the no_std proof crate failed to build:\n{stderr}");
+    assert!(
+        ok.status.success(),
+        "the no_std proof crate failed to build:\n{stderr}"
+    );
 
     let leak = build_proof(Some("leak-std"));
     let stderr = String::from_utf8_lossy(&leak.stderr);

@@ -50,8 +50,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
     let bytes = AlignedBytes::read(&a.file)?;
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
-    write_csv(bytes.as_slice(), &mut out)
-        .map_err(|e| anyhow!("{}: {e}", a.file.display()))?;
+    write_csv(bytes.as_slice(), &mut out).map_err(|e| anyhow!("{}: {e}", a.file.display()))?;
     out.flush()?;
     Ok(())
 }

@@ -1,6 +1,9 @@
 //! The `build-tool` command line (DESIGN.md §3).
 
+pub mod bench;
 pub mod export;
+pub mod metrics;
+pub mod optimize;
 pub mod sobol;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -22,6 +25,12 @@ pub enum Command {
     Sobol(sobol::SobolArgs),
     /// Print a blob's points as CSV: `set,index,x,y` (2D) or `set,index,x,y,z`.
     Export(export::ExportArgs),
+    /// Optimize point sets for a target density: DIR/set.nuld, report.json, set.png.
+    Optimize(optimize::OptimizeArgs),
+    /// Exact discrepancies of a blob's point sets against a target density.
+    Metrics(metrics::MetricsArgs),
+    /// Time the optimizer: fast vs dense gradient per epoch, and full default runs.
+    Bench(bench::BenchArgs),
 }
 
 /// `--domain` values.
@@ -50,5 +59,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Sobol(a) => sobol::run(a),
         Command::Export(a) => export::run(a),
+        Command::Optimize(a) => optimize::run(a),
+        Command::Metrics(a) => metrics::run(a),
+        Command::Bench(a) => bench::run(a),
     }
 }

@@ -1,0 +1,92 @@
+//! `build-tool bench`: the optimizer's speed, fast banded gradient against the dense
+//! reference, and the wall time of full default runs.
+
+use crate::density::parse_spec;
+use crate::discrepancy::GradientPath;
+use crate::optimize::{optimize, OptimizeConfig};
+use anyhow::{Context, Result};
+use clap::Args;
+use std::time::Instant;
+
+/// Arguments of `build-tool bench`.
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Point counts to time per epoch.
+    #[arg(long, value_delimiter = ',', default_value = "256,1024,2048,4096")]
+    pub sizes: Vec<usize>,
+    /// Closed-form target for the per-epoch timings and the first full run.
+    #[arg(long, default_value = "gaussian:0.5,0.5,0.15")]
+    pub density: String,
+    /// Tabulated target for the second full run (skipped if it does not load).
+    #[arg(long, default_value = "image:../shared/data/images/camera.png")]
+    pub image_density: String,
+    /// Epochs timed per size on the fast path (the full alpha ramp is compressed
+    /// into them, so the band widths match a real run's average).
+    #[arg(long, default_value_t = 100)]
+    pub fast_epochs: usize,
+    /// Epochs timed per size on the dense path.
+    #[arg(long, default_value_t = 3)]
+    pub dense_epochs: usize,
+    /// Point count of the full default runs (0 skips them).
+    #[arg(long, default_value_t = 2048)]
+    pub full_n: usize,
+}
+
+fn seconds_per_epoch(spec: &str, n: usize, epochs: usize, path: GradientPath) -> Result<f64> {
+    let density = parse_spec(spec).with_context(|| format!("--density {spec}"))?;
+    let cfg = OptimizeConfig {
+        epochs,
+        path,
+        ..OptimizeConfig::default()
+    };
+    let t = Instant::now();
+    let _ = optimize(density.as_ref(), n, &cfg, &mut |_| {});
+    Ok(t.elapsed().as_secs_f64() / epochs as f64)
+}
+
+fn full_run(spec: &str, n: usize) -> Result<f64> {
+    let density = parse_spec(spec).with_context(|| format!("--image-density {spec}"))?;
+    let t = Instant::now();
+    let _ = optimize(density.as_ref(), n, &OptimizeConfig::default(), &mut |_| {});
+    Ok(t.elapsed().as_secs_f64())
+}
+
+/// Runs `build-tool bench`.
+pub fn run(a: BenchArgs) -> Result<()> {
+    let d = OptimizeConfig::default();
+    println!(
+        "optimizer per-epoch cost, {} ({} anchors x 4 boxes, alpha {}..{} sqrt(N)), {} rayon threads",
+        a.density,
+        d.anchors,
+        d.alpha_start,
+        d.alpha_end,
+        rayon::current_num_threads()
+    );
+    println!(
+        "{:>6} {:>14} {:>14} {:>8}",
+        "N", "fast ms/epoch", "dense ms/epoch", "ratio"
+    );
+    for &n in &a.sizes {
+        let fast = seconds_per_epoch(&a.density, n, a.fast_epochs, GradientPath::Fast)?;
+        let dense = seconds_per_epoch(&a.density, n, a.dense_epochs, GradientPath::Dense)?;
+        println!(
+            "{n:>6} {:>14.2} {:>14.2} {:>7.1}x",
+            fast * 1e3,
+            dense * 1e3,
+            dense / fast
+        );
+    }
+    if a.full_n > 0 {
+        println!("full default runs ({} epochs), N = {}:", d.epochs, a.full_n);
+        let s = full_run(&a.density, a.full_n)?;
+        println!("  {:<45} {s:>7.1} s   (paper, RTX A5000: 150 s)", a.density);
+        match full_run(&a.image_density, a.full_n) {
+            Ok(s) => println!(
+                "  {:<45} {s:>7.1} s   (paper, RTX A5000: 630 s, MC areas)",
+                a.image_density
+            ),
+            Err(e) => println!("  {:<45} skipped: {e:#}", a.image_density),
+        }
+    }
+    Ok(())
+}
