@@ -1,7 +1,9 @@
-//! Pictures: point sets over their target density.
+//! Pictures: point sets over their target density, and log-log curves.
 
+mod curves;
 mod points;
 
+pub use curves::{render_loglog, Series};
 pub use points::render_point_set;
 
 use std::sync::Once;
