@@ -192,7 +192,18 @@ fn optimize_rejects_bad_input_with_one_line_and_writes_nothing() {
         ),
         (vec!["--density", "uniform", "--n", "0"], "--n"),
         (vec!["--density", "bilinear:0,0,0,0"], "bilinear"),
-        (vec!["--density", "uniform", "--domain", "sphere"], "sphere"),
+        (
+            vec!["--domain", "sphere", "--density", "gaussian:0.5,0.5,0.1"],
+            "gaussian",
+        ),
+        (
+            vec!["--domain", "hemisphere", "--density", "brdf:2,45"],
+            "brdf",
+        ),
+        (
+            vec!["--domain", "sphere", "--density", "envmap:/nope.hdr"],
+            "nope.hdr",
+        ),
     ] {
         let out = dir.join("never");
         let o = build_tool()
@@ -210,6 +221,59 @@ fn optimize_rejects_bad_input_with_one_line_and_writes_nothing() {
             "{args:?}: {err}"
         );
         assert!(!out.exists(), "{args:?} left {out:?} behind");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn optimize_directions_writes_a_direction_blob() {
+    let dir = scratch("optimize-dirs");
+    for (domain, density) in [("sphere", "uniform"), ("hemisphere", "cosine")] {
+        let out = dir.join(domain);
+        let st = build_tool()
+            .args([
+                "optimize",
+                "--domain",
+                domain,
+                "--density",
+                density,
+                "--n",
+                "48",
+            ])
+            .args(["--epochs", "150", "--baseline-sets", "2", "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(
+            st.status.success(),
+            "{}",
+            String::from_utf8_lossy(&st.stderr)
+        );
+        let bytes = AlignedBytes::read(&out.join("set.nuld")).unwrap();
+        let blob = Blob::parse(bytes.as_slice()).unwrap();
+        let dirs = blob.direction_set().unwrap();
+        assert_eq!(dirs.len(), 48);
+        for i in 0..48 {
+            let d = dirs.direction(0, i);
+            assert!((d.length() - 1.0).abs() < 1e-5);
+            if domain == "hemisphere" {
+                assert!(d.z >= 0.0);
+            }
+        }
+        let report: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+        assert_eq!(report["domain"], domain);
+        for key in ["cap_l2", "cap_l2_theta", "cap_star_lower_bound"] {
+            assert!(
+                report["optimized_mean"][key].as_f64().unwrap() > 0.0,
+                "{key}"
+            );
+        }
+        let png = image::open(out.join("set.png")).unwrap();
+        assert!(
+            png.width() >= 3 * png.height() / 2,
+            "three panels side by side"
+        );
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -24,5 +24,6 @@
 #![deny(missing_docs)]
 
 pub mod blob;
+pub mod brdf;
 pub mod quantize;
 pub mod sphere;

@@ -3,9 +3,12 @@
 
 use crate::density::parse_spec;
 use crate::discrepancy::GradientPath;
-use crate::optimize::{optimize, OptimizeConfig};
+use crate::optimize::directions::{optimize_directions, DirectionConfig};
+use crate::optimize::{optimize, AreaOption, OptimizeConfig};
+use crate::sphere::parse_direction_spec;
 use anyhow::{Context, Result};
 use clap::Args;
+use nuld_core::blob::Domain;
 use std::time::Instant;
 
 /// Arguments of `build-tool bench`.
@@ -30,6 +33,85 @@ pub struct BenchArgs {
     /// Point count of the full default runs (0 skips them).
     #[arg(long, default_value_t = 2048)]
     pub full_n: usize,
+    /// Direction target (sphere domain) for the direction timings.
+    #[arg(long, default_value = "uniform")]
+    pub direction_density: String,
+    /// Which parts to run.
+    #[arg(long, value_enum, default_value = "all")]
+    pub only: BenchPart,
+}
+
+/// `--only` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum BenchPart {
+    /// 2D and directions.
+    All,
+    /// Only the 2D optimizer.
+    Square,
+    /// Only the direction optimizer.
+    Directions,
+}
+
+fn direction_seconds_per_epoch(
+    spec: &str,
+    n: usize,
+    epochs: usize,
+    path: GradientPath,
+) -> Result<f64> {
+    let density = parse_direction_spec(spec, Domain::Sphere)
+        .with_context(|| format!("--direction-density {spec}"))?;
+    let cfg = DirectionConfig {
+        epochs,
+        path,
+        ..DirectionConfig::default()
+    };
+    let t = Instant::now();
+    let _ = optimize_directions(density.as_ref(), n, &cfg, &mut |_| {});
+    Ok(t.elapsed().as_secs_f64() / epochs as f64)
+}
+
+fn run_directions(a: &BenchArgs) -> Result<()> {
+    let d = DirectionConfig::default();
+    println!(
+        "direction optimizer per-epoch cost, {} on the sphere ({} caps, alpha {}..{} inverse spacings)",
+        a.direction_density, d.caps, d.alpha_start, d.alpha_end
+    );
+    println!(
+        "{:>6} {:>14} {:>14} {:>8}",
+        "N", "fast ms/epoch", "dense ms/epoch", "ratio"
+    );
+    for &n in &a.sizes {
+        let fast = direction_seconds_per_epoch(
+            &a.direction_density,
+            n,
+            5 * a.fast_epochs,
+            GradientPath::Fast,
+        )?;
+        let dense = direction_seconds_per_epoch(
+            &a.direction_density,
+            n,
+            a.dense_epochs,
+            GradientPath::Dense,
+        )?;
+        println!(
+            "{n:>6} {:>14.2} {:>14.2} {:>7.1}x",
+            fast * 1e3,
+            dense * 1e3,
+            dense / fast
+        );
+    }
+    if a.full_n > 0 {
+        let density = parse_direction_spec(&a.direction_density, Domain::Sphere)?;
+        let t = Instant::now();
+        let _ = optimize_directions(density.as_ref(), a.full_n, &d, &mut |_| {});
+        println!(
+            "full default run ({} epochs), N = {}: {:.1} s   (paper, RTX 5090 laptop: 75 s)",
+            d.epochs,
+            a.full_n,
+            t.elapsed().as_secs_f64()
+        );
+    }
+    Ok(())
 }
 
 fn seconds_per_epoch(spec: &str, n: usize, epochs: usize, path: GradientPath) -> Result<f64> {
@@ -44,15 +126,29 @@ fn seconds_per_epoch(spec: &str, n: usize, epochs: usize, path: GradientPath) ->
     Ok(t.elapsed().as_secs_f64() / epochs as f64)
 }
 
-fn full_run(spec: &str, n: usize) -> Result<f64> {
+fn full_run(spec: &str, n: usize, area: AreaOption) -> Result<f64> {
     let density = parse_spec(spec).with_context(|| format!("--image-density {spec}"))?;
+    let cfg = OptimizeConfig {
+        area,
+        ..OptimizeConfig::default()
+    };
     let t = Instant::now();
-    let _ = optimize(density.as_ref(), n, &OptimizeConfig::default(), &mut |_| {});
+    let _ = optimize(density.as_ref(), n, &cfg, &mut |_| {});
     Ok(t.elapsed().as_secs_f64())
 }
 
 /// Runs `build-tool bench`.
 pub fn run(a: BenchArgs) -> Result<()> {
+    if a.only != BenchPart::Directions {
+        run_square(&a)?;
+    }
+    if a.only != BenchPart::Square {
+        run_directions(&a)?;
+    }
+    Ok(())
+}
+
+fn run_square(a: &BenchArgs) -> Result<()> {
     let d = OptimizeConfig::default();
     println!(
         "optimizer per-epoch cost, {} ({} anchors x 4 boxes, alpha {}..{} sqrt(N)), {} rayon threads",
@@ -78,14 +174,18 @@ pub fn run(a: BenchArgs) -> Result<()> {
     }
     if a.full_n > 0 {
         println!("full default runs ({} epochs), N = {}:", d.epochs, a.full_n);
-        let s = full_run(&a.density, a.full_n)?;
-        println!("  {:<45} {s:>7.1} s   (paper, RTX A5000: 150 s)", a.density);
-        match full_run(&a.image_density, a.full_n) {
-            Ok(s) => println!(
-                "  {:<45} {s:>7.1} s   (paper, RTX A5000: 630 s, MC areas)",
-                a.image_density
-            ),
-            Err(e) => println!("  {:<45} skipped: {e:#}", a.image_density),
+        let s = full_run(&a.density, a.full_n, AreaOption::Exact)?;
+        println!("  {:<50} {s:>7.1} s   (paper, RTX A5000: 150 s)", a.density);
+        let mc = AreaOption::MonteCarlo { samples: 65536 };
+        for (area, label) in [
+            (AreaOption::Exact, "exact areas"),
+            (mc, "MC areas, K = 65536"),
+        ] {
+            let name = format!("{} ({label})", a.image_density);
+            match full_run(&a.image_density, a.full_n, area) {
+                Ok(s) => println!("  {name:<50} {s:>7.1} s   (paper, RTX A5000: 630 s, MC areas)"),
+                Err(e) => println!("  {name:<50} skipped: {e:#}"),
+            }
         }
     }
     Ok(())

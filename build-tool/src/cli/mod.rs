@@ -1,6 +1,7 @@
 //! The `build-tool` command line (DESIGN.md §3).
 
 pub mod bench;
+pub mod eval;
 pub mod export;
 pub mod metrics;
 pub mod optimize;
@@ -31,6 +32,8 @@ pub enum Command {
     Metrics(metrics::MetricsArgs),
     /// Time the optimizer: fast vs dense gradient per epoch, and full default runs.
     Bench(bench::BenchArgs),
+    /// Evaluate the paper's §5 figures (fig2, fig3, fig5, fig6, fig7, all): CSV, JSON, plots.
+    Eval(eval::EvalArgs),
 }
 
 /// `--domain` values.
@@ -62,5 +65,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Optimize(a) => optimize::run(a),
         Command::Metrics(a) => metrics::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Eval(a) => eval::run(a),
     }
 }

@@ -15,6 +15,7 @@
 //! the cross through `u` ([`estimator`]). The expectation of `loss` over `u` is the
 //! squared average squared discrepancy `(D2asd_mu)^2` of DESIGN.md §5.
 
+pub mod caps;
 pub mod counting;
 pub mod estimator;
 

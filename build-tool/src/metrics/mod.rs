@@ -14,6 +14,7 @@
 //! Everything is deterministic: sequential, or parallel with fixed chunking and
 //! fixed-order (or exact, for maxima) reductions.
 
+pub mod cap_summary;
 pub mod cells;
 pub mod l2;
 pub mod pairs;

@@ -4,6 +4,7 @@
 //! parameterization `x = T(u)`.
 
 pub mod adam;
+pub mod directions;
 
 use crate::baselines::owen_sobol;
 use crate::density::Density2D;

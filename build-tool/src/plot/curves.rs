@@ -50,8 +50,12 @@ pub fn render_loglog(
     if all.is_empty() {
         return Err(anyhow!("nothing to plot for {title}"));
     }
-    let (xmin, xmax) = all.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
-    let (ymin, ymax) = all.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
+    let (xmin, xmax) = all
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
+    let (ymin, ymax) = all
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
     let mut buf = vec![255u8; (width * height * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (width, height)).into_drawing_area();
@@ -93,10 +97,19 @@ pub fn render_loglog(
                 .map_err(|e| anyhow!("plot: {e}"))?
                 .label(s.label.clone())
                 .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 22, y)], ShapeStyle { stroke_width: 3, ..style })
+                    PathElement::new(
+                        vec![(x, y), (x + 22, y)],
+                        ShapeStyle {
+                            stroke_width: 3,
+                            ..style
+                        },
+                    )
                 });
             chart
-                .draw_series(pts.iter().map(|&p| Circle::new(p, if ours { 4 } else { 3 }, style)))
+                .draw_series(
+                    pts.iter()
+                        .map(|&p| Circle::new(p, if ours { 4 } else { 3 }, style)),
+                )
                 .map_err(|e| anyhow!("plot: {e}"))?;
         }
         chart
@@ -109,7 +122,8 @@ pub fn render_loglog(
             .map_err(|e| anyhow!("plot: {e}"))?;
         root.present().map_err(|e| anyhow!("plot: {e}"))?;
     }
-    let img = image::RgbImage::from_raw(width, height, buf).ok_or_else(|| anyhow!("plot buffer size"))?;
+    let img =
+        image::RgbImage::from_raw(width, height, buf).ok_or_else(|| anyhow!("plot buffer size"))?;
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
     crate::output::write_atomic(path, &png)
@@ -127,11 +141,15 @@ mod tests {
         let series = vec![
             Series {
                 label: "ours".into(),
-                points: (2..10).map(|k| (f64::from(1 << k), 1.0 / f64::from(1 << k))).collect(),
+                points: (2..10)
+                    .map(|k| (f64::from(1 << k), 1.0 / f64::from(1 << k)))
+                    .collect(),
             },
             Series {
                 label: "random".into(),
-                points: (2..10).map(|k| (f64::from(1 << k), f64::from(1 << k).powf(-0.5))).collect(),
+                points: (2..10)
+                    .map(|k| (f64::from(1 << k), f64::from(1 << k).powf(-0.5)))
+                    .collect(),
             },
         ];
         render_loglog(&path, "test", "N", "error", &series, (640, 480)).unwrap();

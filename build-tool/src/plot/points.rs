@@ -1,16 +1,110 @@
-//! A point set drawn over a grayscale image of its target density.
+//! Point sets drawn over a grayscale image of their target density: 2D sets in the
+//! unit square, and direction sets both in their equal-area square and as
+//! orthographic views of the sphere.
 
 use super::register_fonts;
 use anyhow::{anyhow, Result};
-use glam::DVec2;
+use glam::{DVec2, DVec3};
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 
-/// Draws `points` (in `[0,1]^2`) over `density` (grayscale, white = high,
-/// scaled to the 99th percentile so a sharp peak does not wash out the rest) and
-/// writes a PNG of `size x size + 60` pixels to `path` atomically. The y axis
-/// points down, as image rows do (DESIGN.md §3: y grows with the row index), so an
-/// `image:` target appears upright.
+type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
+
+fn err(e: impl std::fmt::Display) -> anyhow::Error {
+    anyhow!("plot: {e}")
+}
+
+/// Fills the plotting area of a `[lo, hi]^2` chart with `shade(x, y)` (grayscale,
+/// white = high, scaled to the 99th percentile so a sharp peak does not wash out the
+/// rest; `None` = outside the domain, drawn white) and draws `points` on top.
+fn draw_panel(
+    area: &Area<'_>,
+    caption: &str,
+    (lo, hi): (f64, f64),
+    axes: Option<(&str, &str)>,
+    shade: &dyn Fn(f64, f64) -> Option<f64>,
+    points: &[(f64, f64)],
+) -> Result<()> {
+    let mut builder = ChartBuilder::on(area);
+    builder.caption(caption, ("sans-serif", 17)).margin(12);
+    if axes.is_some() {
+        builder.x_label_area_size(34).y_label_area_size(44);
+    }
+    let mut chart = builder.build_cartesian_2d(lo..hi, lo..hi).map_err(err)?;
+    if let Some((xd, yd)) = axes {
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc(xd)
+            .y_desc(yd)
+            .y_label_formatter(&|v| format!("{:.1}", 1.0 - v))
+            .draw()
+            .map_err(err)?;
+    }
+    let plot = chart.plotting_area();
+    let (xr, yr) = plot.get_pixel_range();
+    let (pw, ph) = ((xr.end - xr.start) as usize, (yr.end - yr.start) as usize);
+    let values: Vec<Option<f64>> = (0..pw * ph)
+        .map(|k| {
+            let (i, j) = (k % pw, k / pw);
+            let x = lo + (hi - lo) * (i as f64 + 0.5) / pw as f64;
+            let y = hi - (hi - lo) * (j as f64 + 0.5) / ph as f64;
+            shade(x, y)
+        })
+        .collect();
+    let mut sorted: Vec<f64> = values
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|v| v.is_finite())
+        .collect();
+    sorted.sort_by(f64::total_cmp);
+    let top = sorted
+        .get(sorted.len() * 99 / 100)
+        .copied()
+        .unwrap_or(1.0)
+        .max(1e-300);
+    let base = plot.strip_coord_spec();
+    for (k, v) in values.iter().enumerate() {
+        if let Some(v) = v {
+            let g = (60.0 + 195.0 * (v / top).clamp(0.0, 1.0).sqrt()) as u8;
+            base.draw_pixel(((k % pw) as i32, (k / pw) as i32), &RGBColor(g, g, g))
+                .map_err(err)?;
+        }
+    }
+    let radius = if points.len() > 2000 { 1 } else { 2 };
+    for &p in points {
+        plot.draw(&Circle::new(p, radius, RGBColor(220, 30, 30).filled()))
+            .map_err(err)?;
+    }
+    Ok(())
+}
+
+/// Renders into a fresh `w x h` buffer and writes it as PNG to `path` atomically.
+fn write_png(
+    path: &Path,
+    (w, h): (u32, u32),
+    draw: impl FnOnce(&Area<'_>) -> Result<()>,
+) -> Result<()> {
+    register_fonts();
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(err)?;
+        draw(&root)?;
+        root.present().map_err(err)?;
+    }
+    let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| anyhow!("plot buffer size"))?;
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
+    crate::output::write_atomic(path, &png)
+}
+
+/// Draws `points` (in `[0,1]^2`) over `density` and writes a PNG of
+/// `size x (size + 60)` pixels to `path` atomically. The y axis points down, as
+/// image rows do (DESIGN.md §3: y grows with the row index), so an `image:` target
+/// appears upright.
 pub fn render_point_set(
     path: &Path,
     title: &str,
@@ -18,66 +112,66 @@ pub fn render_point_set(
     points: &[DVec2],
     size: u32,
 ) -> Result<()> {
-    register_fonts();
-    let (w, h) = (size, size + 60);
-    let mut buf = vec![255u8; (w * h * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 17))
-            .margin(12)
-            .x_label_area_size(34)
-            .y_label_area_size(44)
-            .build_cartesian_2d(0f64..1f64, 0f64..1f64)
-            .map_err(|e| anyhow!("plot: {e}"))?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc("x")
-            .y_desc("y (down)")
-            .y_label_formatter(&|v| format!("{:.1}", 1.0 - v))
-            .draw()
-            .map_err(|e| anyhow!("plot: {e}"))?;
-        let area = chart.plotting_area();
-        let (xr, yr) = area.get_pixel_range();
-        let (pw, ph) = ((xr.end - xr.start) as usize, (yr.end - yr.start) as usize);
-        let values: Vec<f64> = (0..pw * ph)
-            .map(|k| {
-                let (i, j) = (k % pw, k / pw);
-                density(DVec2::new(
-                    (i as f64 + 0.5) / pw as f64,
-                    (j as f64 + 0.5) / ph as f64,
-                ))
-            })
-            .collect();
-        let mut sorted: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
-        sorted.sort_by(f64::total_cmp);
-        let top = sorted
-            .get(sorted.len() * 99 / 100)
-            .copied()
-            .unwrap_or(1.0)
-            .max(1e-300);
-        let base = area.strip_coord_spec();
-        for (k, v) in values.iter().enumerate() {
-            let g = (60.0 + 195.0 * (v / top).clamp(0.0, 1.0).sqrt()) as u8;
-            let (i, j) = ((k % pw) as i32, (k / pw) as i32);
-            base.draw_pixel((i, j), &RGBColor(g, g, g))
-                .map_err(|e| anyhow!("plot: {e}"))?;
+    let flipped: Vec<(f64, f64)> = points.iter().map(|p| (p.x, 1.0 - p.y)).collect();
+    write_png(path, (size, size + 60), |root| {
+        draw_panel(
+            root,
+            title,
+            (0.0, 1.0),
+            Some(("x", "y (down)")),
+            &|x, y| Some(density(DVec2::new(x, 1.0 - y))),
+            &flipped,
+        )
+    })
+}
+
+/// Draws a direction set three ways, side by side: its points in the domain's
+/// equal-area square over the density, and orthographic views of the sphere from
+/// `+z` and from `-z` (the latter mirrored, as seen from below), each over the
+/// density of the visible half. Writes a PNG of `3 size x (size + 60)` pixels.
+///
+/// `to_direction` is the domain's equal-area map; `density` is per solid angle.
+pub fn render_direction_set(
+    path: &Path,
+    title: &str,
+    density: &dyn Fn(DVec3) -> f64,
+    to_direction: &dyn Fn(DVec2) -> DVec3,
+    square_points: &[DVec2],
+    size: u32,
+) -> Result<()> {
+    let dirs: Vec<DVec3> = square_points.iter().map(|&p| to_direction(p)).collect();
+    let flipped: Vec<(f64, f64)> = square_points.iter().map(|p| (p.x, 1.0 - p.y)).collect();
+    write_png(path, (3 * size, size + 60), |root| {
+        let panels = root.split_evenly((1, 3));
+        draw_panel(
+            &panels[0],
+            title,
+            (0.0, 1.0),
+            Some(("equal-area square x", "y (down)")),
+            &|x, y| Some(density(to_direction(DVec2::new(x, 1.0 - y)))),
+            &flipped,
+        )?;
+        for (panel, sign, caption) in [
+            (&panels[1], 1.0, "seen from +z (x right, y up)"),
+            (&panels[2], -1.0, "seen from -z (x left, y up)"),
+        ] {
+            let visible: Vec<(f64, f64)> = dirs
+                .iter()
+                .filter(|d| d.z * sign >= 0.0)
+                .map(|d| (sign * d.x, d.y))
+                .collect();
+            draw_panel(
+                panel,
+                caption,
+                (-1.05, 1.05),
+                None,
+                &|a, b| {
+                    let r2 = a * a + b * b;
+                    (r2 <= 1.0).then(|| density(DVec3::new(sign * a, b, sign * (1.0 - r2).sqrt())))
+                },
+                &visible,
+            )?;
         }
-        let radius = if points.len() > 2000 { 1 } else { 2 };
-        for p in points {
-            area.draw(&Circle::new(
-                (p.x, 1.0 - p.y),
-                radius,
-                RGBColor(220, 30, 30).filled(),
-            ))
-            .map_err(|e| anyhow!("plot: {e}"))?;
-        }
-        root.present().map_err(|e| anyhow!("plot: {e}"))?;
-    }
-    let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| anyhow!("plot buffer size"))?;
-    let mut png = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
-    crate::output::write_atomic(path, &png)
+        Ok(())
+    })
 }

@@ -1,0 +1,38 @@
+//! Directions on the sphere and the upper hemisphere: target densities, their
+//! samplers and cap measures, and spherical cap discrepancy metrics (DESIGN.md §3,
+//! §5, §6; paper §2.1 Eqs. 7–9 and §3.5).
+//!
+//! * [`density`]: the [`DirectionDensity`] trait and [`parse_direction_spec`] for the
+//!   SPECs `uniform`, `cosine`, `brdf:ROUGHNESS,THETA_O_DEG`, `envmap:PATH`;
+//! * [`brdf_target`], [`envmap`]: the two tabulated targets;
+//! * [`geometry`]: closed-form cap measures (uniform sphere and hemisphere, cosine);
+//! * [`cap_table`]: [`CapMeasureTable`], fast cap sums over a weighted point rule;
+//! * [`metrics`]: cap L2 discrepancy (Stolarsky closed form, energy distance,
+//!   Monte Carlo in the paper's theta-uniform convention) and a lower bound of the
+//!   cap star discrepancy.
+//!
+//! A cap is `C(w, t) = {x : <w, x> >= t}`, `t = cos theta`.
+
+pub mod brdf_target;
+pub mod cap_table;
+pub mod density;
+pub mod envmap;
+pub mod geometry;
+pub mod metrics;
+
+pub use brdf_target::{sample_ggx_vndf, BrdfTarget};
+pub use cap_table::CapMeasureTable;
+pub use density::{
+    parse_direction_spec, CosineDirections, DirectionDensity, DirectionSpecError, UniformDirections,
+};
+pub use envmap::EnvmapDensity;
+pub use geometry::{
+    cosine_cap_measure, random_direction, uniform_hemisphere_cap_measure,
+    uniform_sphere_cap_measure,
+};
+pub use metrics::{
+    cap_l2_for_density, cap_l2_for_density_squared, cap_l2_mc_squared, cap_l2_nonuniform,
+    cap_l2_nonuniform_squared, cap_l2_theta_uniform_estimate, cap_l2_uniform,
+    cap_l2_uniform_squared, cap_star_estimate, cap_star_estimate_with, CapRadius, CapStarEstimate,
+    CapStarOptions,
+};
