@@ -246,6 +246,20 @@ struct SetReport<M: Serialize> {
     final_loss: f64,
 }
 
+/// A SPEC for picture titles: file paths shortened to their file name.
+fn short_spec(spec: &str) -> String {
+    match spec.split_once(':') {
+        Some((kind, path)) if path.contains('/') => {
+            let name = std::path::Path::new(path)
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_else(|| path.to_string());
+            format!("{kind}:{name}")
+        }
+        _ => spec.to_string(),
+    }
+}
+
 /// A progress bar over all epochs of all sets.
 fn progress(total: u64) -> ProgressBar {
     let bar = ProgressBar::new(total);
@@ -382,7 +396,10 @@ fn run_square(a: &OptimizeArgs) -> Result<()> {
     };
     let title = format!(
         "{} — N = {}, D2asd {:.2e} (warped Owen-Sobol {:.2e})",
-        spec, a.n, optimized.asd, base.asd
+        short_spec(&spec),
+        a.n,
+        optimized.asd,
+        base.asd
     );
     write_outputs(
         a,
@@ -480,7 +497,11 @@ fn run_directions(a: &OptimizeArgs) -> Result<()> {
     let ps = PointSets { domain, sets };
     let title = format!(
         "{} ({:?}), N = {}: cap L2 {:.2e} (Owen-Sobol {:.2e})",
-        spec, domain, a.n, optimized.cap_l2, base.cap_l2
+        short_spec(&spec),
+        domain,
+        a.n,
+        optimized.cap_l2,
+        base.cap_l2
     );
     write_outputs(
         a,

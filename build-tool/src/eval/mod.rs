@@ -4,8 +4,8 @@
 //! * Fig. 3: uniform sphere — cap L2 (Stolarsky, exact) and a cap star lower bound.
 //! * Fig. 5: 2D non-uniform targets — asd, L2-star (exact for the target's cell
 //!   tabulation) and exact `D*(mu)`, ours vs warped baselines.
-//! * Fig. 6: directions, non-uniform targets — energy-form cap L2 and the cap star
-//!   lower bound, ours vs baselines warped by the target's standard sampler.
+//! * Fig. 6: directions, non-uniform targets — cap L2 (Monte Carlo over caps with
+//!   exact cap measures) and the cap star lower bound, ours vs baselines warped by the target's standard sampler.
 //! * Fig. 7: integration RMSE over independent realizations
 //!   ([`integrands`] lists the integrands and their reference values).
 //!
@@ -16,7 +16,6 @@
 //! Everything is deterministic given the seeds ([`methods::realization_seed`]).
 
 pub mod cache;
-pub mod cap_energy;
 pub mod figures;
 pub mod integrands;
 pub mod methods;
@@ -113,8 +112,9 @@ pub struct EvalSettings {
     pub cap_star_refine: usize,
     /// Hill-climbing rounds per refined cap.
     pub cap_star_rounds: usize,
-    /// Points of the target's quadrature rule for the non-uniform cap L2.
-    pub cap_quadrature: usize,
+    /// Random caps of the Monte Carlo estimate of the non-uniform cap L2
+    /// discrepancy (per point set; unbiased for `D^2`).
+    pub cap_l2_caps: usize,
     /// Per-pixel midpoint grid side of the `brdf-envmap` reference quadrature.
     pub reference_subdivision: usize,
 }
@@ -123,7 +123,7 @@ impl EvalSettings {
     /// The full settings (the paper's): N up to 4096, 128 / 16 realizations, 1000 /
     /// 5000 epochs (16384 Monte Carlo samples per epoch where areas are estimated),
     /// 20000 random caps with 16 refined over 12 rounds (the sphere module's
-    /// defaults), a 65536-point rule, 8x8 subpixels.
+    /// defaults), 4096 caps for the Monte Carlo cap L2, 8x8 subpixels.
     pub fn full(out: impl Into<PathBuf>, data: impl Into<PathBuf>) -> Self {
         Self {
             out: out.into(),
@@ -138,14 +138,14 @@ impl EvalSettings {
             cap_star_caps: 20_000,
             cap_star_refine: 16,
             cap_star_rounds: 12,
-            cap_quadrature: 65_536,
+            cap_l2_caps: 4096,
             reference_subdivision: 8,
         }
     }
 
     /// The `--quick` settings: N up to 64, 8 / 2 realizations, 200 / 100 epochs
-    /// (4096 Monte Carlo samples), 500 random caps with 4 refined over 6 rounds, a
-    /// 16384-point rule, 4x4 subpixels.
+    /// (4096 Monte Carlo samples), 500 random caps with 4 refined over 6 rounds, 512
+    /// caps for the Monte Carlo cap L2, 4x4 subpixels.
     pub fn quick(out: impl Into<PathBuf>, data: impl Into<PathBuf>) -> Self {
         Self {
             max_n: 64,
@@ -158,7 +158,7 @@ impl EvalSettings {
             cap_star_caps: 500,
             cap_star_refine: 4,
             cap_star_rounds: 6,
-            cap_quadrature: 16_384,
+            cap_l2_caps: 512,
             reference_subdivision: 4,
             ..Self::full(out, data)
         }
@@ -189,7 +189,7 @@ impl EvalSettings {
         );
         ensure!(
             self.cap_star_caps >= 1
-                && self.cap_quadrature >= 1
+                && self.cap_l2_caps >= 1
                 && self.reference_subdivision >= 1
                 && self.direction_mc_samples >= 1,
             "metric settings must be positive"

@@ -98,8 +98,8 @@ pub struct SettingsReport {
     pub cap_star_refine: usize,
     /// Hill-climbing rounds per refined cap.
     pub cap_star_rounds: usize,
-    /// Quadrature points of the non-uniform cap L2.
-    pub cap_l2_quadrature_points: usize,
+    /// Random caps of the Monte Carlo non-uniform cap L2.
+    pub cap_l2_caps: usize,
     /// Subpixel grid side of the `brdf-envmap` reference.
     pub reference_subdivision: usize,
     /// Data directory.
@@ -199,7 +199,7 @@ impl FigureReport {
                 cap_star_random_caps: s.cap_star_caps,
                 cap_star_refine: s.cap_star_refine,
                 cap_star_rounds: s.cap_star_rounds,
-                cap_l2_quadrature_points: s.cap_quadrature,
+                cap_l2_caps: s.cap_l2_caps,
                 reference_subdivision: s.reference_subdivision,
                 data: s.data.display().to_string(),
                 seeds: format!(

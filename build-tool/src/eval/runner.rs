@@ -3,7 +3,6 @@
 //! parallel themselves), then aggregated into [`Row`]s.
 
 use super::cache::{Cache, CacheKey, Values};
-use super::cap_energy::CapL2Energy;
 use super::figures::{Aggregation, Panel, PanelKind};
 use super::methods::{
     method_fingerprint, projected_density, realization_seed, slow_cap_measure, DirectionSampler,
@@ -15,7 +14,10 @@ use crate::baselines::HierarchicalWarp;
 use crate::metrics::summary::{Target, TABULATION_RESOLUTION};
 use crate::optimize::AreaOption;
 use crate::seeding::derive_seed;
-use crate::sphere::{cap_l2_uniform, cap_star_estimate_with, CapStarOptions, DirectionDensity};
+use crate::sphere::{
+    cap_l2_mc_squared, cap_l2_uniform, cap_star_estimate_with, CapRadius, CapStarOptions,
+    DirectionDensity,
+};
 use anyhow::{anyhow, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -27,18 +29,31 @@ type Evaluator<'a> = Box<dyn Fn(Method, usize, u64) -> Result<Values> + Sync + '
 
 /// Stream for the seed of the cap star search of a realization.
 const CAP_STAR_STREAM: u64 = 0xCA95_7A12;
+/// Stream for the caps of the Monte Carlo cap L2 of a realization.
+const CAP_L2_STREAM: u64 = 0xCA91_2B2E;
 
-/// The cap metrics of `points` against `density` (see the figure notes).
+/// The cap metrics of `points` against `density` (see the figure notes): the cap
+/// L2 discrepancy (Stolarsky's closed form for the uniform sphere, else the Monte
+/// Carlo estimate over `s.cap_l2_caps` caps in the same cos-uniform convention) and
+/// the cap star lower bound.
 fn cap_values(
     points: &[glam::DVec3],
     density: &dyn DirectionDensity,
-    energy: Option<&CapL2Energy>,
+    uniform: bool,
     s: &EvalSettings,
     seed: u64,
 ) -> Values {
-    let l2 = match energy {
-        None => cap_l2_uniform(points),
-        Some(e) => e.value(points),
+    let l2 = if uniform {
+        cap_l2_uniform(points)
+    } else {
+        let (d2, _) = cap_l2_mc_squared(
+            points,
+            |w, t| density.cap_measure(w, t),
+            s.cap_l2_caps,
+            derive_seed(seed, CAP_L2_STREAM),
+            CapRadius::CosUniform,
+        );
+        d2.max(0.0).sqrt()
     };
     let options = CapStarOptions {
         random_caps: s.cap_star_caps,
@@ -118,16 +133,17 @@ fn evaluator<'a>(
             (Box::new(f), fp)
         }
         PanelKind::SphereDiscrepancy { density } => {
-            let uniform = density.spec() == "uniform";
+            // Stolarsky's closed form holds for the uniform measure on the sphere.
+            let uniform =
+                density.spec() == "uniform" && density.domain() == nuld_core::blob::Domain::Sphere;
             let star = format!(
                 "{}/{}/{}",
                 s.cap_star_caps, s.cap_star_refine, s.cap_star_rounds
             );
-            let energy = (!uniform).then(|| CapL2Energy::new(density.as_ref(), s.cap_quadrature));
             let fp = if uniform {
                 format!("sph-v1;{};star={}", panel.spec, star)
             } else {
-                format!("sph-v1;{};star={};K={}", panel.spec, star, s.cap_quadrature)
+                format!("sph-v1;{};star={};l2mc={}", panel.spec, star, s.cap_l2_caps)
             };
             let sampler = DirectionSampler {
                 density: density.as_ref(),
@@ -138,7 +154,7 @@ fn evaluator<'a>(
             };
             let f = move |m: Method, n: usize, seed: u64| -> Result<Values> {
                 let pts = sampler.directions(m, n, seed)?;
-                Ok(cap_values(&pts, sampler.density, energy.as_ref(), s, seed))
+                Ok(cap_values(&pts, sampler.density, uniform, s, seed))
             };
             (Box::new(f), fp)
         }
