@@ -14,7 +14,7 @@
 //! sigmoid band from its rim, are counted (or skipped) without touching their
 //! points.
 
-use super::estimator::SIGMOID_BAND;
+use super::estimator::{sigmoid_slope, sum_partials, SIGMOID_BAND};
 use super::GradientPath;
 use glam::{DVec2, DVec3};
 use nuld_core::sphere::sphere_to_square;
@@ -251,8 +251,7 @@ fn rim_gradient(cap: &Cap, x: DVec3, alpha: f64) -> DVec3 {
         return DVec3::ZERO;
     }
     let sdf = cap.theta - d.acos();
-    let e = (-(alpha * sdf).abs()).exp();
-    (alpha * e / ((1.0 + e) * (1.0 + e)) / len) * tangent
+    (sigmoid_slope(alpha, sdf) / len) * tangent
 }
 
 /// How the target measure of a cap is obtained.
@@ -315,16 +314,7 @@ pub fn cap_loss_and_gradient(
         })
         .collect();
     let m = caps.len().max(1) as f64;
-    let scale = 2.0 / (m * n.max(1) as f64);
-    grad.iter_mut().for_each(|g| *g = DVec3::ZERO);
-    let mut loss = 0.0;
-    for (l, g) in partials {
-        loss += l;
-        for (a, b) in grad.iter_mut().zip(g) {
-            *a += b;
-        }
-    }
-    grad.iter_mut().for_each(|g| *g *= scale);
+    let loss = sum_partials(partials, grad, 2.0 / (m * n.max(1) as f64));
     loss / m
 }
 

@@ -76,9 +76,11 @@ pub fn residuals(points: &[DVec2], anchors: &[DVec2], measures: &[[f64; 4]]) -> 
         .collect()
 }
 
-/// `alpha * sigma'(alpha * sdf)` with `sigma'(z) = e^-|z| / (1 + e^-|z|)^2`.
+/// `alpha * sigma'(alpha * sdf)` with `sigma'(z) = e^-|z| / (1 + e^-|z|)^2`: the
+/// derivative of the mollified indicator `sigma(alpha * sdf)` with respect to `sdf`
+/// (paper §3.1), shared by the box and cap estimators.
 #[inline]
-fn sigmoid_slope(alpha: f64, sdf: f64) -> f64 {
+pub(crate) fn sigmoid_slope(alpha: f64, sdf: f64) -> f64 {
     let e = (-(alpha * sdf).abs()).exp();
     alpha * e / ((1.0 + e) * (1.0 + e))
 }
@@ -145,6 +147,25 @@ fn horizontal_face_gradient(p: DVec2, u: DVec2, r: &[f64; 4], alpha: f64) -> DVe
         (r[1], r[3])
     };
     DVec2::new(0.0, slope * (above - below))
+}
+
+/// Sums per-chunk `(loss, gradient)` partials in chunk order into `grad` (then
+/// scaled by `scale`) and returns the summed loss: a fixed-order reduction, so the
+/// result does not depend on how rayon scheduled the chunks.
+pub(crate) fn sum_partials<V>(partials: Vec<(f64, Vec<V>)>, grad: &mut [V], scale: f64) -> f64
+where
+    V: Copy + Default + std::ops::AddAssign + std::ops::MulAssign<f64>,
+{
+    grad.iter_mut().for_each(|g| *g = V::default());
+    let mut loss = 0.0;
+    for (l, g) in partials {
+        loss += l;
+        for (a, b) in grad.iter_mut().zip(g) {
+            *a += b;
+        }
+    }
+    grad.iter_mut().for_each(|g| *g *= scale);
+    loss
 }
 
 /// Points sorted along one axis, with their original indices.
@@ -235,16 +256,7 @@ pub fn loss_and_gradient(
             (loss, g)
         })
         .collect();
-    let scale = 2.0 / (m_boxes * n as f64);
-    grad.iter_mut().for_each(|g| *g = DVec2::ZERO);
-    let mut loss = 0.0;
-    for (l, g) in partials {
-        loss += l;
-        for (a, b) in grad.iter_mut().zip(g) {
-            *a += b;
-        }
-    }
-    grad.iter_mut().for_each(|g| *g *= scale);
+    let loss = sum_partials(partials, grad, 2.0 / (m_boxes * n as f64));
     loss / m_boxes
 }
 

@@ -193,3 +193,58 @@ pub fn optimize_directions(
     }
     params
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sphere::parse_direction_spec;
+
+    fn run(threads: usize, domain: Domain, spec: &str, seed: u64) -> (Vec<DVec2>, Vec<f64>) {
+        let density = parse_direction_spec(spec, domain).unwrap();
+        let cfg = DirectionConfig {
+            epochs: 300,
+            caps: 300,
+            seed,
+            ..DirectionConfig::default()
+        };
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut losses = Vec::new();
+        let pts = pool.install(|| {
+            optimize_directions(density.as_ref(), 200, &cfg, &mut |r| losses.push(r.loss))
+        });
+        (pts, losses)
+    }
+
+    #[test]
+    fn same_seed_gives_bit_identical_directions_for_any_thread_count() {
+        let bits = |v: &[DVec2]| {
+            v.iter()
+                .flat_map(|p| [p.x.to_bits(), p.y.to_bits()])
+                .collect::<Vec<_>>()
+        };
+        let (a, _) = run(1, Domain::Sphere, "uniform", 4);
+        let (b, _) = run(2, Domain::Sphere, "uniform", 4);
+        assert_eq!(bits(&a), bits(&b));
+        let (c, _) = run(2, Domain::Sphere, "uniform", 5);
+        assert_ne!(bits(&a), bits(&c));
+    }
+
+    #[test]
+    fn optimization_lowers_the_cap_loss_and_stays_in_the_domain() {
+        for (domain, spec) in [(Domain::Sphere, "uniform"), (Domain::Hemisphere, "cosine")] {
+            let (pts, losses) = run(2, domain, spec, 1);
+            assert!(pts
+                .iter()
+                .all(|p| (0.0..=1.0).contains(&p.x) && (0.0..=1.0).contains(&p.y)));
+            if domain == Domain::Hemisphere {
+                assert!(pts.iter().all(|&p| to_direction(domain, p).z >= 0.0));
+            }
+            let head: f64 = losses[..30].iter().sum::<f64>() / 30.0;
+            let tail: f64 = losses[losses.len() - 30..].iter().sum::<f64>() / 30.0;
+            assert!(tail < 0.85 * head, "{spec}: {head} -> {tail}");
+        }
+    }
+}
