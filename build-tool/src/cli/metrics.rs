@@ -2,7 +2,7 @@
 //! target. The domain is read from the blob.
 
 use crate::density::parse_spec;
-use crate::metrics::cap_summary::{evaluate_directions, method_note, CapMetricSummary};
+use crate::metrics::cap_summary::{CapMetricSummary, CapTarget};
 use crate::metrics::summary::{MetricSummary, Target};
 use crate::pointset::AlignedBytes;
 use crate::sphere::parse_direction_spec;
@@ -78,12 +78,13 @@ pub fn run(a: MetricsArgs) -> Result<()> {
             let dirs = blob.direction_set().map_err(|e| anyhow!("{file}: {e}"))?;
             let density = parse_direction_spec(&a.density, dirs.domain())
                 .with_context(|| format!("--density {}", a.density))?;
+            let target = CapTarget::new(density.as_ref());
             let per_set: Vec<CapMetricSummary> = (0..dirs.set_count())
                 .map(|s| {
                     let set: Vec<DVec3> = (0..dirs.len())
                         .map(|i| dirs.direction(s, i).as_dvec3().normalize())
                         .collect();
-                    evaluate_directions(density.as_ref(), &set)
+                    target.evaluate(&set)
                 })
                 .collect();
             let out = MetricsOutput {
@@ -91,7 +92,7 @@ pub fn run(a: MetricsArgs) -> Result<()> {
                 density: &a.density,
                 domain: format!("{:?}", dirs.domain()).to_lowercase(),
                 n: dirs.len(),
-                method: method_note(density.as_ref()),
+                method: target.method(),
                 mean: CapMetricSummary::mean(&per_set),
                 per_set,
             };

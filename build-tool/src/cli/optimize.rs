@@ -5,7 +5,7 @@
 use super::DomainArg;
 use crate::density::{parse_spec, Density2D};
 use crate::discrepancy::GradientPath;
-use crate::metrics::cap_summary::{evaluate_directions, method_note, CapMetricSummary};
+use crate::metrics::cap_summary::{CapMetricSummary, CapTarget};
 use crate::metrics::summary::{MetricSummary, Target};
 use crate::optimize::directions::{
     initial_square_points, optimize_directions, to_direction, DirectionConfig,
@@ -444,7 +444,8 @@ fn run_directions(a: &OptimizeArgs) -> Result<()> {
     let dirs_of = |square: &[DVec2]| -> Vec<DVec3> {
         square.iter().map(|&p| to_direction(domain, p)).collect()
     };
-    let evaluate = |square: &[DVec2]| evaluate_directions(density.as_ref(), &dirs_of(square));
+    let target = CapTarget::new(density.as_ref());
+    let evaluate = |square: &[DVec2]| target.evaluate(&dirs_of(square));
     let per_set: Vec<SetReport<CapMetricSummary>> = sets
         .iter()
         .zip(&losses)
@@ -482,7 +483,7 @@ fn run_directions(a: &OptimizeArgs) -> Result<()> {
         threads: rayon::current_num_threads(),
         wall_time_s: started.elapsed().as_secs_f64(),
         optimize_time_s: optimize_time,
-        metric_method: method_note(density.as_ref()),
+        metric_method: target.method(),
         per_set,
         optimized_mean: optimized,
         baseline_warped_owen_sobol_mean: base,

@@ -1,7 +1,6 @@
 //! The metrics of one direction set against one target, as `optimize` and
 //! `metrics` report them for the sphere and hemisphere domains.
 
-use crate::optimize::directions::has_closed_form_caps;
 use crate::sphere::{
     cap_l2_for_density, cap_l2_theta_uniform_estimate, cap_l2_uniform, cap_star_estimate,
     CapMeasureTable, DirectionDensity,
@@ -55,43 +54,71 @@ pub const TABLE_POINTS: usize = 1 << 18;
 /// Random caps (before refinement) for the cap star estimate.
 pub const STAR_CAPS: usize = 20_000;
 
-/// Evaluates direction sets against `density` with fixed estimator seeds (so two
-/// sets are compared on the same caps).
-pub fn evaluate_directions(density: &dyn DirectionDensity, points: &[DVec3]) -> CapMetricSummary {
-    let cap_l2 =
-        if density.spec() == "uniform" && density.domain() == nuld_core::blob::Domain::Sphere {
+/// A direction target prepared for evaluation: the cap-measure table of a target
+/// without closed-form cap measures is built once and reused for every set.
+pub struct CapTarget<'a> {
+    density: &'a dyn DirectionDensity,
+    table: Option<CapMeasureTable>,
+}
+
+impl<'a> CapTarget<'a> {
+    /// Prepares `density` (builds its [`TABLE_POINTS`]-point table if needed).
+    pub fn new(density: &'a dyn DirectionDensity) -> Self {
+        let table = (!density.has_closed_form_caps())
+            .then(|| CapMeasureTable::new(&density.quadrature(TABLE_POINTS)));
+        Self { density, table }
+    }
+
+    fn stolarsky(&self) -> bool {
+        self.density.spec() == "uniform" && self.density.domain() == nuld_core::blob::Domain::Sphere
+    }
+
+    /// The metrics of `points`, with fixed estimator seeds (so two sets are compared
+    /// on the same caps).
+    pub fn evaluate(&self, points: &[DVec3]) -> CapMetricSummary {
+        let density = self.density;
+        let cap_l2 = if self.stolarsky() {
             cap_l2_uniform(points)
         } else {
             cap_l2_for_density(points, density, CAP_QUADRATURE_POINTS)
         };
-    let (theta, se) = if has_closed_form_caps(density) {
-        cap_l2_theta_uniform_estimate(points, |c, t| density.cap_measure(c, t), THETA_CAPS, 0x7e7a)
-    } else {
-        let table = CapMeasureTable::new(&density.quadrature(TABLE_POINTS));
-        cap_l2_theta_uniform_estimate(points, |c, t| table.measure(c, t), THETA_CAPS, 0x7e7a)
-    };
-    CapMetricSummary {
-        cap_l2,
-        cap_l2_theta: theta,
-        cap_l2_theta_stderr: se,
-        cap_star_lower_bound: cap_star_estimate(points, density, STAR_CAPS, 0x57a2).lower_bound,
+        let (theta, se) = match &self.table {
+            None => cap_l2_theta_uniform_estimate(
+                points,
+                |c, t| density.cap_measure(c, t),
+                THETA_CAPS,
+                0x7e7a,
+            ),
+            Some(table) => cap_l2_theta_uniform_estimate(
+                points,
+                |c, t| table.measure(c, t),
+                THETA_CAPS,
+                0x7e7a,
+            ),
+        };
+        CapMetricSummary {
+            cap_l2,
+            cap_l2_theta: theta,
+            cap_l2_theta_stderr: se,
+            cap_star_lower_bound: cap_star_estimate(points, density, STAR_CAPS, 0x57a2).lower_bound,
+        }
     }
-}
 
-/// One line saying how [`evaluate_directions`] computed its numbers.
-pub fn method_note(density: &dyn DirectionDensity) -> String {
-    let l2 = if density.spec() == "uniform" && density.domain() == nuld_core::blob::Domain::Sphere {
-        "Stolarsky closed form".to_string()
-    } else {
-        format!("energy form with a {CAP_QUADRATURE_POINTS}-point quadrature of the target")
-    };
-    let theta = if has_closed_form_caps(density) {
-        "closed-form cap measures".to_string()
-    } else {
-        format!("cap measures from a {TABLE_POINTS}-point quadrature table")
-    };
-    format!(
-        "cap_l2: t = cos(theta) uniform, {l2}; cap_l2_theta: paper's Eq. 9, {THETA_CAPS} random caps, {theta}; \
-         cap_star_lower_bound: max over {STAR_CAPS} random caps plus local refinement"
-    )
+    /// One line saying how [`CapTarget::evaluate`] computed its numbers.
+    pub fn method(&self) -> String {
+        let l2 = if self.stolarsky() {
+            "Stolarsky closed form".to_string()
+        } else {
+            format!("energy form with a {CAP_QUADRATURE_POINTS}-point quadrature of the target")
+        };
+        let theta = if self.table.is_none() {
+            "closed-form cap measures".to_string()
+        } else {
+            format!("cap measures from a {TABLE_POINTS}-point quadrature table")
+        };
+        format!(
+            "cap_l2: t = cos(theta) uniform, {l2}; cap_l2_theta: paper's Eq. 9, {THETA_CAPS} random caps, {theta}; \
+             cap_star_lower_bound: max over {STAR_CAPS} random caps plus local refinement"
+        )
+    }
 }

@@ -99,12 +99,6 @@ fn map_jacobian(domain: Domain, p: DVec2) -> (DVec3, DVec3) {
     )
 }
 
-/// Whether `density`'s cap measure is a cheap closed form (`uniform`, `cosine`);
-/// tabulated targets (`brdf`, `envmap`) go through a [`CapMeasureTable`].
-pub fn has_closed_form_caps(density: &dyn DirectionDensity) -> bool {
-    matches!(density.spec().as_str(), "uniform" | "cosine")
-}
-
 /// The starting set: Owen-Sobol points warped by the target's standard sampler,
 /// expressed in the domain's equal-area square.
 pub fn initial_square_points(density: &dyn DirectionDensity, n: usize, seed: u64) -> Vec<DVec2> {
@@ -132,7 +126,7 @@ pub fn optimize_directions(
     let spacing = (area_of_domain / n as f64).sqrt();
     // Square units per radian: the equal-area map scales areas by 1/area_of_domain.
     let square_per_radian = 1.0 / area_of_domain.sqrt();
-    let table = (!has_closed_form_caps(density))
+    let table = (!density.has_closed_form_caps())
         .then(|| CapMeasureTable::new(&density.quadrature(config.table_points)));
     let exact = |c: DVec3, t: f64| match &table {
         Some(table) => table.measure(c, t),

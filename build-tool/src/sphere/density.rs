@@ -55,6 +55,13 @@ pub trait DirectionDensity: Send + Sync {
         self.sample(u)
     }
 
+    /// Whether [`DirectionDensity::cap_measure`] is a cheap closed form. Targets
+    /// without one (tabulated: `brdf`, `envmap`) are served from a
+    /// [`super::CapMeasureTable`] by optimizers and estimators that need many caps.
+    fn has_closed_form_caps(&self) -> bool {
+        false
+    }
+
     /// Target measure `mu(C)` of the cap `C = {x : <center, x> >= cos_theta}`;
     /// `center` is normalized here, `cos_theta` is clamped into `[-1, 1]`.
     fn cap_measure(&self, center: DVec3, cos_theta: f64) -> f64;
@@ -331,6 +338,10 @@ pub struct UniformDirections {
 }
 
 impl DirectionDensity for UniformDirections {
+    fn has_closed_form_caps(&self) -> bool {
+        true
+    }
+
     fn spec(&self) -> String {
         "uniform".to_string()
     }
@@ -380,6 +391,10 @@ pub struct CosineDirections {
 }
 
 impl DirectionDensity for CosineDirections {
+    fn has_closed_form_caps(&self) -> bool {
+        true
+    }
+
     fn spec(&self) -> String {
         "cosine".to_string()
     }
