@@ -96,6 +96,16 @@ fn check_outputs(out: &Path, fig: &str, metrics: &[&str]) -> usize {
             assert!(out.join(&name).is_file(), "{name}");
         }
     }
+    // One summary line per (target, metric), each naming ours' value and a ratio.
+    let summary = std::fs::read_to_string(out.join(format!("{fig}-summary.md"))).unwrap();
+    let lines: Vec<&str> = summary.lines().skip(2).collect();
+    assert_eq!(lines.len(), targets.len() * metrics.len(), "{summary}");
+    for l in lines {
+        assert!(
+            l.starts_with(&format!("| {fig} | ")) && l.ends_with("/4 |"),
+            "{l}"
+        );
+    }
     rows
 }
 

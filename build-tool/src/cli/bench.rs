@@ -1,6 +1,7 @@
 //! `build-tool bench`: the optimizer's speed, fast banded gradient against the dense
 //! reference, and the wall time of full default runs.
 
+use crate::baselines::Baseline;
 use crate::density::parse_spec;
 use crate::discrepancy::GradientPath;
 use crate::optimize::directions::{optimize_directions, DirectionConfig};
@@ -50,6 +51,8 @@ pub enum BenchPart {
     Square,
     /// Only the direction optimizer.
     Directions,
+    /// Only the baseline generators (milliseconds per set; not part of `all`).
+    Baselines,
 }
 
 fn direction_seconds_per_epoch(
@@ -139,11 +142,40 @@ fn full_run(spec: &str, n: usize, area: AreaOption) -> Result<f64> {
 
 /// Runs `build-tool bench`.
 pub fn run(a: BenchArgs) -> Result<()> {
-    if a.only != BenchPart::Directions {
-        run_square(&a)?;
+    match a.only {
+        BenchPart::All => {
+            run_square(&a)?;
+            run_directions(&a)
+        }
+        BenchPart::Square => run_square(&a),
+        BenchPart::Directions => run_directions(&a),
+        BenchPart::Baselines => run_baselines(&a),
     }
-    if a.only != BenchPart::Square {
-        run_directions(&a)?;
+}
+
+/// Milliseconds per uniform set of every baseline generator (one set per size,
+/// seed 1; SOT and GBN at their default iteration counts): what the evaluation
+/// harness pays per realization before any metric.
+fn run_baselines(a: &BenchArgs) -> Result<()> {
+    println!(
+        "baseline generators, ms per uniform 2D set, {} rayon threads",
+        rayon::current_num_threads()
+    );
+    print!("{:<14}", "method");
+    for n in &a.sizes {
+        print!(" {:>10}", format!("N={n}"));
+    }
+    println!();
+    for b in Baseline::ALL {
+        print!("{:<14}", b.name());
+        for &n in &a.sizes {
+            let t = Instant::now();
+            let pts = b.generate(n, 1);
+            let ms = t.elapsed().as_secs_f64() * 1e3;
+            anyhow::ensure!(pts.len() == n, "{b} made {} points, not {n}", pts.len());
+            print!(" {ms:>10.2}");
+        }
+        println!();
     }
     Ok(())
 }

@@ -107,6 +107,7 @@ pub fn run(a: EvalArgs) -> Result<()> {
     for f in figures {
         let started = Instant::now();
         let rep = run_figure(f, &s)?;
+        print!("{}", rep.summary_markdown());
         eprintln!(
             "{f}: {} rows, {} panel(s){} in {:.1} s -> {}",
             rep.rows.len(),

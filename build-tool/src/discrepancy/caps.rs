@@ -261,6 +261,10 @@ pub enum CapArea<'a> {
     Exact(&'a (dyn Fn(DVec3, f64) -> f64 + Sync)),
     /// The fraction of shared target samples (in a [`CapTree`]) inside the cap.
     MonteCarlo(&'a CapTree),
+    /// Measures computed beforehand, `mu(caps[i])` at index `i` (same length as the
+    /// caps): how a precomputed cap schedule shares one table lookup per cap among
+    /// many optimizations.
+    Precomputed(&'a [f64]),
 }
 
 /// Fixed number of work chunks (results are summed in chunk order).
@@ -269,6 +273,9 @@ const CHUNKS: usize = 32;
 /// Residuals `r_c = count / N - mu(C_c)` of every cap, loss `(1/M) sum r^2` and its
 /// surrogate gradient with respect to each point (ambient, tangent to the sphere),
 /// written to `grad`. Bit-identical for any thread count.
+///
+/// # Panics
+/// If `area` is [`CapArea::Precomputed`] with a length other than `caps.len()`.
 pub fn cap_loss_and_gradient(
     points: &[DVec3],
     caps: &[Cap],
@@ -282,15 +289,20 @@ pub fn cap_loss_and_gradient(
     let band = SIGMOID_BAND / alpha;
     let tree = (path == GradientPath::Fast).then(|| CapTree::new(points));
     let chunk = caps.len().div_ceil(CHUNKS).max(1);
+    if let CapArea::Precomputed(mu) = area {
+        assert_eq!(mu.len(), caps.len(), "one precomputed measure per cap");
+    }
     let partials: Vec<(f64, Vec<DVec3>)> = caps
         .par_chunks(chunk)
-        .map(|cs| {
+        .enumerate()
+        .map(|(ci, cs)| {
             let mut g = vec![DVec3::ZERO; n];
             let mut loss = 0.0;
             let mut rim: Vec<(usize, DVec3)> = Vec::new();
-            for cap in cs {
+            for (j, cap) in cs.iter().enumerate() {
                 let mu = match area {
                     CapArea::Exact(f) => f(cap.center, cap.cos_theta),
+                    CapArea::Precomputed(mu) => mu[ci * chunk + j],
                     CapArea::MonteCarlo(samples) => {
                         samples.query(cap, 0.0, |_, _| {}) as f64
                             / samples.points.len().max(1) as f64

@@ -9,13 +9,17 @@ use crate::baselines::{
     GBN_DEFAULT_ITERATIONS, SOT_DEFAULT_ITERATIONS,
 };
 use crate::density::{Density2D, TabulatedDensity};
-use crate::optimize::directions::{optimize_directions, to_direction, DirectionConfig};
+use crate::optimize::directions::{
+    optimize_directions, optimize_directions_scheduled, to_direction, CapSchedule, DirectionConfig,
+};
 use crate::optimize::{optimize, AreaOption, OptimizeConfig};
 use crate::seeding::derive_seed;
 use crate::sphere::DirectionDensity;
 use anyhow::Result;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
 
 /// Base seed of the evaluation: realization `r` uses [`realization_seed`]`(r)`.
 pub const EVAL_SEED: u64 = 0x5EED_E7A1;
@@ -229,12 +233,26 @@ pub fn projected_density(density: &dyn DirectionDensity) -> Result<TabulatedDens
     Ok(TabulatedDensity::from_grid(m, m, values)?)
 }
 
-/// Whether `density`'s exact cap measure is too slow for our optimizer's 1024 caps
-/// per epoch (environment maps: `O(H)` per cap, about 0.3–0.7 ms for 1024x512, so
-/// an epoch takes about 0.35 s on 2 cores); such targets are optimized with Monte
-/// Carlo cap areas (paper Eq. 11) instead.
-pub fn slow_cap_measure(density: &dyn DirectionDensity) -> bool {
-    density.spec().starts_with("envmap:")
+/// Our direction optimizer's [`CapSchedule`]s for a target without closed-form cap
+/// measures, one per seed, kept while a panel runs: every size of a realization
+/// shares its seed's schedule, so the table lookups are paid once per realization
+/// instead of once per (realization, N). About 8 bytes x epochs x caps each (41 MB
+/// at the full settings).
+#[derive(Default)]
+pub struct ScheduleMemo(Mutex<HashMap<u64, Arc<CapSchedule>>>);
+
+impl ScheduleMemo {
+    /// The schedule of `config` for `density`, built on first use.
+    fn get(&self, density: &dyn DirectionDensity, config: &DirectionConfig) -> Arc<CapSchedule> {
+        let mut memo = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        let s = memo
+            .entry(config.seed)
+            .or_insert_with(|| Arc::new(CapSchedule::new(density, config)));
+        if !s.matches(config) {
+            *s = Arc::new(CapSchedule::new(density, config));
+        }
+        Arc::clone(s)
+    }
 }
 
 /// A direction target as methods see it.
@@ -243,10 +261,12 @@ pub struct DirectionSampler<'a> {
     pub density: &'a dyn DirectionDensity,
     /// Its projection to the square (non-uniform targets that SOT / GBN need).
     pub projected: Option<TabulatedDensity>,
-    /// Epochs of our direction optimizer.
+    /// Epochs of our direction optimizer (cap measures always
+    /// [exact](AreaOption::Exact): closed forms, or the density's quadrature table
+    /// through a [`ScheduleMemo`]).
     pub epochs: usize,
-    /// How our direction optimizer computes cap areas.
-    pub area: AreaOption,
+    /// Cap schedules of targets without closed-form cap measures.
+    pub schedules: ScheduleMemo,
     /// Point cache.
     pub cache: &'a Cache,
 }
@@ -277,18 +297,29 @@ impl DirectionSampler<'_> {
                 let fp = format!(
                     "v1;{spec};{};area={:?}",
                     method_fingerprint(method, self.epochs),
-                    self.area
+                    AreaOption::Exact
                 );
                 let sq = match self.cache.get_points(&group, n, seed, &fp) {
                     Some(p) => p,
                     None => {
                         let cfg = DirectionConfig {
                             epochs: self.epochs,
-                            area: self.area,
+                            area: AreaOption::Exact,
                             seed,
                             ..DirectionConfig::default()
                         };
-                        let p = optimize_directions(self.density, n, &cfg, &mut |_| {});
+                        let p = if self.density.has_closed_form_caps() {
+                            optimize_directions(self.density, n, &cfg, &mut |_| {})
+                        } else {
+                            let schedule = self.schedules.get(self.density, &cfg);
+                            optimize_directions_scheduled(
+                                self.density,
+                                n,
+                                &cfg,
+                                &schedule,
+                                &mut |_| {},
+                            )
+                        };
                         self.cache.put_points(&group, seed, &fp, &p)?;
                         p
                     }
@@ -365,7 +396,7 @@ mod tests {
             density: u.as_ref(),
             projected: Some(projected_density(u.as_ref()).unwrap()),
             epochs: 5,
-            area: AreaOption::Exact,
+            schedules: ScheduleMemo::default(),
             cache: &cache,
         };
         for m in [

@@ -12,7 +12,8 @@
 //! [`figures`] defines every figure's panels (targets, methods, metrics),
 //! [`runner`] evaluates them with an on-disk [`cache`] of per-realization results
 //! (reruns skip finished work and reproduce the output byte for byte), and
-//! [`report`] writes `figN.csv`, `figN.json` and `figN-<target>-<metric>.png`.
+//! [`report`] writes `figN.csv`, `figN.json`, `figN-<target>-<metric>.png` and
+//! `figN-summary.md` ([`summary`]: ours against the best other method).
 //! Everything is deterministic given the seeds ([`methods::realization_seed`]).
 
 pub mod cache;
@@ -22,6 +23,7 @@ pub mod methods;
 pub mod report;
 pub mod runner;
 pub mod stats;
+pub mod summary;
 
 use anyhow::{ensure, Result};
 use serde::Serialize;
@@ -101,10 +103,6 @@ pub struct EvalSettings {
     pub epochs: usize,
     /// Epochs of our direction optimizer (paper: 5000).
     pub direction_epochs: usize,
-    /// Target samples per epoch when our direction optimizer uses Monte Carlo cap
-    /// areas (paper Eq. 11): only for targets whose exact cap measure is too slow
-    /// to call 1024 times an epoch ([`methods::slow_cap_measure`]: environment maps).
-    pub direction_mc_samples: usize,
     /// Random caps of the cap star discrepancy search (then refined).
     pub cap_star_caps: usize,
     /// Best random caps refined by the cap star search (radius sweeps and hill
@@ -121,7 +119,7 @@ pub struct EvalSettings {
 
 impl EvalSettings {
     /// The full settings (the paper's): N up to 4096, 128 / 16 realizations, 1000 /
-    /// 5000 epochs (16384 Monte Carlo samples per epoch where areas are estimated),
+    /// 5000 epochs,
     /// 20000 random caps with 16 refined over 12 rounds (the sphere module's
     /// defaults), 4096 caps for the Monte Carlo cap L2, 8x8 subpixels.
     pub fn full(out: impl Into<PathBuf>, data: impl Into<PathBuf>) -> Self {
@@ -134,7 +132,6 @@ impl EvalSettings {
             realizations_ours: 16,
             epochs: 1000,
             direction_epochs: 5000,
-            direction_mc_samples: 16_384,
             cap_star_caps: 20_000,
             cap_star_refine: 16,
             cap_star_rounds: 12,
@@ -143,8 +140,7 @@ impl EvalSettings {
         }
     }
 
-    /// The `--quick` settings: N up to 64, 8 / 2 realizations, 200 / 100 epochs
-    /// (4096 Monte Carlo samples), 500 random caps with 4 refined over 6 rounds, 512
+    /// The `--quick` settings: N up to 64, 8 / 2 realizations, 200 / 100 epochs, 500 random caps with 4 refined over 6 rounds, 512
     /// caps for the Monte Carlo cap L2, 4x4 subpixels.
     pub fn quick(out: impl Into<PathBuf>, data: impl Into<PathBuf>) -> Self {
         Self {
@@ -154,7 +150,6 @@ impl EvalSettings {
             realizations_ours: 2,
             epochs: 200,
             direction_epochs: 100,
-            direction_mc_samples: 4096,
             cap_star_caps: 500,
             cap_star_refine: 4,
             cap_star_rounds: 6,
@@ -188,10 +183,7 @@ impl EvalSettings {
             "epochs must be at least 1"
         );
         ensure!(
-            self.cap_star_caps >= 1
-                && self.cap_l2_caps >= 1
-                && self.reference_subdivision >= 1
-                && self.direction_mc_samples >= 1,
+            self.cap_star_caps >= 1 && self.cap_l2_caps >= 1 && self.reference_subdivision >= 1,
             "metric settings must be positive"
         );
         Ok(())

@@ -1,5 +1,5 @@
-//! The outputs of a figure: `figN.csv`, `figN.json` and one log-log PNG per
-//! (target, metric), all written atomically.
+//! The outputs of a figure: `figN.csv`, `figN.json`, `figN-summary.md` and one
+//! log-log PNG per (target, metric), all written atomically.
 
 use super::cache::sanitize;
 use super::figures::{MetricDef, Panel, Skipped};
@@ -90,8 +90,6 @@ pub struct SettingsReport {
     pub epochs_2d: usize,
     /// Epochs of the direction optimizer.
     pub epochs_directions: usize,
-    /// Monte Carlo samples per epoch of the direction optimizer (envmap targets).
-    pub direction_mc_samples: usize,
     /// Random caps of the cap star search.
     pub cap_star_random_caps: usize,
     /// Caps refined by the cap star search.
@@ -195,7 +193,6 @@ impl FigureReport {
                 realizations_ours: s.realizations_ours,
                 epochs_2d: s.epochs,
                 epochs_directions: s.direction_epochs,
-                direction_mc_samples: s.direction_mc_samples,
                 cap_star_random_caps: s.cap_star_caps,
                 cap_star_refine: s.cap_star_refine,
                 cap_star_rounds: s.cap_star_rounds,
@@ -228,7 +225,13 @@ impl FigureReport {
         out
     }
 
-    /// Writes `figN.csv`, `figN.json` and the plots into `dir`; returns the paths.
+    /// The [`summary`](super::summary) of the rows as a Markdown table.
+    pub fn summary_markdown(&self) -> String {
+        super::summary::markdown(&self.figure, &super::summary::summarize(&self.rows))
+    }
+
+    /// Writes `figN.csv`, `figN.json`, `figN-summary.md` and the plots into `dir`;
+    /// returns the paths.
     pub fn write(&self, dir: &Path, panels: &[Panel]) -> Result<Vec<PathBuf>> {
         let mut written = Vec::new();
         let csv = dir.join(format!("{}.csv", self.figure));
@@ -239,6 +242,9 @@ impl FigureReport {
         text.push('\n');
         crate::output::write_atomic(&json, text.as_bytes())?;
         written.push(json);
+        let summary = dir.join(format!("{}-summary.md", self.figure));
+        crate::output::write_atomic(&summary, self.summary_markdown().as_bytes())?;
+        written.push(summary);
         let figure = Figure::ALL
             .into_iter()
             .find(|f| f.name() == self.figure)

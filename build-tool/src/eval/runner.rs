@@ -5,14 +5,13 @@
 use super::cache::{Cache, CacheKey, Values};
 use super::figures::{Aggregation, Panel, PanelKind};
 use super::methods::{
-    method_fingerprint, projected_density, realization_seed, slow_cap_measure, DirectionSampler,
-    Method, SquareSampler, SquareWarp,
+    method_fingerprint, projected_density, realization_seed, DirectionSampler, Method,
+    SquareSampler, SquareWarp,
 };
 use super::report::Row;
 use super::{stats, EvalSettings, Figure};
 use crate::baselines::HierarchicalWarp;
 use crate::metrics::summary::{Target, TABULATION_RESOLUTION};
-use crate::optimize::AreaOption;
 use crate::seeding::derive_seed;
 use crate::sphere::{
     cap_l2_mc_squared, cap_l2_uniform, cap_star_estimate_with, CapRadius, CapStarOptions,
@@ -73,18 +72,6 @@ fn cap_values(
     ]
     .into_iter()
     .collect()
-}
-
-/// How our direction optimizer gets cap areas for `density` (see
-/// [`slow_cap_measure`]).
-pub fn direction_area(density: &dyn DirectionDensity, s: &EvalSettings) -> AreaOption {
-    if slow_cap_measure(density) {
-        AreaOption::MonteCarlo {
-            samples: s.direction_mc_samples,
-        }
-    } else {
-        AreaOption::Exact
-    }
 }
 
 /// The evaluator of `panel` and the panel part of the cache fingerprint.
@@ -149,7 +136,7 @@ fn evaluator<'a>(
                 density: density.as_ref(),
                 projected: None,
                 epochs: s.direction_epochs,
-                area: direction_area(density.as_ref(), s),
+                schedules: Default::default(),
                 cache,
             };
             let f = move |m: Method, n: usize, seed: u64| -> Result<Values> {
@@ -187,7 +174,7 @@ fn evaluator<'a>(
                 density,
                 projected,
                 epochs: s.direction_epochs,
-                area: direction_area(density, s),
+                schedules: Default::default(),
                 cache,
             };
             let f = move |m: Method, n: usize, seed: u64| -> Result<Values> {

@@ -109,11 +109,131 @@ pub fn initial_square_points(density: &dyn DirectionDensity, n: usize, seed: u64
         .collect()
 }
 
+/// The caps of epoch `epoch` for seed `seed`: `count` points of a freshly
+/// scrambled 3D Owen-Sobol set mapped by [`Cap::from_unit_cube`] (independent of
+/// the point count, so every size shares them).
+fn epoch_caps(seed: u64, epoch: usize, count: usize) -> Vec<Cap> {
+    let scramble = derive_seed(seed, 2 * epoch as u64 + 1) as u32;
+    (0..count)
+        .map(|i| {
+            let (idx, dim) = ((i % (1 << 16)) as u32, 3 * (i >> 16) as u32);
+            Cap::from_unit_cube(DVec3::new(
+                sobol_burley::sample(idx, dim, scramble) as f64,
+                sobol_burley::sample(idx, dim + 1, scramble) as f64,
+                sobol_burley::sample(idx, dim + 2, scramble) as f64,
+            ))
+        })
+        .collect()
+}
+
+/// The target measure of a cap as the optimizer sees it with
+/// [`AreaOption::Exact`]: the closed form where the density has one, else its
+/// [`CapMeasureTable`] over `table_points` quadrature points.
+struct ExactCapMeasure<'a> {
+    density: &'a dyn DirectionDensity,
+    table: Option<CapMeasureTable>,
+}
+
+impl<'a> ExactCapMeasure<'a> {
+    fn new(density: &'a dyn DirectionDensity, table_points: usize) -> Self {
+        let table = (!density.has_closed_form_caps())
+            .then(|| CapMeasureTable::new(&density.quadrature(table_points)));
+        Self { density, table }
+    }
+
+    fn measure(&self, c: DVec3, t: f64) -> f64 {
+        match &self.table {
+            Some(table) => table.measure(c, t),
+            None => self.density.cap_measure(c, t),
+        }
+    }
+}
+
+/// Every cap measure of a run, computed once: the caps of each epoch depend only
+/// on the seed, the epoch and the cap count, never on `N`, so runs of many sizes
+/// with one seed can share them. For targets without closed-form cap measures
+/// (`brdf`, `envmap`) the table lookups cost more than the rest of an epoch; a
+/// schedule pays them once per seed instead of once per run, with bit-identical
+/// results ([`optimize_directions_scheduled`]).
+pub struct CapSchedule {
+    seed: u64,
+    epochs: usize,
+    caps: usize,
+    table_points: usize,
+    /// `mu` of cap `i` of epoch `e` at `e * caps + i`.
+    measures: Vec<f64>,
+}
+
+impl CapSchedule {
+    /// The schedule of `config` (its seed, epochs, caps and table size) for
+    /// `density`; `epochs * caps` measures (8 bytes each), computed in parallel.
+    pub fn new(density: &dyn DirectionDensity, config: &DirectionConfig) -> Self {
+        use rayon::prelude::*;
+        let exact = ExactCapMeasure::new(density, config.table_points);
+        let per_epoch: Vec<Vec<f64>> = (0..config.epochs)
+            .into_par_iter()
+            .map(|e| {
+                epoch_caps(config.seed, e, config.caps)
+                    .iter()
+                    .map(|c| exact.measure(c.center, c.cos_theta))
+                    .collect()
+            })
+            .collect();
+        Self {
+            seed: config.seed,
+            epochs: config.epochs,
+            caps: config.caps,
+            table_points: config.table_points,
+            measures: per_epoch.concat(),
+        }
+    }
+
+    /// Whether this schedule holds the cap measures `config` would compute.
+    pub fn matches(&self, config: &DirectionConfig) -> bool {
+        config.area == AreaOption::Exact
+            && (self.seed, self.epochs, self.caps, self.table_points)
+                == (config.seed, config.epochs, config.caps, config.table_points)
+    }
+
+    fn epoch(&self, e: usize) -> &[f64] {
+        &self.measures[e * self.caps..(e + 1) * self.caps]
+    }
+}
+
 /// Optimizes `n` directions for `density`; returns their equal-area square points.
 pub fn optimize_directions(
     density: &dyn DirectionDensity,
     n: usize,
     config: &DirectionConfig,
+    on_epoch: &mut dyn FnMut(&EpochReport),
+) -> Vec<DVec2> {
+    run(density, n, config, None, on_epoch)
+}
+
+/// [`optimize_directions`] with the cap measures taken from `schedule`: the same
+/// output bit for bit, without the per-cap table lookups.
+///
+/// # Panics
+/// If the schedule does not [match](CapSchedule::matches) `config`.
+pub fn optimize_directions_scheduled(
+    density: &dyn DirectionDensity,
+    n: usize,
+    config: &DirectionConfig,
+    schedule: &CapSchedule,
+    on_epoch: &mut dyn FnMut(&EpochReport),
+) -> Vec<DVec2> {
+    assert!(
+        schedule.matches(config),
+        "cap schedule built for other settings"
+    );
+    run(density, n, config, Some(schedule), on_epoch)
+}
+
+fn run(
+    density: &dyn DirectionDensity,
+    n: usize,
+    config: &DirectionConfig,
+    schedule: Option<&CapSchedule>,
     on_epoch: &mut dyn FnMut(&EpochReport),
 ) -> Vec<DVec2> {
     let domain = density.domain();
@@ -126,12 +246,11 @@ pub fn optimize_directions(
     let spacing = (area_of_domain / n as f64).sqrt();
     // Square units per radian: the equal-area map scales areas by 1/area_of_domain.
     let square_per_radian = 1.0 / area_of_domain.sqrt();
-    let table = (!density.has_closed_form_caps())
-        .then(|| CapMeasureTable::new(&density.quadrature(config.table_points)));
-    let exact = |c: DVec3, t: f64| match &table {
-        Some(table) => table.measure(c, t),
-        None => density.cap_measure(c, t),
+    let exact_measure = match (schedule, config.area) {
+        (None, AreaOption::Exact) => Some(ExactCapMeasure::new(density, config.table_points)),
+        _ => None,
     };
+    let exact = |c: DVec3, t: f64| exact_measure.as_ref().map_or(0.0, |m| m.measure(c, t));
     let mut adam = Adam::new(n);
     let mut grad3 = vec![DVec3::ZERO; n];
     let mut grad = vec![DVec2::ZERO; n];
@@ -147,21 +266,12 @@ pub fn optimize_directions(
             config.final_learning_rate_ratio + (1.0 - config.final_learning_rate_ratio) * cosine;
         let lr = config.learning_rate * spacing * square_per_radian * lr_ratio;
 
-        let scramble = derive_seed(config.seed, 2 * epoch as u64 + 1) as u32;
-        let caps: Vec<Cap> = (0..config.caps)
-            .map(|i| {
-                let (idx, dim) = ((i % (1 << 16)) as u32, 3 * (i >> 16) as u32);
-                Cap::from_unit_cube(DVec3::new(
-                    sobol_burley::sample(idx, dim, scramble) as f64,
-                    sobol_burley::sample(idx, dim + 1, scramble) as f64,
-                    sobol_burley::sample(idx, dim + 2, scramble) as f64,
-                ))
-            })
-            .collect();
+        let caps = epoch_caps(config.seed, epoch, config.caps);
         let sample_tree;
-        let area = match config.area {
-            AreaOption::Exact => CapArea::Exact(&exact),
-            AreaOption::MonteCarlo { samples } => {
+        let area = match (schedule, config.area) {
+            (Some(s), _) => CapArea::Precomputed(s.epoch(epoch)),
+            (None, AreaOption::Exact) => CapArea::Exact(&exact),
+            (None, AreaOption::MonteCarlo { samples }) => {
                 let mut r = rng(config.seed, 2 * epoch as u64 + 2);
                 let s: Vec<DVec3> = (0..samples)
                     .map(|_| density.sample_target(&mut r))
@@ -240,5 +350,65 @@ mod tests {
             let tail: f64 = losses[losses.len() - 30..].iter().sum::<f64>() / 30.0;
             assert!(tail < 0.85 * head, "{spec}: {head} -> {tail}");
         }
+    }
+
+    #[test]
+    fn a_cap_schedule_reproduces_the_unscheduled_run_bit_for_bit_for_every_size() {
+        // brdf has no closed-form cap measure: the schedule replaces table lookups.
+        let density = parse_direction_spec("brdf:0.3,45", Domain::Hemisphere).unwrap();
+        let cfg = DirectionConfig {
+            epochs: 40,
+            caps: 200,
+            table_points: 1 << 12,
+            seed: 9,
+            ..DirectionConfig::default()
+        };
+        let schedule = CapSchedule::new(density.as_ref(), &cfg);
+        assert!(schedule.matches(&cfg));
+        for n in [16, 50] {
+            let plain = optimize_directions(density.as_ref(), n, &cfg, &mut |_| {});
+            let scheduled =
+                optimize_directions_scheduled(density.as_ref(), n, &cfg, &schedule, &mut |_| {});
+            assert_eq!(plain, scheduled, "N = {n}");
+        }
+        // Any setting the measures depend on breaks the match.
+        for other in [
+            DirectionConfig {
+                seed: 10,
+                ..cfg.clone()
+            },
+            DirectionConfig {
+                epochs: 41,
+                ..cfg.clone()
+            },
+            DirectionConfig {
+                caps: 201,
+                ..cfg.clone()
+            },
+            DirectionConfig {
+                table_points: 1 << 13,
+                ..cfg.clone()
+            },
+            DirectionConfig {
+                area: AreaOption::MonteCarlo { samples: 64 },
+                ..cfg.clone()
+            },
+        ] {
+            assert!(!schedule.matches(&other));
+        }
+    }
+
+    #[test]
+    #[should_panic(expected = "cap schedule built for other settings")]
+    fn a_mismatched_cap_schedule_is_refused() {
+        let density = parse_direction_spec("cosine", Domain::Hemisphere).unwrap();
+        let cfg = DirectionConfig {
+            epochs: 3,
+            caps: 8,
+            ..DirectionConfig::default()
+        };
+        let schedule = CapSchedule::new(density.as_ref(), &cfg);
+        let other = DirectionConfig { seed: 1, ..cfg };
+        optimize_directions_scheduled(density.as_ref(), 8, &other, &schedule, &mut |_| {});
     }
 }
