@@ -277,3 +277,39 @@ fn optimize_directions_writes_a_direction_blob() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn bench_baselines_times_every_generator_at_every_size() {
+    let out = build_tool()
+        .args(["bench", "--only", "baselines", "--sizes", "16,32"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let names = [
+        "random",
+        "owen-sobol",
+        "sobol-cp",
+        "halton",
+        "poisson-disk",
+        "sot",
+        "gbn",
+    ];
+    for name in names {
+        let line = text
+            .lines()
+            .find(|l| l.split_whitespace().next() == Some(name))
+            .unwrap_or_else(|| panic!("no row for {name}:\n{text}"));
+        let ms: Vec<f64> = line
+            .split_whitespace()
+            .skip(1)
+            .map(|v| v.parse().unwrap())
+            .collect();
+        assert_eq!(ms.len(), 2, "{line}");
+        assert!(ms.iter().all(|m| m.is_finite() && *m >= 0.0), "{line}");
+    }
+}
