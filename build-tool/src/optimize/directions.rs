@@ -4,7 +4,7 @@
 //! [`crate::discrepancy::caps`], and the gradient is chained back through the map.
 
 use super::adam::Adam;
-use super::{AreaOption, EpochReport};
+use super::{epoch_schedule, AreaOption, EpochReport};
 use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea, CapTree};
 use crate::discrepancy::GradientPath;
 use crate::seeding::{derive_seed, rng};
@@ -255,15 +255,13 @@ fn run(
     let mut grad3 = vec![DVec3::ZERO; n];
     let mut grad = vec![DVec2::ZERO; n];
     for epoch in 0..config.epochs {
-        let t = if config.epochs > 1 {
-            epoch as f64 / (config.epochs - 1) as f64
-        } else {
-            1.0
-        };
-        let alpha = (config.alpha_start + (config.alpha_end - config.alpha_start) * t) / spacing;
-        let cosine = 0.5 * (1.0 + (std::f64::consts::PI * t).cos());
-        let lr_ratio =
-            config.final_learning_rate_ratio + (1.0 - config.final_learning_rate_ratio) * cosine;
+        let (alpha_spacings, lr_ratio) = epoch_schedule(
+            epoch,
+            config.epochs,
+            (config.alpha_start, config.alpha_end),
+            config.final_learning_rate_ratio,
+        );
+        let alpha = alpha_spacings / spacing;
         let lr = config.learning_rate * spacing * square_per_radian * lr_ratio;
 
         let caps = epoch_caps(config.seed, epoch, config.caps);

@@ -126,6 +126,28 @@ pub fn to_points(density: &dyn Density2D, params: &[DVec2], p: Parameterization)
     }
 }
 
+/// The annealing of epoch `epoch` of `epochs`, shared by the 2D and direction
+/// optimizers: with `t = epoch / (epochs - 1)` (1 for a single epoch), the sigmoid
+/// sharpness `alpha_start + (alpha_end - alpha_start) t` (in inverse point
+/// spacings) and the step ratio `final + (1 - final) (1 + cos(pi t)) / 2` (cosine
+/// decay from 1 to `final`).
+pub fn epoch_schedule(
+    epoch: usize,
+    epochs: usize,
+    (alpha_start, alpha_end): (f64, f64),
+    final_learning_rate_ratio: f64,
+) -> (f64, f64) {
+    let t = if epochs > 1 {
+        epoch as f64 / (epochs - 1) as f64
+    } else {
+        1.0
+    };
+    let alpha = alpha_start + (alpha_end - alpha_start) * t;
+    let cosine = 0.5 * (1.0 + (std::f64::consts::PI * t).cos());
+    let lr_ratio = final_learning_rate_ratio + (1.0 - final_learning_rate_ratio) * cosine;
+    (alpha, lr_ratio)
+}
+
 /// Optimizes `n` points for `density`, starting from [`initial_parameters`] (warped
 /// by the inverse CDF, so the start is the standard warped Owen-Sobol baseline).
 /// Calls `on_epoch` after every epoch. Returns the points in `[0,1]^2`.
@@ -146,15 +168,13 @@ pub fn optimize(
     let mut anchors = vec![DVec2::ZERO; config.anchors.max(1)];
     let mut samples = Vec::new();
     for epoch in 0..config.epochs {
-        let t = if config.epochs > 1 {
-            epoch as f64 / (config.epochs - 1) as f64
-        } else {
-            1.0
-        };
-        let alpha = (config.alpha_start + (config.alpha_end - config.alpha_start) * t) / spacing;
-        let cosine = 0.5 * (1.0 + (std::f64::consts::PI * t).cos());
-        let lr_ratio =
-            config.final_learning_rate_ratio + (1.0 - config.final_learning_rate_ratio) * cosine;
+        let (alpha_spacings, lr_ratio) = epoch_schedule(
+            epoch,
+            config.epochs,
+            (config.alpha_start, config.alpha_end),
+            config.final_learning_rate_ratio,
+        );
+        let alpha = alpha_spacings / spacing;
         let lr = config.learning_rate * spacing * lr_ratio;
 
         match config.anchor_sampling {
@@ -215,6 +235,17 @@ pub fn optimize(
 mod tests {
     use super::*;
     use crate::density::parse_spec;
+
+    #[test]
+    fn epoch_schedule_anneals_from_start_to_end() {
+        let a = (8.0, 128.0);
+        assert_eq!(epoch_schedule(0, 11, a, 0.02), (8.0, 1.0));
+        assert_eq!(epoch_schedule(10, 11, a, 0.02), (128.0, 0.02));
+        assert_eq!(epoch_schedule(0, 1, a, 0.02), (128.0, 0.02));
+        // Halfway: alpha at the midpoint, the step halfway between 1 and the end.
+        let (alpha, lr) = epoch_schedule(5, 11, a, 0.02);
+        assert!((alpha - 68.0).abs() < 1e-12 && (lr - 0.51).abs() < 1e-12);
+    }
 
     fn run_with_threads(threads: usize, cfg: &OptimizeConfig) -> Vec<DVec2> {
         let density = parse_spec("gaussian:0.4,0.6,0.2").unwrap();
