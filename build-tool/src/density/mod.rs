@@ -173,21 +173,28 @@ pub(crate) fn one_line(s: impl std::fmt::Display) -> String {
         .join(" ")
 }
 
-/// Parses the comma-separated numeric parameters of `kind` (all must be finite).
-fn parse_params(
-    kind: &'static str,
-    usage: &'static str,
+/// Why a SPEC's comma-separated parameter list was refused ([`split_params`]).
+pub(crate) enum ParamError<'a> {
+    /// `got` parameters where the kind takes `expected`.
+    Count { expected: usize, got: usize },
+    /// Parameter `param` is not a number.
+    NotANumber { param: &'static str, text: &'a str },
+}
+
+/// The numbers of a SPEC's parameter list `text` (after the `:`), one per name in
+/// `names`; no list, or an empty one, is zero parameters. Shared by the 2D and the
+/// direction SPEC parsers, which map [`ParamError`] into their own error types and
+/// do their own range checks.
+pub(crate) fn split_params<'a>(
     names: &[&'static str],
-    text: Option<&str>,
-) -> Result<Vec<f64>, DensityError> {
+    text: Option<&'a str>,
+) -> Result<Vec<f64>, ParamError<'a>> {
     let parts: Vec<&str> = match text.map(str::trim) {
         None | Some("") => Vec::new(),
         Some(t) => t.split(',').map(str::trim).collect(),
     };
     if parts.len() != names.len() {
-        return Err(DensityError::ParamCount {
-            kind,
-            usage,
+        return Err(ParamError::Count {
             expected: names.len(),
             got: parts.len(),
         });
@@ -195,19 +202,39 @@ fn parse_params(
     parts
         .iter()
         .zip(names)
-        .map(|(t, &param)| {
-            let value: f64 = t.parse().map_err(|_| DensityError::NotANumber {
-                kind,
-                param,
-                text: (*t).to_string(),
-            })?;
-            if value.is_finite() {
-                Ok(value)
-            } else {
-                Err(DensityError::NonFinite { kind, param, value })
-            }
+        .map(|(&text, &param)| {
+            text.parse::<f64>()
+                .map_err(|_| ParamError::NotANumber { param, text })
         })
         .collect()
+}
+
+/// Parses the comma-separated numeric parameters of `kind` (all must be finite).
+fn parse_params(
+    kind: &'static str,
+    usage: &'static str,
+    names: &[&'static str],
+    text: Option<&str>,
+) -> Result<Vec<f64>, DensityError> {
+    let values = split_params(names, text).map_err(|e| match e {
+        ParamError::Count { expected, got } => DensityError::ParamCount {
+            kind,
+            usage,
+            expected,
+            got,
+        },
+        ParamError::NotANumber { param, text } => DensityError::NotANumber {
+            kind,
+            param,
+            text: text.to_string(),
+        },
+    })?;
+    for (&value, &param) in values.iter().zip(names) {
+        if !value.is_finite() {
+            return Err(DensityError::NonFinite { kind, param, value });
+        }
+    }
+    Ok(values)
 }
 
 /// Parses a square-domain density SPEC (DESIGN.md §3):

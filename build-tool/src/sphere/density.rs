@@ -21,7 +21,7 @@ use super::envmap::EnvmapDensity;
 use super::geometry::{
     cosine_cap_measure, uniform_hemisphere_cap_measure, uniform_sphere_cap_measure,
 };
-use crate::density::{fmt_num, DensityError};
+use crate::density::{fmt_num, split_params, DensityError, ParamError};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
 use nuld_core::sphere::{square_to_hemisphere, square_to_sphere};
@@ -297,30 +297,19 @@ fn params(
     names: &[&'static str],
     text: Option<&str>,
 ) -> Result<Vec<f64>, DirectionSpecError> {
-    let parts: Vec<&str> = match text.map(str::trim) {
-        None | Some("") => Vec::new(),
-        Some(t) => t.split(',').map(str::trim).collect(),
-    };
-    if parts.len() != names.len() {
-        return Err(DirectionSpecError::ParamCount {
+    split_params(names, text).map_err(|e| match e {
+        ParamError::Count { expected, got } => DirectionSpecError::ParamCount {
             kind,
             usage,
-            expected: names.len(),
-            got: parts.len(),
-        });
-    }
-    parts
-        .iter()
-        .zip(names)
-        .map(|(t, &param)| {
-            t.parse::<f64>()
-                .map_err(|_| DirectionSpecError::NotANumber {
-                    kind,
-                    param,
-                    text: (*t).to_string(),
-                })
-        })
-        .collect()
+            expected,
+            got,
+        },
+        ParamError::NotANumber { param, text } => DirectionSpecError::NotANumber {
+            kind,
+            param,
+            text: text.to_string(),
+        },
+    })
 }
 
 /// Canonical number formatting for SPEC strings.
