@@ -35,6 +35,55 @@ pub struct LuminanceImage {
     pub values: Vec<f64>,
 }
 
+/// What [`LuminanceImage::clamp_negatives`] changed: lossy EXR compression (DWAB,
+/// PXR24, B44) routinely leaves a few tiny negative pixels around bright edges.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct NegativePixels {
+    /// Pixels whose luminance was negative (now 0).
+    pub pixels: usize,
+    /// Their summed magnitude relative to the sum of the positive values (0 when
+    /// there are none).
+    pub share: f64,
+}
+
+impl NegativePixels {
+    /// One line for stderr and reports, `None` when nothing was clamped.
+    pub fn note(&self, what: &str) -> Option<String> {
+        (self.pixels > 0).then(|| {
+            format!(
+                "{what}: {} negative pixel(s) set to 0 (together {:.1e} of the total luminance), \
+                 as renderers do for lossy-compressed maps",
+                self.pixels, self.share
+            )
+        })
+    }
+}
+
+impl LuminanceImage {
+    /// Sets negative values to 0, as pbrt and Mitsuba do when they build a
+    /// sampling distribution from a map, and says how many there were and how much
+    /// they weighed. NaN and infinite values are left as they are (the densities
+    /// reject them).
+    pub fn clamp_negatives(&mut self) -> NegativePixels {
+        let (mut pixels, mut negative, mut positive) = (0, 0.0, 0.0);
+        for v in self.values.iter_mut() {
+            if *v < 0.0 {
+                pixels += 1;
+                negative -= *v;
+                *v = 0.0;
+            } else if v.is_finite() {
+                positive += *v;
+            }
+        }
+        let share = if positive > 0.0 {
+            negative / positive
+        } else {
+            0.0
+        };
+        NegativePixels { pixels, share }
+    }
+}
+
 /// OpenEXR magic number (first four bytes of every EXR file).
 const EXR_MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
 

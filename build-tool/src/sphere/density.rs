@@ -62,6 +62,13 @@ pub trait DirectionDensity: Send + Sync {
         false
     }
 
+    /// Lines a user should read about how the target was built from its input
+    /// (e.g. negative pixels of a map set to 0); empty by default. The CLI prints
+    /// each on stderr and records them in reports.
+    fn notes(&self) -> Vec<String> {
+        Vec::new()
+    }
+
     /// Target measure `mu(C)` of the cap `C = {x : <center, x> >= cos_theta}`;
     /// `center` is normalized here, `cos_theta` is clamped into `[-1, 1]`.
     fn cap_measure(&self, center: DVec3, cos_theta: f64) -> f64;
@@ -179,10 +186,9 @@ pub enum DirectionSpecError {
     /// The environment map could not be read or decoded.
     #[error(transparent)]
     Image(#[from] DensityError),
-    /// A pixel's luminance is negative or not finite.
+    /// A pixel's luminance is NaN or infinite.
     #[error(
-        "envmap `{path}`: pixel (col {col}, row {row}) has luminance {value} \
-         (must be finite and >= 0)"
+        "envmap `{path}`: pixel (col {col}, row {row}) has luminance {value} (must be finite)"
     )]
     BadPixel {
         /// The map's path (or name).

@@ -31,14 +31,16 @@
 //!   percentile 5e-7, max 5e-6 against a 32-pieces-per-row reference, which
 //!   [`EnvmapDensity::cap_measure_with`] provides). Cost `O(H)` per cap, about
 //!   0.1–0.3 ms for a 1024x512 map.
-//! * **Profiles / quadrature**: block sums of `b x b` pixels at their mass-weighted
-//!   mean direction ([`DirectionDensity::quadrature`]); profiles use a `2^15`-point
-//!   rule (coarser than `cap_measure`).
+//! * **Profiles / quadrature** ([`EnvmapDensity::mass_rule`]): points spread in
+//!   proportion to the mass, each carrying at most about `1/k` of it (a bright pixel
+//!   is cut into many equal-mass cells, dim regions are merged into blocks), so a
+//!   sun of a few pixels is resolved as finely as the rest of the light; profiles
+//!   use a `2^15`-point rule (coarser than `cap_measure`).
 
 use super::cap_table::profile_of_rule;
-use super::density::{domain_name, DirectionDensity, DirectionSpecError};
+use super::density::{domain_name, normalize_rule, DirectionDensity, DirectionSpecError};
 use super::geometry::unit_or_z;
-use crate::density::image::{load_luminance, LuminanceImage};
+use crate::density::image::{load_luminance, LuminanceImage, NegativePixels};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
@@ -60,6 +62,17 @@ const PSI_PIECE: f64 = PI / 16.0;
 /// Levels of geometric grading toward a band end (pieces of 1/2, 1/4, ... of the
 /// end piece).
 const END_GRADING: u32 = 12;
+/// A pixel is *bright* when it holds more than this multiple of its row's mean
+/// pixel mass ...
+const BRIGHT_PIXEL: f64 = 16.0;
+/// ... and more than this much of the map's mass. Cap measures integrate the rows
+/// holding bright pixels piecewise between the angles where an arc end crosses a
+/// bright pixel's edge, adaptively.
+const BRIGHT_MASS: f64 = 1e-7;
+/// Absolute tolerance (in mass) of one adaptively integrated piece.
+const ADAPTIVE_TOL: f64 = 1e-10;
+/// Most halvings of one adaptively integrated piece.
+const ADAPTIVE_DEPTH: u32 = 24;
 
 /// `∫_a^b f` by 4-point Gauss–Legendre.
 fn gl4(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
@@ -67,16 +80,48 @@ fn gl4(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
     GL4.iter().map(|(x, w)| w * h * f(a + h * x)).sum()
 }
 
-/// `∫_a^b f` graded geometrically toward both ends (halves, quarters, ...).
-fn graded_both(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+/// `∫_a^b f` by [`gl4`] on halves until two successive levels agree to `tol`
+/// (at most `depth` halvings): resolves the kinks where an arc end crosses the
+/// column edge of a pixel much brighter than its neighbours.
+fn gl4_adaptive(f: &impl Fn(f64) -> f64, a: f64, b: f64, tol: f64, depth: u32) -> f64 {
     let m = 0.5 * (a + b);
-    let mut s = 0.0;
-    let mut len = m - a;
-    for _ in 0..END_GRADING {
-        len *= 0.5;
-        s += gl4(f, a + len, a + 2.0 * len) + gl4(f, b - 2.0 * len, b - len);
+    let whole = gl4(f, a, b);
+    let halves = gl4(f, a, m) + gl4(f, m, b);
+    if depth == 0 || (whole - halves).abs() <= tol {
+        halves
+    } else {
+        gl4_adaptive(f, a, m, 0.5 * tol, depth - 1) + gl4_adaptive(f, m, b, 0.5 * tol, depth - 1)
     }
-    s + gl4(f, a, a + len) + gl4(f, b - len, b)
+}
+
+/// `∫_a^b` of what `piece` integrates, graded geometrically toward the ends that
+/// are flagged (halves, quarters, ... of the piece).
+fn graded(piece: &impl Fn(f64, f64) -> f64, a: f64, b: f64, at_a: bool, at_b: bool) -> f64 {
+    match (at_a, at_b) {
+        (false, false) => piece(a, b),
+        (true, true) => {
+            let m = 0.5 * (a + b);
+            graded(piece, a, m, true, false) + graded(piece, m, b, false, true)
+        }
+        (true, false) => {
+            let mut len = b - a;
+            let mut s = 0.0;
+            for _ in 0..END_GRADING {
+                len *= 0.5;
+                s += piece(a + len, a + 2.0 * len);
+            }
+            s + piece(a, a + len)
+        }
+        (false, true) => {
+            let mut len = b - a;
+            let mut s = 0.0;
+            for _ in 0..END_GRADING {
+                len *= 0.5;
+                s += piece(b - 2.0 * len, b - len);
+            }
+            s + piece(b - len, b)
+        }
+    }
 }
 
 /// The `envmap:` target (see the module docs).
@@ -95,7 +140,10 @@ pub struct EnvmapDensity {
     col_cum: Vec<f64>,
     /// `H + 1` cumulative row masses.
     row_cdf: Vec<f64>,
+    /// Per row, the columns of its bright pixels (see [`BRIGHT_PIXEL`]).
+    bright_cols: Vec<Vec<usize>>,
     profile_rule: Vec<(DVec3, f64)>,
+    negative: NegativePixels,
 }
 
 /// `z = cos(pi r / H)` written as `sin(pi (H - 2r) / (2H))`, exact 0 at the equator.
@@ -111,11 +159,16 @@ impl EnvmapDensity {
     }
 
     /// Builds the density from decoded luminance (`name` is the SPEC's path).
+    /// Negative pixels are set to 0 and counted ([`EnvmapDensity::negative_pixels`]);
+    /// a NaN or infinite pixel, or a map without positive mass on `domain`, is an
+    /// error.
     pub fn from_luminance(
         img: &LuminanceImage,
         domain: Domain,
         name: &str,
     ) -> Result<Self, DirectionSpecError> {
+        let mut img = img.clone();
+        let negative = img.clamp_negatives();
         let (w, h) = (img.width, img.height);
         if w == 0 || h == 0 || img.values.len() != w * h {
             return Err(DirectionSpecError::BadImage {
@@ -123,11 +176,7 @@ impl EnvmapDensity {
                 reason: format!("{w}x{h} pixels with {} values", img.values.len()),
             });
         }
-        if let Some(k) = img
-            .values
-            .iter()
-            .position(|v| !(v.is_finite() && *v >= 0.0))
-        {
+        if let Some(k) = img.values.iter().position(|v| !v.is_finite()) {
             return Err(DirectionSpecError::BadPixel {
                 path: name.to_string(),
                 col: k % w,
@@ -170,6 +219,14 @@ impl EnvmapDensity {
             }
             row_cdf.push(row_cdf[r] + s);
         }
+        let bright_cols: Vec<Vec<usize>> = mass
+            .chunks_exact(w)
+            .map(|row| {
+                let mean = row.iter().sum::<f64>() / w as f64;
+                let floor = (BRIGHT_PIXEL * mean).max(BRIGHT_MASS);
+                (0..w).filter(|&c| row[c] > floor).collect()
+            })
+            .collect();
         let mut d = Self {
             name: name.to_string(),
             width: w,
@@ -180,10 +237,17 @@ impl EnvmapDensity {
             mass,
             col_cum,
             row_cdf,
+            bright_cols,
             profile_rule: Vec::new(),
+            negative,
         };
         d.profile_rule = d.quadrature(PROFILE_POINTS);
         Ok(d)
+    }
+
+    /// The negative pixels that were set to 0 when the map was loaded.
+    pub fn negative_pixels(&self) -> NegativePixels {
+        self.negative
     }
 
     /// Map width (columns, along `phi`).
@@ -283,32 +347,50 @@ impl EnvmapDensity {
                     arc_mass(r, sa, ca) * sa * 0.5 * la * sy
                 };
                 let (p0, p1) = (psi(pa), psi(pb));
-                let pieces = (((p1 - p0) / PSI_PIECE).ceil() as usize).max(min_pieces);
-                let h = (p1 - p0) / pieces as f64;
-                let mut s = 0.0;
-                for k in 0..pieces {
-                    let (x0, x1) = (p0 + k as f64 * h, p0 + (k + 1) as f64 * h);
-                    // Pieces at a band end are graded geometrically toward it.
-                    let (at_start, at_end) = (k == 0 && p0 == 0.0, k + 1 == pieces && p1 == PI);
-                    if at_start && at_end {
-                        s += graded_both(&f, x0, x1);
-                    } else if at_start || at_end {
-                        let mut len = x1 - x0;
-                        for _ in 0..END_GRADING {
-                            len *= 0.5;
-                            s += if at_start {
-                                gl4(&f, x0 + len, x0 + 2.0 * len)
-                            } else {
-                                gl4(&f, x1 - 2.0 * len, x1 - len)
-                            };
+                // Where an arc end crosses an edge of a bright pixel the arc mass
+                // has a strong kink: integrate between those angles, adaptively.
+                let bright = &self.bright_cols[r];
+                let mut cuts = vec![p0, p1];
+                for &c in bright {
+                    for edge in [c, c + 1] {
+                        let phi_c = TAU * edge as f64 / self.width as f64;
+                        let d = (phi_c - phi_w).rem_euclid(TAU);
+                        let cos_d = d.min(TAU - d).cos();
+                        // The arc's half width is d where t = cg cos(alpha) + sg cos(d) sin(alpha).
+                        let (x, y) = (cg, sg * cos_d);
+                        let big_r = (x * x + y * y).sqrt();
+                        if big_r <= 0.0 || t.abs() > big_r {
+                            continue;
                         }
-                        s += if at_start {
-                            gl4(&f, x0, x0 + len)
-                        } else {
-                            gl4(&f, x1 - len, x1)
-                        };
+                        let (delta, spread) = (y.atan2(x), (t / big_r).acos());
+                        for al in [delta - spread, delta + spread, delta - spread + TAU] {
+                            if al > pa && al < pb {
+                                cuts.push(psi(al));
+                            }
+                        }
+                    }
+                }
+                cuts.sort_by(f64::total_cmp);
+                cuts.dedup();
+                let piece = |a: f64, b: f64| {
+                    if bright.is_empty() {
+                        gl4(&f, a, b)
                     } else {
-                        s += gl4(&f, x0, x1);
+                        gl4_adaptive(&f, a, b, ADAPTIVE_TOL, ADAPTIVE_DEPTH)
+                    }
+                };
+                let mut s = 0.0;
+                for (k, span) in cuts.windows(2).enumerate() {
+                    let (q0, q1) = (span[0], span[1]);
+                    let least = if cuts.len() == 2 { min_pieces } else { 1 };
+                    let pieces = (((q1 - q0) / PSI_PIECE).ceil() as usize).max(least);
+                    let h = (q1 - q0) / pieces as f64;
+                    for j in 0..pieces {
+                        let (x0, x1) = (q0 + j as f64 * h, q0 + (j + 1) as f64 * h);
+                        // Pieces at a band end are graded geometrically toward it.
+                        let at_start = k == 0 && j == 0 && p0 == 0.0;
+                        let at_end = k + 2 == cuts.len() && j + 1 == pieces && p1 == PI;
+                        s += graded(&piece, x0, x1, at_start, at_end);
                     }
                 }
                 part += s / dz;
@@ -386,6 +468,10 @@ impl DirectionDensity for EnvmapDensity {
         DVec3::new(s * phi.cos(), s * phi.sin(), z)
     }
 
+    fn notes(&self) -> Vec<String> {
+        self.negative.note(&self.spec()).into_iter().collect()
+    }
+
     fn cap_measure(&self, center: DVec3, cos_theta: f64) -> f64 {
         self.cap_measure_with(center, cos_theta, 1)
     }
@@ -394,31 +480,135 @@ impl DirectionDensity for EnvmapDensity {
         profile_of_rule(self.profile_rule.iter().copied(), center, cos_thetas)
     }
 
-    /// Block sums of `b x b` pixels (`b = max(1, round(sqrt(W H / k)))`) placed at
-    /// the block's mass-weighted mean of pixel-centre directions (normalized).
+    /// The mass-adaptive rule of [`EnvmapDensity::mass_rule`].
     fn quadrature(&self, k: usize) -> Vec<(DVec3, f64)> {
+        self.mass_rule(k)
+    }
+}
+
+/// A rectangle of pixels `[c0, c1) x [r0, r1)`.
+#[derive(Clone, Copy, Debug)]
+struct PixelBlock {
+    c0: usize,
+    c1: usize,
+    r0: usize,
+    r1: usize,
+}
+
+impl EnvmapDensity {
+    /// A weighted rule of about `k` to `3k` directions whose points are spread in
+    /// proportion to the *mass*, not the solid angle, with exact pixel masses:
+    ///
+    /// * a pixel block (starting from the whole map) is split in two across its
+    ///   longer side on the sphere while its mass exceeds `1/k`; a block whose mass
+    ///   is at most `1/k` becomes one point, at the mass-weighted mean of its pixel
+    ///   centres, carrying the block's mass;
+    /// * a single pixel of mass `m > 1/k` is cut into about `ceil(m k)` cells of
+    ///   equal solid angle (uniform in `z` and `phi`, nearly square on the
+    ///   sphere), each a point at its centre carrying `m / cells`.
+    ///
+    /// Every point therefore carries at most about `1/k` of the mass wherever the
+    /// map is bright, however small the bright region: a sun of a few pixels that
+    /// holds half the light is resolved by `k/2` points. A rule of equal-solid-angle
+    /// blocks (what a plain midpoint grid does) would put such a sun into one point
+    /// carrying half the mass; an optimizer matching cap measures of that rule piles
+    /// its points onto that one direction, and an energy-form metric built on it
+    /// misjudges sets that spread inside the sun.
+    pub fn mass_rule(&self, k: usize) -> Vec<(DVec3, f64)> {
         let (w, h) = (self.width, self.height);
-        let b = (((w * h) as f64 / k.max(1) as f64).sqrt().round() as usize).max(1);
+        // Summed-area table of pixel masses, (W+1) x (H+1), for O(1) block masses.
+        let mut sat = vec![0.0; (w + 1) * (h + 1)];
+        for r in 0..h {
+            for c in 0..w {
+                sat[(r + 1) * (w + 1) + c + 1] =
+                    self.mass[r * w + c] + sat[r * (w + 1) + c + 1] + sat[(r + 1) * (w + 1) + c]
+                        - sat[r * (w + 1) + c];
+            }
+        }
+        let block_mass = |b: &PixelBlock| -> f64 {
+            let at = |c: usize, r: usize| sat[r * (w + 1) + c];
+            (at(b.c1, b.r1) - at(b.c0, b.r1) - at(b.c1, b.r0) + at(b.c0, b.r0)).max(0.0)
+        };
+        let per_point = 1.0 / k.max(1) as f64;
         let mut rule = Vec::new();
-        for by in (0..h).step_by(b) {
-            for bx in (0..w).step_by(b) {
-                let mut m = 0.0;
+        let mut stack = vec![PixelBlock {
+            c0: 0,
+            c1: w,
+            r0: 0,
+            r1: h,
+        }];
+        while let Some(b) = stack.pop() {
+            let m = block_mass(&b);
+            if m <= 0.0 {
+                continue;
+            }
+            let single = b.c1 - b.c0 == 1 && b.r1 - b.r0 == 1;
+            if single {
+                self.push_pixel_cells(b.c0, b.r0, (m / per_point).ceil() as usize, &mut rule);
+            } else if m <= per_point {
                 let mut d = DVec3::ZERO;
-                for r in by..(by + b).min(h) {
-                    for c in bx..(bx + b).min(w) {
+                let mut sum = 0.0;
+                for r in b.r0..b.r1 {
+                    for c in b.c0..b.c1 {
                         let pm = self.mass[r * w + c];
                         if pm > 0.0 {
-                            m += pm;
+                            sum += pm;
                             d += pm * self.pixel_center(c, r);
                         }
                     }
                 }
-                if m > 0.0 {
-                    rule.push((unit_or_z(d), m));
+                if sum > 0.0 {
+                    rule.push((unit_or_z(d), sum));
+                }
+            } else {
+                // Split across the longer side as seen on the sphere (the width of
+                // a column shrinks with sin theta toward the poles).
+                let theta_mid = PI * (b.r0 + b.r1) as f64 / (2.0 * h as f64);
+                let width = (b.c1 - b.c0) as f64 * TAU / w as f64 * theta_mid.sin();
+                let height = (b.r1 - b.r0) as f64 * PI / h as f64;
+                let split_cols = b.r1 - b.r0 == 1 || (b.c1 - b.c0 > 1 && width >= height);
+                if split_cols {
+                    let mid = (b.c0 + b.c1) / 2;
+                    stack.push(PixelBlock { c1: mid, ..b });
+                    stack.push(PixelBlock { c0: mid, ..b });
+                } else {
+                    let mid = (b.r0 + b.r1) / 2;
+                    stack.push(PixelBlock { r1: mid, ..b });
+                    stack.push(PixelBlock { r0: mid, ..b });
                 }
             }
         }
+        normalize_rule(&mut rule);
         rule
+    }
+
+    /// Appends about `cells` points of equal mass for pixel `(c, r)`: a grid
+    /// uniform in `z` and `phi` (so every cell has the same solid angle, hence the
+    /// same mass), with as many rows as keep the cells near square on the sphere.
+    fn push_pixel_cells(&self, c: usize, r: usize, cells: usize, rule: &mut Vec<(DVec3, f64)>) {
+        let m = self.mass[r * self.width + c];
+        let (zl, zh) = (self.z_lo[r], self.z_hi[r]);
+        if m <= 0.0 || zh <= zl {
+            return;
+        }
+        let cells = cells.max(1);
+        let theta_extent = zl.clamp(-1.0, 1.0).acos() - zh.clamp(-1.0, 1.0).acos();
+        let z_mid = 0.5 * (zl + zh);
+        let width = TAU / self.width as f64 * (1.0 - z_mid * z_mid).max(0.0).sqrt();
+        let rows = ((cells as f64 * theta_extent / width.max(1e-300))
+            .sqrt()
+            .round() as usize)
+            .clamp(1, cells);
+        let cols = cells.div_ceil(rows);
+        let share = m / (rows * cols) as f64;
+        for i in 0..rows {
+            let z = zh - (i as f64 + 0.5) / rows as f64 * (zh - zl);
+            let s = (1.0 - z * z).max(0.0).sqrt();
+            for j in 0..cols {
+                let phi = TAU * (c as f64 + (j as f64 + 0.5) / cols as f64) / self.width as f64;
+                rule.push((DVec3::new(s * phi.cos(), s * phi.sin(), z), share));
+            }
+        }
     }
 }
 
@@ -618,8 +808,51 @@ mod tests {
         assert!(EnvmapDensity::from_luminance(&low, Domain::Sphere, "l").is_ok());
         let e = EnvmapDensity::from_luminance(&low, Domain::Hemisphere, "l").unwrap_err();
         assert!(e.to_string().contains("zero mass on the hemisphere"), "{e}");
-        let neg = image(8, 4, |c, r| if c == 3 && r == 1 { -1.0 } else { 1.0 });
-        let e = EnvmapDensity::from_luminance(&neg, Domain::Sphere, "n").unwrap_err();
+        let nan = image(8, 4, |c, r| if c == 3 && r == 1 { f64::NAN } else { 1.0 });
+        let e = EnvmapDensity::from_luminance(&nan, Domain::Sphere, "n").unwrap_err();
         assert!(e.to_string().contains("pixel (col 3, row 1)"), "{e}");
+        let inf = image(
+            8,
+            4,
+            |c, r| if c == 5 && r == 2 { f64::INFINITY } else { 1.0 },
+        );
+        let e = EnvmapDensity::from_luminance(&inf, Domain::Sphere, "i").unwrap_err();
+        assert!(e.to_string().contains("pixel (col 5, row 2)"), "{e}");
+    }
+
+    #[test]
+    fn tiny_negative_pixels_of_lossy_maps_are_set_to_zero_and_reported() {
+        // Two slightly negative pixels, as DWAB/PXR24 compression leaves them.
+        let img = image(8, 4, |c, r| match (c, r) {
+            (3, 1) => -2e-4,
+            (6, 2) => -1e-4,
+            _ => 1.0,
+        });
+        let d = EnvmapDensity::from_luminance(&img, Domain::Sphere, "lossy").unwrap();
+        let neg = d.negative_pixels();
+        assert_eq!(neg.pixels, 2);
+        // 3e-4 against 30 pixels of luminance 1.
+        assert!((neg.share - 3e-4 / 30.0).abs() < 1e-15, "{}", neg.share);
+        assert_eq!((d.pixel_mass(3, 1), d.pixel_mass(6, 2)), (0.0, 0.0));
+        let notes = d.notes();
+        assert_eq!(notes.len(), 1);
+        assert!(
+            notes[0].contains("2 negative pixel(s) set to 0"),
+            "{}",
+            notes[0]
+        );
+        // The rest is the constant map: the masses of a row are equal and sum to 1.
+        assert!((d.pixel_mass(0, 1) - d.pixel_mass(4, 1)).abs() < 1e-15);
+        let total: f64 = (0..4)
+            .flat_map(|r| (0..8).map(move |c| (c, r)))
+            .map(|(c, r)| d.pixel_mass(c, r))
+            .sum();
+        assert!((total - 1.0).abs() < 1e-12);
+        // A clean map has no note.
+        let clean = EnvmapDensity::from_luminance(&image(8, 4, |_, _| 1.0), Domain::Sphere, "c");
+        assert!(clean.unwrap().notes().is_empty());
+        // All pixels negative: nothing left, rejected as zero mass.
+        let e = EnvmapDensity::from_luminance(&image(8, 4, |_, _| -1.0), Domain::Sphere, "z");
+        assert!(e.unwrap_err().to_string().contains("zero mass"));
     }
 }
