@@ -40,6 +40,15 @@ pub struct DirectionConfig {
     /// measures during optimization (built once; error about `1e-4`, against
     /// `O(H)` or `O(K)` per cap for the exact measures).
     pub table_points: usize,
+    /// Work in units of each point's *local* spacing where the target is denser
+    /// than uniform: point `i` gets the sigmoid sharpness `alpha f_i` and the Adam
+    /// step `lr / f_i`, with `f_i = sqrt(|domain| pdf(x_i))` clamped into
+    /// `[1, MAX_LOCAL_FACTOR]` (the ratio of the uniform spacing `sqrt(|domain| / N)`
+    /// to the spacing `sqrt(1 / (N pdf))` the target asks for there). Without it, a
+    /// sun or a sharp lobe smaller than the global spacing is seen through a sigmoid
+    /// wider than itself, every point in it feels the same pull, and they collapse
+    /// onto one spot. `false` reproduces the global units of earlier versions.
+    pub local_units: bool,
     /// Fast tree-based gradient or the dense reference.
     pub path: GradientPath,
     /// Fixes the initialization and every random draw.
@@ -56,10 +65,28 @@ impl Default for DirectionConfig {
             alpha_start: 8.0,
             alpha_end: 128.0,
             area: AreaOption::Exact,
-            table_points: 1 << 16,
+            table_points: 1 << 14,
+            local_units: true,
             path: GradientPath::Fast,
             seed: 0,
         }
+    }
+}
+
+/// Largest local factor of [`DirectionConfig::local_units`]: a region may be this
+/// many times denser in points (per unit length) than the uniform spacing, i.e.
+/// hold `MAX_LOCAL_FACTOR^2` times the uniform density (far beyond a sun in an
+/// 8-bit-exponent HDR map at 4k).
+pub const MAX_LOCAL_FACTOR: f64 = 1e4;
+
+/// The local factor `f = sqrt(|domain| pdf(x))`, clamped into
+/// `[1, MAX_LOCAL_FACTOR]` ([`DirectionConfig::local_units`]).
+fn local_factor(area_of_domain: f64, pdf: f64) -> f64 {
+    let f = (area_of_domain * pdf).sqrt();
+    if f.is_finite() {
+        f.clamp(1.0, MAX_LOCAL_FACTOR)
+    } else {
+        1.0
     }
 }
 
@@ -254,6 +281,7 @@ fn run(
     let mut adam = Adam::new(n);
     let mut grad3 = vec![DVec3::ZERO; n];
     let mut grad = vec![DVec2::ZERO; n];
+    let (mut local, mut step) = (vec![1.0; n], vec![1.0; n]);
     for epoch in 0..config.epochs {
         let (alpha_spacings, lr_ratio) = epoch_schedule(
             epoch,
@@ -279,12 +307,28 @@ fn run(
             }
         };
         let dirs: Vec<DVec3> = params.iter().map(|&p| to_direction(domain, p)).collect();
-        let loss = cap_loss_and_gradient(&dirs, &caps, area, alpha, config.path, &mut grad3);
+        if config.local_units {
+            for (f, (s, &x)) in local.iter_mut().zip(step.iter_mut().zip(&dirs)) {
+                *f = local_factor(area_of_domain, density.pdf(x));
+                *s = 1.0 / *f;
+            }
+        }
+        let sharpness = config.local_units.then_some(local.as_slice());
+        let loss = cap_loss_and_gradient(
+            &dirs,
+            &caps,
+            area,
+            alpha,
+            sharpness,
+            config.path,
+            &mut grad3,
+        );
         for ((g, &g3), &p) in grad.iter_mut().zip(&grad3).zip(&params) {
             let (jx, jy) = map_jacobian(domain, p);
             *g = DVec2::new(jx.dot(g3), jy.dot(g3));
         }
-        adam.step(&mut params, &grad, lr);
+        let steps = config.local_units.then_some(step.as_slice());
+        adam.step_scaled(&mut params, &grad, lr, steps);
         params.iter_mut().for_each(|p| *p = fold(domain, *p));
         on_epoch(&EpochReport {
             epoch,
