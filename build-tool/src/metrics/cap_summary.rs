@@ -2,8 +2,8 @@
 //! `metrics` report them for the sphere and hemisphere domains.
 
 use crate::sphere::{
-    cap_l2_for_density, cap_l2_theta_uniform_estimate, cap_l2_uniform, cap_star_estimate,
-    CapMeasureTable, DirectionDensity,
+    cap_l2_uniform, cap_star_estimate_screened, root_with_stderr, CapMeasureTable, CapRadius,
+    CapStarOptions, DirectionDensity, EnergyReference, MeasuredCaps,
 };
 use glam::DVec3;
 use serde::Serialize;
@@ -50,75 +50,96 @@ pub const CAP_QUADRATURE_POINTS: usize = 128 * 128;
 pub const THETA_CAPS: usize = 100_000;
 /// Quadrature points of the cap-measure table used by the theta-uniform estimate for
 /// targets without closed-form cap measures (brdf, envmap).
-pub const TABLE_POINTS: usize = 1 << 18;
+pub const TABLE_POINTS: usize = 1 << 16;
+/// Whether Stolarsky's closed form gives the cap L2 discrepancy of `density`.
+fn stolarsky(density: &dyn DirectionDensity) -> bool {
+    density.spec() == "uniform" && density.domain() == nuld_core::blob::Domain::Sphere
+}
+
 /// Random caps (before refinement) for the cap star estimate.
 pub const STAR_CAPS: usize = 20_000;
 
-/// A direction target prepared for evaluation: the cap-measure table of a target
-/// without closed-form cap measures is built once and reused for every set.
+/// A direction target prepared for evaluation: what does not depend on the set is
+/// computed once and reused for every set: the target side of the energy form, and
+/// the random caps of the theta-uniform estimate and of the cap star search with
+/// their measures (closed forms, or for targets without them the
+/// [`TABLE_POINTS`]-point cap-measure table of the target's rule).
 pub struct CapTarget<'a> {
     density: &'a dyn DirectionDensity,
-    table: Option<CapMeasureTable>,
+    tabulated: bool,
+    energy: Option<EnergyReference>,
+    theta_caps: MeasuredCaps,
+    star_caps: MeasuredCaps,
 }
 
+/// Seed of the theta-uniform estimate's caps.
+const THETA_SEED: u64 = 0x7e7a;
+/// Seed of the cap star search.
+const STAR_SEED: u64 = 0x57a2;
+
 impl<'a> CapTarget<'a> {
-    /// Prepares `density` (builds its [`TABLE_POINTS`]-point table if needed).
+    /// Prepares `density`: its energy reference unless Stolarsky's closed form
+    /// applies, and the measures of [`THETA_CAPS`] + [`STAR_CAPS`] random caps.
     pub fn new(density: &'a dyn DirectionDensity) -> Self {
         let table = (!density.has_closed_form_caps())
             .then(|| CapMeasureTable::new(&density.quadrature(TABLE_POINTS)));
-        Self { density, table }
+        let measure = |w: DVec3, t: f64| match &table {
+            Some(table) => table.measure(w, t),
+            None => density.cap_measure(w, t),
+        };
+        let energy =
+            (!stolarsky(density)).then(|| EnergyReference::new(density, CAP_QUADRATURE_POINTS));
+        Self {
+            density,
+            tabulated: table.is_some(),
+            energy,
+            theta_caps: MeasuredCaps::draw(
+                THETA_CAPS,
+                THETA_SEED,
+                CapRadius::ThetaUniform,
+                measure,
+            ),
+            star_caps: MeasuredCaps::draw(STAR_CAPS, STAR_SEED, CapRadius::ThetaUniform, measure),
+        }
     }
 
-    fn stolarsky(&self) -> bool {
-        self.density.spec() == "uniform" && self.density.domain() == nuld_core::blob::Domain::Sphere
-    }
-
-    /// The metrics of `points`, with fixed estimator seeds (so two sets are compared
-    /// on the same caps).
+    /// The metrics of `points`, all on the same caps for every set.
     pub fn evaluate(&self, points: &[DVec3]) -> CapMetricSummary {
-        let density = self.density;
-        let cap_l2 = if self.stolarsky() {
-            cap_l2_uniform(points)
-        } else {
-            cap_l2_for_density(points, density, CAP_QUADRATURE_POINTS)
+        let cap_l2 = match &self.energy {
+            None => cap_l2_uniform(points),
+            Some(energy) => energy.cap_l2(points),
         };
-        let (theta, se) = match &self.table {
-            None => cap_l2_theta_uniform_estimate(
-                points,
-                |c, t| density.cap_measure(c, t),
-                THETA_CAPS,
-                0x7e7a,
-            ),
-            Some(table) => cap_l2_theta_uniform_estimate(
-                points,
-                |c, t| table.measure(c, t),
-                THETA_CAPS,
-                0x7e7a,
-            ),
+        let (d2, se2) = self.theta_caps.l2_squared(points, CapRadius::ThetaUniform);
+        let (theta, se) = root_with_stderr(d2, se2);
+        let options = CapStarOptions {
+            random_caps: STAR_CAPS,
+            ..CapStarOptions::default()
         };
+        let star =
+            cap_star_estimate_screened(points, self.density, &self.star_caps, &options, STAR_SEED);
         CapMetricSummary {
             cap_l2,
             cap_l2_theta: theta,
             cap_l2_theta_stderr: se,
-            cap_star_lower_bound: cap_star_estimate(points, density, STAR_CAPS, 0x57a2).lower_bound,
+            cap_star_lower_bound: star.lower_bound,
         }
     }
 
     /// One line saying how [`CapTarget::evaluate`] computed its numbers.
     pub fn method(&self) -> String {
-        let l2 = if self.stolarsky() {
+        let l2 = if self.energy.is_none() {
             "Stolarsky closed form".to_string()
         } else {
             format!("energy form with a {CAP_QUADRATURE_POINTS}-point quadrature of the target")
         };
-        let theta = if self.table.is_none() {
+        let theta = if !self.tabulated {
             "closed-form cap measures".to_string()
         } else {
             format!("cap measures from a {TABLE_POINTS}-point quadrature table")
         };
         format!(
             "cap_l2: t = cos(theta) uniform, {l2}; cap_l2_theta: paper's Eq. 9, {THETA_CAPS} random caps, {theta}; \
-             cap_star_lower_bound: max over {STAR_CAPS} random caps plus local refinement"
+             cap_star_lower_bound: max over {STAR_CAPS} random caps plus local refinement, exact cap measures"
         )
     }
 }

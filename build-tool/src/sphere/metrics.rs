@@ -96,10 +96,18 @@ pub fn cap_l2_nonuniform_squared(points: &[DVec3], quadrature: &[(DVec3, f64)]) 
         return 0.0;
     }
     let n = points.len() as f64;
-    let t1 = cross_distance_sum(points, quadrature) / n;
-    let t2 = weighted_self_distance_sum(quadrature);
-    let t3 = self_distance_sum(points) / (n * n);
-    0.25 * (2.0 * t1 - t2 - t3)
+    energy_form(
+        cross_distance_sum(points, quadrature) / n,
+        weighted_self_distance_sum(quadrature),
+        self_distance_sum(points) / (n * n),
+    )
+}
+
+/// `D^2 = (1/4)(2 cross - target_self - set_self)` from the energy form's three
+/// terms: `cross = (1/N) sum_i ∫|x_i - y| dmu`, `target_self = ∫∫|x - y| dmu dmu`,
+/// `set_self = (1/N^2) sum_{j,k} |x_j - x_k|`.
+fn energy_form(cross: f64, target_self: f64, set_self: f64) -> f64 {
+    0.25 * (2.0 * cross - target_self - set_self)
 }
 
 /// Cos-uniform cap L2 discrepancy against a general measure: `sqrt` of
@@ -110,32 +118,88 @@ pub fn cap_l2_nonuniform(points: &[DVec3], quadrature: &[(DVec3, f64)]) -> f64 {
         .sqrt()
 }
 
-/// Squared cos-uniform cap L2 discrepancy against `density`, from its own rules
-/// ([`DirectionDensity::quadrature`]) of about `k` and `k/4` points, combined by
-/// Richardson extrapolation. The energy form's error with a rule of `K` cells of
-/// size `h` is dominated by the cells' self-distances, `∝ h / K ∝ K^{-3/2}` (about
-/// `1e-7` at `K = 128^2` on the sphere), so with `K1 > K2` the actual rule lengths,
+/// The target side of the energy form, computed once and shared by every set
+/// evaluated against one target: two of the target's rules
+/// ([`DirectionDensity::quadrature`], about `k` and `k/4` points) and their self
+/// terms `∫∫|x - y| dmu dmu`, which cost `O(K^2)` and do not depend on the set.
+///
+/// [`EnergyReference::cap_l2_squared`] combines the two rules by Richardson
+/// extrapolation. The energy form's error with a rule of `K` cells of size `h` is
+/// dominated by the cells' self-distances, `∝ h / K ∝ K^{-3/2}` (about `1e-7` at
+/// `K = 128^2` on the sphere), so with `K1 > K2` the actual rule lengths,
 /// `D^2 ≈ (K1^{3/2} D^2(K1) - K2^{3/2} D^2(K2)) / (K1^{3/2} - K2^{3/2})`; for
 /// Fibonacci sets of N = 256..4096 this brings the error from ~1e-7 to ~1e-8 or
-/// below at `k = 128^2` (tests). Cost about `1.06 k^2` distance evaluations.
+/// below at `k = 128^2` (tests). The same law holds for rules whose points carry
+/// equal mass rather than equal area (the `envmap` rule), where `h` is the local
+/// cell size: concentrated light is resolved by many small cells.
+pub struct EnergyReference {
+    fine: Vec<(DVec3, f64)>,
+    coarse: Vec<(DVec3, f64)>,
+    fine_self: f64,
+    coarse_self: f64,
+}
+
+impl EnergyReference {
+    /// The rules of about `k` and `k/4` points of `density` and their self terms;
+    /// cost about `1.06 k^2` distance evaluations (parallel).
+    pub fn new(density: &dyn DirectionDensity, k: usize) -> Self {
+        let fine = density.quadrature(k);
+        let coarse = density.quadrature((k / 4).max(1));
+        let fine_self = weighted_self_distance_sum(&fine);
+        let coarse_self = weighted_self_distance_sum(&coarse);
+        Self {
+            fine,
+            coarse,
+            fine_self,
+            coarse_self,
+        }
+    }
+
+    /// Points of the finer rule.
+    pub fn rule_len(&self) -> usize {
+        self.fine.len()
+    }
+
+    /// Squared cos-uniform cap L2 discrepancy of `points` (unit vectors), the
+    /// energy form of [`cap_l2_nonuniform_squared`] with both rules, extrapolated.
+    /// `O(N^2 + N K)`. 0 for an empty set.
+    pub fn cap_l2_squared(&self, points: &[DVec3]) -> f64 {
+        if points.is_empty() {
+            return 0.0;
+        }
+        let n = points.len() as f64;
+        let set_self = self_distance_sum(points) / (n * n);
+        let form = |rule: &[(DVec3, f64)], target_self: f64| {
+            energy_form(cross_distance_sum(points, rule) / n, target_self, set_self)
+        };
+        let d1 = form(&self.fine, self.fine_self);
+        let d2 = form(&self.coarse, self.coarse_self);
+        let (k1, k2) = (
+            (self.fine.len() as f64).powf(1.5),
+            (self.coarse.len() as f64).powf(1.5),
+        );
+        if k1 > k2 {
+            (k1 * d1 - k2 * d2) / (k1 - k2)
+        } else {
+            d1
+        }
+    }
+
+    /// `sqrt` of [`EnergyReference::cap_l2_squared`] (clamped at 0).
+    pub fn cap_l2(&self, points: &[DVec3]) -> f64 {
+        self.cap_l2_squared(points).max(0.0).sqrt()
+    }
+}
+
+/// Squared cos-uniform cap L2 discrepancy against `density`, from its own rules of
+/// about `k` and `k/4` points, extrapolated ([`EnergyReference`], built for this one
+/// set; build an [`EnergyReference`] once to evaluate many sets).
 pub fn cap_l2_for_density_squared(
     points: &[DVec3],
     density: &dyn DirectionDensity,
     k: usize,
 ) -> f64 {
-    let fine = density.quadrature(k);
-    let coarse = density.quadrature((k / 4).max(1));
-    let d1 = cap_l2_nonuniform_squared(points, &fine);
-    let d2 = cap_l2_nonuniform_squared(points, &coarse);
-    let (k1, k2) = (
-        (fine.len() as f64).powf(1.5),
-        (coarse.len() as f64).powf(1.5),
-    );
-    if k1 > k2 {
-        (k1 * d1 - k2 * d2) / (k1 - k2)
-    } else {
-        d1
-    }
+    EnergyReference::new(density, k).cap_l2_squared(points)
 }
 
 /// `sqrt` of [`cap_l2_for_density_squared`] (clamped at 0).
@@ -160,12 +224,100 @@ fn count_in_cap(points: &[DVec3], w: DVec3, t: f64) -> usize {
     points.iter().filter(|p| w.dot(**p) >= t).count()
 }
 
+/// Random caps drawn once with their target measures, so that many sets can be
+/// scored on the same caps while each measure is paid once: `count` caps, `w`
+/// uniform and the radius per `radius`, drawn in chunks of 256 caps (stream `chunk`
+/// of `seed`), so the caps do not depend on the thread count.
+pub struct MeasuredCaps {
+    /// `(w, t, mu(C(w, t)))` in draw order.
+    caps: Vec<(DVec3, f64, f64)>,
+}
+
+impl MeasuredCaps {
+    /// Draws the caps and measures each with `cap_measure(w, t)` (in parallel).
+    pub fn draw(
+        count: usize,
+        seed: u64,
+        radius: CapRadius,
+        cap_measure: impl Fn(DVec3, f64) -> f64 + Sync,
+    ) -> Self {
+        let chunks = count.div_ceil(CAP_CHUNK);
+        let caps = (0..chunks)
+            .into_par_iter()
+            .flat_map_iter(|c| {
+                let mut g = rng(seed, c as u64);
+                let m = CAP_CHUNK.min(count - c * CAP_CHUNK);
+                let drawn: Vec<(DVec3, f64)> = (0..m)
+                    .map(|_| {
+                        let w = random_direction(&mut g);
+                        let t = match radius {
+                            CapRadius::CosUniform => 1.0 - 2.0 * g.random::<f64>(),
+                            CapRadius::ThetaUniform => (PI * g.random::<f64>()).cos(),
+                        };
+                        (w, t)
+                    })
+                    .collect();
+                drawn.into_iter().map(|(w, t)| (w, t, cap_measure(w, t)))
+            })
+            .collect();
+        Self { caps }
+    }
+
+    /// Number of caps.
+    pub fn len(&self) -> usize {
+        self.caps.len()
+    }
+
+    /// Whether there are no caps.
+    pub fn is_empty(&self) -> bool {
+        self.caps.is_empty()
+    }
+
+    /// `(s mean(r^2), s sd(r^2) / sqrt(caps))` over these caps, `s` as in
+    /// [`cap_l2_mc_squared`] (these caps must have been drawn with `radius`).
+    pub fn l2_squared(&self, points: &[DVec3], radius: CapRadius) -> (f64, f64) {
+        if self.caps.is_empty() || points.is_empty() {
+            return (0.0, 0.0);
+        }
+        let parts: Vec<(f64, f64)> = self
+            .caps
+            .par_chunks(CAP_CHUNK)
+            .map(|chunk| {
+                chunk.iter().fold((0.0, 0.0), |(s, s2), cap| {
+                    let r2 = residual(points, cap).powi(2);
+                    (s + r2, s2 + r2 * r2)
+                })
+            })
+            .collect();
+        let (s, s2) = parts
+            .iter()
+            .fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y));
+        let m = self.caps.len() as f64;
+        let mean = s / m;
+        let var = if self.caps.len() > 1 {
+            ((s2 - m * mean * mean) / (m - 1.0)).max(0.0)
+        } else {
+            0.0
+        };
+        let scale = match radius {
+            CapRadius::CosUniform => 2.0,
+            CapRadius::ThetaUniform => 1.0,
+        };
+        (scale * mean, scale * (var / m).sqrt())
+    }
+}
+
+/// The local discrepancy `#{x_i in C}/N - mu(C)` of a measured cap `(w, t, mu)`.
+fn residual(points: &[DVec3], &(w, t, mu): &(DVec3, f64, f64)) -> f64 {
+    count_in_cap(points, w, t) as f64 / points.len() as f64 - mu
+}
+
 /// Monte Carlo estimate of the squared cap L2 discrepancy under `radius`, with its
 /// standard error: `caps` caps with `w` uniform and the radius drawn per `radius`;
 /// local discrepancy `r = #{x_i in C}/N - cap_measure(w, t)` by exact counting;
 /// `D^2 ≈ s mean(r^2)`, `s = 2` for [`CapRadius::CosUniform`] (its `dt` has mass 2),
 /// 1 otherwise; `se = s sd(r^2) / sqrt(caps)`. `O(caps (N + cost of cap_measure))`,
-/// parallel over chunks of 256 caps (stream `chunk` of `seed`).
+/// the caps of [`MeasuredCaps::draw`].
 pub fn cap_l2_mc_squared(
     points: &[DVec3],
     cap_measure: impl Fn(DVec3, f64) -> f64 + Sync,
@@ -176,43 +328,7 @@ pub fn cap_l2_mc_squared(
     if caps == 0 || points.is_empty() {
         return (0.0, 0.0);
     }
-    let n = points.len() as f64;
-    let chunks = caps.div_ceil(CAP_CHUNK);
-    let parts: Vec<(f64, f64)> = (0..chunks)
-        .into_par_iter()
-        .map(|c| {
-            let mut g = rng(seed, c as u64);
-            let m = CAP_CHUNK.min(caps - c * CAP_CHUNK);
-            let (mut s, mut s2) = (0.0, 0.0);
-            for _ in 0..m {
-                let w = random_direction(&mut g);
-                let t = match radius {
-                    CapRadius::CosUniform => 1.0 - 2.0 * g.random::<f64>(),
-                    CapRadius::ThetaUniform => (PI * g.random::<f64>()).cos(),
-                };
-                let r = count_in_cap(points, w, t) as f64 / n - cap_measure(w, t);
-                let r2 = r * r;
-                s += r2;
-                s2 += r2 * r2;
-            }
-            (s, s2)
-        })
-        .collect();
-    let (s, s2) = parts
-        .iter()
-        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y));
-    let m = caps as f64;
-    let mean = s / m;
-    let var = if caps > 1 {
-        ((s2 - m * mean * mean) / (m - 1.0)).max(0.0)
-    } else {
-        0.0
-    };
-    let scale = match radius {
-        CapRadius::CosUniform => 2.0,
-        CapRadius::ThetaUniform => 1.0,
-    };
-    (scale * mean, scale * (var / m).sqrt())
+    MeasuredCaps::draw(caps, seed, radius, cap_measure).l2_squared(points, radius)
 }
 
 /// The paper's `D_cap,2` (Eq. 9: `w` uniform, `theta` uniform on `[0, pi]`) by
@@ -227,6 +343,12 @@ pub fn cap_l2_theta_uniform_estimate(
     seed: u64,
 ) -> (f64, f64) {
     let (d2, se2) = cap_l2_mc_squared(points, cap_measure, caps, seed, CapRadius::ThetaUniform);
+    root_with_stderr(d2, se2)
+}
+
+/// `(D, se(D))` from `(D^2, se(D^2))`: `se = se(D^2) / (2 D)` (delta method; the
+/// standard error of `D^2` itself if `D = 0`).
+pub fn root_with_stderr(d2: f64, se2: f64) -> (f64, f64) {
     let d = d2.max(0.0).sqrt();
     let se = if d > 0.0 { se2 / (2.0 * d) } else { se2 };
     (d, se)
@@ -350,6 +472,29 @@ pub fn cap_star_estimate_with(
     options: &CapStarOptions,
     seed: u64,
 ) -> CapStarEstimate {
+    let screened = MeasuredCaps::draw(
+        options.random_caps,
+        seed,
+        CapRadius::ThetaUniform,
+        |w, t| density.cap_measure(w, t),
+    );
+    cap_star_estimate_screened(points, density, &screened, options, seed)
+}
+
+/// [`cap_star_estimate_with`] whose random caps (phase 1) are `screened`: drawn
+/// once with [`CapRadius::ThetaUniform`] (`options.random_caps` is ignored) and
+/// measured beforehand, possibly by something cheaper than the exact
+/// `cap_measure` (e.g. a [`super::CapMeasureTable`] of a target whose exact
+/// measure costs `O(H)`), so that many sets share the cost. The `refine` best of
+/// them are scored again with the exact `density.cap_measure`, as are the refined
+/// caps: the reported value rests on exact measures only.
+pub fn cap_star_estimate_screened(
+    points: &[DVec3],
+    density: &dyn DirectionDensity,
+    screened: &MeasuredCaps,
+    options: &CapStarOptions,
+    seed: u64,
+) -> CapStarEstimate {
     let n = points.len();
     let empty = CapStarEstimate {
         lower_bound: 0.0,
@@ -364,23 +509,23 @@ pub fn cap_star_estimate_with(
     }
     let nf = n as f64;
     // Phase 1: random caps.
-    let chunks = options.random_caps.div_ceil(CAP_CHUNK);
-    let mut found: Vec<(f64, usize, DVec3, f64, bool)> = (0..chunks)
-        .into_par_iter()
-        .flat_map_iter(|c| {
-            let mut g = rng(seed, c as u64);
-            let m = CAP_CHUNK.min(options.random_caps - c * CAP_CHUNK);
-            let mut v = Vec::with_capacity(m);
-            for i in 0..m {
-                let w = random_direction(&mut g);
-                let t = (PI * g.random::<f64>()).cos();
-                let r = count_in_cap(points, w, t) as f64 / nf - density.cap_measure(w, t);
-                v.push((r.abs(), c * CAP_CHUNK + i, w, t, r >= 0.0));
-            }
-            v
+    let mut found: Vec<(f64, usize, DVec3, f64, bool)> = screened
+        .caps
+        .par_iter()
+        .enumerate()
+        .map(|(i, cap)| {
+            let r = residual(points, cap);
+            (r.abs(), i, cap.0, cap.1, r >= 0.0)
         })
         .collect();
     found.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    // The leaders are scored again with the exact measure and re-ranked.
+    let leaders = options.refine.max(1).min(found.len());
+    found[..leaders].par_iter_mut().for_each(|f| {
+        let r = count_in_cap(points, f.2, f.3) as f64 / nf - density.cap_measure(f.2, f.3);
+        (f.0, f.4) = (r.abs(), r >= 0.0);
+    });
+    found[..leaders].sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
     let mut best = match found.first() {
         Some(&(v, _, w, t, e)) => CapStarEstimate {
             lower_bound: v,

@@ -33,6 +33,6 @@ pub use geometry::{
 pub use metrics::{
     cap_l2_for_density, cap_l2_for_density_squared, cap_l2_mc_squared, cap_l2_nonuniform,
     cap_l2_nonuniform_squared, cap_l2_theta_uniform_estimate, cap_l2_uniform,
-    cap_l2_uniform_squared, cap_star_estimate, cap_star_estimate_with, CapRadius, CapStarEstimate,
-    CapStarOptions,
+    cap_l2_uniform_squared, cap_star_estimate, cap_star_estimate_screened, cap_star_estimate_with,
+    root_with_stderr, CapRadius, CapStarEstimate, CapStarOptions, EnergyReference, MeasuredCaps,
 };
