@@ -149,7 +149,7 @@ pub fn alpha<T: Real>(roughness: T) -> T {
 /// clamps it); it must be positive for `D` to be finite.
 #[inline]
 pub fn ggx_d<T: Real>(n_dot_h: T, alpha: T) -> T {
-    if !(n_dot_h > T::ZERO) {
+    if n_dot_h.is_nan() || n_dot_h <= T::ZERO {
         return T::ZERO;
     }
     let c = n_dot_h.min(T::ONE);
@@ -164,7 +164,7 @@ pub fn ggx_d<T: Real>(n_dot_h: T, alpha: T) -> T {
 /// factor of visible-normal sampling (Heitz 2018).
 #[inline]
 pub fn smith_g1<T: Real>(n_dot_w: T, alpha: T) -> T {
-    if !(n_dot_w > T::ZERO) {
+    if n_dot_w.is_nan() || n_dot_w <= T::ZERO {
         return T::ZERO;
     }
     let c = n_dot_w.min(T::ONE);
@@ -205,13 +205,12 @@ pub fn schlick_fresnel<T: Real>(v_dot_h: T) -> T {
 #[inline]
 fn pair_cosines<T: Real>(wo: [T; 3], wi: [T; 3]) -> Option<[T; 4]> {
     let finite = wo.iter().chain(wi.iter()).all(|x| x.is_finite());
-    // `!(x > 0)` also rejects NaN.
-    if !finite || !(wo[2] > T::ZERO) || !(wi[2] > T::ZERO) {
+    if !finite || wo[2] <= T::ZERO || wi[2] <= T::ZERO {
         return None;
     }
     let s = [wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]];
     let len = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
-    if !(len > T::ZERO) {
+    if len.is_nan() || len <= T::ZERO {
         return None;
     }
     let h = [s[0] / len, s[1] / len, s[2] / len];
@@ -279,7 +278,7 @@ pub fn cosine_weighted(wo: DVec3, wi: DVec3, roughness: f64) -> f64 {
 #[inline]
 pub fn burley_diffuse(n_dot_wo: f64, n_dot_wi: f64, h_dot_wi: f64, roughness: f64) -> f64 {
     let r = clamp_roughness(roughness);
-    let c = |x: f64| x.max(0.0).min(1.0);
+    let c = |x: f64| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
     let hw = c(h_dot_wi);
     let fd90 = 0.5 + 2.0 * r * hw * hw;
     let p5 = |x: f64| x * x * x * x * x;

@@ -4,7 +4,7 @@
 //! `q(wi) = f(wo, wi) max(n.wi, 0) / A(wo)`, with `A` the directional albedo.
 //!
 //! * **Normalizer** `A`: [`directional_albedo`], a Gauss–Legendre rule over half
-//!   vectors (error below `1e-8`), split into the diffuse and specular layers.
+//!   vectors (error below `1e-10`), split into the diffuse and specular layers.
 //! * **Baseline warp** ([`BrdfTarget::sample`]): what a renderer does: GGX
 //!   visible-normal sampling (Heitz 2018) with probability `A_spec / A`, else Malley
 //!   cosine sampling; a direction below the horizon (possible for VNDF) is mirrored
