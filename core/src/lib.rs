@@ -6,6 +6,8 @@
 //! * [`sphere`]: the equal-area maps between the unit square and the sphere
 //!   (octahedral, Clarberg 2008) and the hemisphere (concentric disk lifted to the
 //!   hemisphere), with their inverses and the edge wrapping used by optimizers;
+//! * [`brdf`]: the glTF 2.0 BRDF of `brdf:` targets and conditional samplers, over
+//!   [`real::Real`] so that `f32` and `f64` share one formula;
 //! * [`quantize`]: the u16 unorm and f16 codecs blobs store values with;
 //! * [`blob`]: the byte layout of a `.nuld` blob (format v1): header, section table,
 //!   checksum, metadata, and a writer that fills a caller-provided buffer.
@@ -26,4 +28,5 @@
 pub mod blob;
 pub mod brdf;
 pub mod quantize;
+pub mod real;
 pub mod sphere;

@@ -61,7 +61,8 @@ pub struct OptimizeArgs {
     pub domain: DomainArg,
     /// Target SPEC (DESIGN.md §3). Square: `uniform`, `gaussian:MX,MY,S`,
     /// `bilinear:..`, `quarter-disc`, `step-gaussian`, `image:PATH`; sphere and
-    /// hemisphere: `uniform`, `cosine`, `brdf:ROUGHNESS,THETA_O_DEG`, `envmap:PATH`.
+    /// hemisphere: `uniform`, `cosine`, `brdf:ROUGHNESS,THETA_O_DEG` (glTF 2.0),
+    /// `brdf-burley:ROUGHNESS,THETA_O_DEG`, `envmap:PATH`.
     /// Default: `gaussian:0.5,0.5,0.15` for the square, `uniform` for directions.
     #[arg(long)]
     pub density: Option<String>,

@@ -1,23 +1,25 @@
-//! `brdf:ROUGHNESS,THETA_O_DEG`: the cosine-weighted BRDF of [`nuld_core::brdf`] as a
-//! density of light directions `wi` on the upper hemisphere,
+//! `brdf:ROUGHNESS,THETA_O_DEG` (and `brdf-burley:ROUGHNESS,THETA_O_DEG`): the
+//! cosine-weighted BRDF of [`nuld_core::brdf`] (glTF 2.0 by default, Burley on
+//! request) as a density of light directions `wi` on the upper hemisphere,
 //! `q(wi) = f(wo, wi) max(n.wi, 0) / A(wo)`, with `A` the directional albedo.
 //!
-//! * **Normalizer** `A`: computed once by quadrature, the diffuse part on a 512^2
-//!   midpoint grid of the equal-area hemisphere map, the specular part on a 512^2
-//!   midpoint grid in half-vector space through the exact inverse CDF of
-//!   `D(h)(n.h)` (so narrow lobes are resolved at any roughness).
+//! * **Normalizer** `A`: [`directional_albedo`], a Gauss–Legendre rule over half
+//!   vectors (error below `1e-10`), split into the diffuse and specular layers.
 //! * **Baseline warp** ([`BrdfTarget::sample`]): what a renderer does: GGX
 //!   visible-normal sampling (Heitz 2018) with probability `A_spec / A`, else Malley
 //!   cosine sampling; a direction below the horizon (possible for VNDF) is mirrored
 //!   to `z -> -z`. Not distributed exactly by `q`.
 //! * **Exact samples** ([`BrdfTarget::sample_target`]): rejection from the mixture
-//!   `p = w p_vndf + (1 - w) p_cos`. The specular part satisfies
-//!   `f_spec cos = p_vndf F G1(wi) <= p_vndf`, the diffuse part
-//!   `(1 - F0) f_diff cos <= c_d p_cos` with
+//!   `p = w p_vndf + (1 - w) p_cos`, `p_vndf = G1(wo) D / (4 n.wo)`. The specular layer
+//!   satisfies `f_spec cos <= p_vndf`: for glTF `F D Vis (n.wi) = F D G2 / (4 n.wo)`
+//!   with the height-correlated `G2 = 1/(1 + Λ(wo) + Λ(wi)) <= G1(wo)`, for Burley
+//!   `F D G1(wo) G1(wi) / (4 n.wo)` with `G1(wi) <= 1`; and the diffuse layer
+//!   `f_diff cos <= c_d p_cos` with `c_d = 1 - F0` for glTF (`(1 - F)/pi <= (1 - F0)/pi`)
+//!   and, for Burley,
 //!   `c_d = (1 - F0) max(1, Fd90max) max(1, 1 + (Fd90max - 1)(1 - n.wo)^5)`,
-//!   `Fd90max = 0.5 + 2 roughness`; with `w = 1/(1 + c_d)`,
-//!   `f cos <= (1 + c_d) p`, so accepting with probability `f cos / ((1 + c_d) p)`
-//!   is exact; on average `(1 + c_d)/A` (about 2 to 7) proposals per sample.
+//!   `Fd90max = 0.5 + 2 roughness`. With `w = 1/(1 + c_d)`, `f cos <= (1 + c_d) p`,
+//!   so accepting with probability `f cos / ((1 + c_d) p)` is exact; on average
+//!   `(1 + c_d)/A` proposals per sample (about 2 for glTF, 2 to 7 for Burley).
 //! * **Cap measure**: a weighted rule of `2^18` directions (stratified midpoint grids
 //!   of the same two proposals, balance-heuristic weights `q / (n_s p_vndf + n_c p_cos)`,
 //!   renormalized) in a [`CapMeasureTable`]: `O(sqrt K)` per cap (~10 µs); its error
@@ -25,6 +27,7 @@
 //!   rule), checked against exact samples in the tests. Building it takes ~0.1 s.
 //!   [`DirectionDensity::cap_measure_profile`] uses a `2^16`-point rule (coarser).
 
+use super::brdf_albedo::directional_albedo;
 use super::cap_table::{profile_of_rule, CapMeasureTable};
 use super::density::{
     domain_name, malley, normalize_rule, spec_num, DirectionDensity, DirectionSpecError,
@@ -32,9 +35,9 @@ use super::density::{
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
 use nuld_core::brdf::{
-    alpha, brdf, burley_diffuse, cosine_weighted, ggx_d, smith_g1, view_direction, F0,
+    alpha, ggx_d, smith_g1, view_direction, BrdfModel, F0, MAX_ROUGHNESS, MAX_THETA_O_DEG,
+    MIN_ROUGHNESS,
 };
-use nuld_core::sphere::square_to_hemisphere;
 use rand::{Rng, RngCore};
 use std::f64::consts::PI;
 
@@ -42,12 +45,11 @@ use std::f64::consts::PI;
 const TABLE_POINTS: usize = 1 << 18;
 /// Points of the rule used for cap-measure profiles.
 const PROFILE_POINTS: usize = 1 << 16;
-/// Side of the midpoint grids used for the normalizer.
-const ALBEDO_GRID: usize = 512;
 
 /// The `brdf:` target (see the module docs for every method and its cost).
 #[derive(Clone, Debug)]
 pub struct BrdfTarget {
+    model: BrdfModel,
     roughness: f64,
     theta_o_deg: f64,
     wo: DVec3,
@@ -62,36 +64,47 @@ pub struct BrdfTarget {
 }
 
 impl BrdfTarget {
-    /// The target for `roughness` in `(0, 1]` and view angle `theta_o_deg` in
-    /// `[0, 90)` degrees; `domain` is [`Domain::Sphere`] or [`Domain::Hemisphere`]
-    /// (the density lives on `z > 0` either way).
+    /// The glTF 2.0 target ([`BrdfModel::Gltf`]) for `roughness` in `[0.1, 1]` and view
+    /// angle `theta_o_deg` in `[0, 89]` degrees; `domain` is [`Domain::Sphere`] or
+    /// [`Domain::Hemisphere`] (the density lives on `z > 0` either way).
     pub fn new(
         roughness: f64,
         theta_o_deg: f64,
         domain: Domain,
     ) -> Result<Self, DirectionSpecError> {
-        if !(roughness > 0.0 && roughness <= 1.0) {
+        Self::with_model(BrdfModel::Gltf, roughness, theta_o_deg, domain)
+    }
+
+    /// [`BrdfTarget::new`] for any [`BrdfModel`]. Conditions outside the range are
+    /// an error (not clamped): a SPEC names exactly the target it gets.
+    pub fn with_model(
+        model: BrdfModel,
+        roughness: f64,
+        theta_o_deg: f64,
+        domain: Domain,
+    ) -> Result<Self, DirectionSpecError> {
+        let kind = spec_kind(model);
+        if !(MIN_ROUGHNESS..=MAX_ROUGHNESS).contains(&roughness) {
             return Err(DirectionSpecError::OutOfRange {
-                kind: "brdf",
+                kind,
                 param: "ROUGHNESS",
                 value: roughness,
-                range: "(0, 1]",
+                range: "[0.1, 1]",
             });
         }
-        if !(0.0..90.0).contains(&theta_o_deg) {
+        if !(0.0..=MAX_THETA_O_DEG).contains(&theta_o_deg) {
             return Err(DirectionSpecError::OutOfRange {
-                kind: "brdf",
+                kind,
                 param: "THETA_O_DEG",
                 value: theta_o_deg,
-                range: "[0, 90)",
+                range: "[0, 89]",
             });
         }
         let wo = view_direction(theta_o_deg);
         let a = alpha(roughness);
-        let diffuse_albedo = diffuse_albedo(wo, roughness, ALBEDO_GRID);
-        let specular_albedo = specular_albedo(wo, roughness, ALBEDO_GRID);
-        let total = diffuse_albedo + specular_albedo;
-        let what = format!("brdf:{},{}", spec_num(roughness), spec_num(theta_o_deg));
+        let parts = directional_albedo(model, roughness, theta_o_deg);
+        let total = parts.total();
+        let what = format!("{kind}:{},{}", spec_num(roughness), spec_num(theta_o_deg));
         if !total.is_finite() {
             return Err(DirectionSpecError::NonFiniteMass { what });
         }
@@ -101,17 +114,23 @@ impl BrdfTarget {
                 domain: domain_name(domain),
             });
         }
-        let fd90_max = 0.5 + 2.0 * roughness;
-        let fo = 1.0 + (fd90_max - 1.0) * (1.0 - wo.z).powi(5);
-        let c_d = (1.0 - F0) * fd90_max.max(1.0) * fo.max(1.0);
+        let c_d = match model {
+            BrdfModel::Gltf => 1.0 - F0,
+            BrdfModel::Burley => {
+                let fd90_max = 0.5 + 2.0 * roughness;
+                let fo = 1.0 + (fd90_max - 1.0) * (1.0 - wo.z).powi(5);
+                (1.0 - F0) * fd90_max.max(1.0) * fo.max(1.0)
+            }
+        };
         let mut target = Self {
+            model,
             roughness,
             theta_o_deg,
             wo,
             alpha: a,
             domain,
-            diffuse_albedo,
-            specular_albedo,
+            diffuse_albedo: parts.diffuse,
+            specular_albedo: parts.specular,
             bound: 1.0 + c_d,
             table: CapMeasureTable::new(&[]),
             profile_rule: Vec::new(),
@@ -119,6 +138,11 @@ impl BrdfTarget {
         target.table = CapMeasureTable::new(&target.quadrature(TABLE_POINTS));
         target.profile_rule = target.quadrature(PROFILE_POINTS);
         Ok(target)
+    }
+
+    /// The BRDF model.
+    pub fn model(&self) -> BrdfModel {
+        self.model
     }
 
     /// The roughness.
@@ -186,7 +210,7 @@ impl BrdfTarget {
             if wi.z <= 0.0 {
                 return;
             }
-            let q = cosine_weighted(self.wo, wi, self.roughness) / a;
+            let q = self.model.cosine_weighted(self.wo, wi, self.roughness) / a;
             let p = ns * self.pdf_vndf(wi) + nc * wi.z / PI;
             if q > 0.0 && p > 0.0 {
                 rule.push((wi, q / p));
@@ -213,7 +237,8 @@ impl BrdfTarget {
 impl DirectionDensity for BrdfTarget {
     fn spec(&self) -> String {
         format!(
-            "brdf:{},{}",
+            "{}:{},{}",
+            spec_kind(self.model),
             spec_num(self.roughness),
             spec_num(self.theta_o_deg)
         )
@@ -224,7 +249,7 @@ impl DirectionDensity for BrdfTarget {
     }
 
     fn pdf(&self, w: DVec3) -> f64 {
-        cosine_weighted(self.wo, w, self.roughness) / self.albedo()
+        self.model.cosine_weighted(self.wo, w, self.roughness) / self.albedo()
     }
 
     /// The baseline warp: `u.x < A_spec / A` picks the VNDF lobe (`u.x` rescaled),
@@ -255,7 +280,7 @@ impl DirectionDensity for BrdfTarget {
             if wi.z <= 0.0 {
                 continue;
             }
-            let f = cosine_weighted(self.wo, wi, self.roughness);
+            let f = self.model.cosine_weighted(self.wo, wi, self.roughness);
             let p = self.pdf_proposal(wi);
             if rng.random::<f64>() * self.bound * p <= f {
                 return wi.normalize();
@@ -298,52 +323,12 @@ pub fn sample_ggx_vndf(wo: DVec3, alpha: f64, u: DVec2) -> DVec3 {
     DVec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(0.0)).normalize()
 }
 
-/// `(1 - F0) f_diff` of the pair.
-fn diffuse_part(wo: DVec3, wi: DVec3, roughness: f64) -> f64 {
-    let h = (wo + wi).normalize_or_zero();
-    burley_diffuse(wo.z, wi.z, h.dot(wi), roughness) * (1.0 - F0)
-}
-
-/// `∫ (1 - F0) f_diff cos dwi`: midpoint rule on an `m x m` equal-area hemisphere grid.
-fn diffuse_albedo(wo: DVec3, roughness: f64, m: usize) -> f64 {
-    let mut s = 0.0;
-    for j in 0..m {
-        for i in 0..m {
-            let p = DVec2::new((i as f64 + 0.5) / m as f64, (j as f64 + 0.5) / m as f64);
-            let wi = square_to_hemisphere(p);
-            s += diffuse_part(wo, wi, roughness) * wi.z;
-        }
+/// The SPEC kind of `model`: `brdf` (glTF 2.0, the default) or `brdf-burley`.
+pub fn spec_kind(model: BrdfModel) -> &'static str {
+    match model {
+        BrdfModel::Gltf => "brdf",
+        BrdfModel::Burley => "brdf-burley",
     }
-    s * 2.0 * PI / (m * m) as f64
-}
-
-/// `∫ f_spec cos dwi` in half-vector space: `h` on an `m x m` midpoint grid through
-/// the inverse CDF of `D(h)(n.h)` (`tan^2 theta_h = alpha^2 u/(1-u)`,
-/// `phi = 2 pi v`), `wi = reflect(wo, h)`, weight `f_spec cos 4 (wo.h) / (D (n.h))`.
-fn specular_albedo(wo: DVec3, roughness: f64, m: usize) -> f64 {
-    let a = alpha(roughness);
-    let mut s = 0.0;
-    for j in 0..m {
-        for i in 0..m {
-            let u = (i as f64 + 0.5) / m as f64;
-            let v = (j as f64 + 0.5) / m as f64;
-            let cos_h = 1.0 / (1.0 + a * a * u / (1.0 - u)).sqrt();
-            let sin_h = (1.0 - cos_h * cos_h).max(0.0).sqrt();
-            let phi = 2.0 * PI * v;
-            let h = DVec3::new(sin_h * phi.cos(), sin_h * phi.sin(), cos_h);
-            let wo_h = wo.dot(h);
-            if wo_h <= 0.0 {
-                continue;
-            }
-            let wi = 2.0 * wo_h * h - wo;
-            if wi.z <= 0.0 {
-                continue;
-            }
-            let spec = brdf(wo, wi, roughness) - diffuse_part(wo, wi, roughness);
-            s += spec * wi.z * 4.0 * wo_h / (ggx_d(cos_h, a) * cos_h);
-        }
-    }
-    s / (m * m) as f64
 }
 
 #[cfg(test)]
@@ -381,7 +366,13 @@ mod tests {
     fn vndf_and_proposal_densities_match() {
         // The balance-heuristic weights sum to ∫ q = 1 only if the VNDF sampler
         // produces exactly the density pdf_vndf (and Malley z/pi).
-        for (r, t) in [(0.05, 0.0), (0.1, 30.0), (0.3, 60.0), (0.7, 85.0)] {
+        for (r, t) in [
+            (0.1, 0.0),
+            (0.1, 30.0),
+            (0.3, 60.0),
+            (0.7, 85.0),
+            (0.1, 89.0),
+        ] {
             let b = BrdfTarget::new(r, t, Domain::Hemisphere).unwrap();
             let (_, raw) = b.rule(1 << 18);
             assert!((raw - 1.0).abs() < 2e-3, "r={r} t={t}: {raw}");

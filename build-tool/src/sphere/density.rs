@@ -1,6 +1,6 @@
 //! Target densities of directions (DESIGN.md §3 sphere SPECs): `uniform`, `cosine`,
-//! `brdf:ROUGHNESS,THETA_O_DEG` and `envmap:PATH`, on the sphere or the upper
-//! hemisphere.
+//! `brdf:ROUGHNESS,THETA_O_DEG` (glTF 2.0; `brdf-burley:` for Burley's BRDF) and
+//! `envmap:PATH`, on the sphere or the upper hemisphere.
 //!
 //! Every density is a probability density per unit solid angle, normalized over the
 //! sphere (`∫ pdf dω = 1`; zero where the target has no mass). Each one offers:
@@ -24,6 +24,7 @@ use super::geometry::{
 use crate::density::{fmt_num, split_params, DensityError, ParamError};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
+use nuld_core::brdf::BrdfModel;
 use nuld_core::sphere::{square_to_hemisphere, square_to_sphere};
 use rand::{Rng, RngCore};
 use std::f64::consts::{FRAC_PI_4, PI};
@@ -134,7 +135,7 @@ pub enum DirectionSpecError {
     /// The kind before `:` is not a direction density.
     #[error(
         "unknown direction density spec kind `{kind}` (expected uniform, cosine, \
-         brdf:ROUGHNESS,THETA_O_DEG or envmap:PATH)"
+         brdf:ROUGHNESS,THETA_O_DEG, brdf-burley:ROUGHNESS,THETA_O_DEG or envmap:PATH)"
     )]
     UnknownKind {
         /// The kind as written.
@@ -238,9 +239,11 @@ pub(crate) fn domain_name(d: Domain) -> &'static str {
 ///
 /// * `uniform` — uniform on the domain (on the hemisphere: over `z >= 0`);
 /// * `cosine` — `∝ max(z, 0)` (the same on both domains);
-/// * `brdf:ROUGHNESS,THETA_O_DEG` — `∝ f(wo, wi) max(n.wi, 0)` of
-///   [`nuld_core::brdf`] with `wo = view_direction(THETA_O_DEG)`;
-///   ROUGHNESS in `(0, 1]`, THETA_O_DEG in `[0, 90)`;
+/// * `brdf:ROUGHNESS,THETA_O_DEG` — `∝ f(wo, wi) max(n.wi, 0)` of the glTF 2.0 BRDF
+///   ([`nuld_core::brdf`]) with `wo = view_direction(THETA_O_DEG)`;
+///   ROUGHNESS in `[0.1, 1]`, THETA_O_DEG in `[0, 89]`;
+/// * `brdf-burley:ROUGHNESS,THETA_O_DEG` — the same with Burley's 2012 BRDF
+///   ([`BrdfModel::Burley`]), same ranges;
 /// * `envmap:PATH` — equirectangular luminance map, `+z` up (everything after the
 ///   first `:` is the path). On the hemisphere domain the map is cut at the horizon.
 ///
@@ -282,6 +285,20 @@ pub fn parse_direction_spec(
                 rest,
             )?;
             Ok(Box::new(BrdfTarget::new(p[0], p[1], domain)?))
+        }
+        "brdf-burley" => {
+            let p = params(
+                "brdf-burley",
+                "brdf-burley:ROUGHNESS,THETA_O_DEG",
+                &["ROUGHNESS", "THETA_O_DEG"],
+                rest,
+            )?;
+            Ok(Box::new(BrdfTarget::with_model(
+                BrdfModel::Burley,
+                p[0],
+                p[1],
+                domain,
+            )?))
         }
         "envmap" => {
             let path = rest.unwrap_or("");
@@ -448,6 +465,7 @@ mod tests {
             ("uniform", Domain::Sphere),
             (" cosine ", Domain::Hemisphere),
             ("brdf:0.5, 30", Domain::Hemisphere),
+            ("brdf-burley:0.5,30", Domain::Hemisphere),
         ] {
             let den = parse_direction_spec(s, d).unwrap();
             assert_eq!(den.domain(), d);
@@ -458,6 +476,12 @@ mod tests {
                 .unwrap()
                 .spec(),
             "brdf:0.5,30"
+        );
+        assert_eq!(
+            parse_direction_spec("brdf-burley:0.1,89", Domain::Sphere)
+                .unwrap()
+                .spec(),
+            "brdf-burley:0.1,89"
         );
         let bad = [
             ("", "empty"),
@@ -471,10 +495,18 @@ mod tests {
                 "takes 2 parameter(s) (brdf:ROUGHNESS,THETA_O_DEG), got 1",
             ),
             ("brdf:x,30", "ROUGHNESS = `x` is not a number"),
-            ("brdf:0,30", "ROUGHNESS = 0 is outside (0, 1]"),
+            ("brdf:0.09,30", "ROUGHNESS = 0.09 is outside [0.1, 1]"),
             ("brdf:1.5,30", "ROUGHNESS = 1.5 is outside"),
             ("brdf:nan,30", "ROUGHNESS = NaN is outside"),
-            ("brdf:0.5,90", "THETA_O_DEG = 90 is outside [0, 90)"),
+            ("brdf:0.5,89.5", "THETA_O_DEG = 89.5 is outside [0, 89]"),
+            (
+                "brdf-burley:0.05,30",
+                "`brdf-burley`: parameter ROUGHNESS = 0.05",
+            ),
+            (
+                "brdf-burley:1",
+                "takes 2 parameter(s) (brdf-burley:ROUGHNESS,THETA_O_DEG)",
+            ),
             ("brdf:0.5,-1", "THETA_O_DEG = -1 is outside"),
             ("envmap:", "needs a file path"),
             ("envmap:/nonexistent/x.hdr", "not found"),

@@ -3,8 +3,11 @@
 //! §5, §6; paper §2.1 Eqs. 7–9 and §3.5).
 //!
 //! * [`density`]: the [`DirectionDensity`] trait and [`parse_direction_spec`] for the
-//!   SPECs `uniform`, `cosine`, `brdf:ROUGHNESS,THETA_O_DEG`, `envmap:PATH`;
+//!   SPECs `uniform`, `cosine`, `brdf:ROUGHNESS,THETA_O_DEG` (`brdf-burley:...`),
+//!   `envmap:PATH`;
 //! * [`brdf_target`], [`envmap`]: the two tabulated targets;
+//! * [`brdf_albedo`]: the BRDF's directional albedo (the `brdf` normalizer and the
+//!   per-condition sample weight) and tables of it;
 //! * [`geometry`]: closed-form cap measures (uniform sphere and hemisphere, cosine);
 //! * [`cap_table`]: [`CapMeasureTable`], fast cap sums over a weighted point rule;
 //! * [`metrics`]: cap L2 discrepancy (Stolarsky closed form, energy distance,
@@ -13,6 +16,7 @@
 //!
 //! A cap is `C(w, t) = {x : <w, x> >= t}`, `t = cos theta`.
 
+pub mod brdf_albedo;
 pub mod brdf_target;
 pub mod cap_table;
 pub mod density;

@@ -1,0 +1,174 @@
+//! [`Real`]: the few floating-point operations that shared formulas need, for `f32`
+//! and `f64`.
+//!
+//! A formula written once over `T: Real` serves the build tool (in `f64`, for
+//! quadratures and references) and the runtime (in `f32`, the precision a shader
+//! reproduces) without a second copy. Transcendentals go through `libm`, so both
+//! instantiations are `no_std` and give the same bits on every platform.
+
+use core::ops::{Add, Div, Mul, Neg, Sub};
+
+/// A real scalar type (`f32` or `f64`) with the operations shared formulas use.
+///
+/// Every method is total: NaN propagates as IEEE 754 says, except in [`Real::max`]
+/// and [`Real::min`], which return the other argument when one is NaN (IEEE
+/// `maxNum`/`minNum`, like `f64::max`).
+pub trait Real:
+    Copy
+    + PartialOrd
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// `0`.
+    const ZERO: Self;
+    /// `1`.
+    const ONE: Self;
+    /// `pi`.
+    const PI: Self;
+    /// `x` rounded to the nearest value of `Self` (exact for `f64`).
+    fn of(x: f64) -> Self;
+    /// The square root (NaN for negative arguments).
+    fn sqrt(self) -> Self;
+    /// The larger argument; the other one if either is NaN.
+    fn max(self, other: Self) -> Self;
+    /// The smaller argument; the other one if either is NaN.
+    fn min(self, other: Self) -> Self;
+    /// The absolute value.
+    fn abs(self) -> Self;
+    /// Whether `self` is NaN.
+    fn is_nan(self) -> bool;
+    /// Whether `self` is neither infinite nor NaN.
+    fn is_finite(self) -> bool;
+    /// `cos` of an angle in radians.
+    fn cos(self) -> Self;
+    /// `sin` of an angle in radians.
+    fn sin(self) -> Self;
+    /// Rounded towards negative infinity.
+    fn floor(self) -> Self;
+    /// The value as `f64` (exact).
+    fn to_f64(self) -> f64;
+}
+
+impl Real for f64 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    const PI: Self = core::f64::consts::PI;
+    #[inline]
+    fn of(x: f64) -> Self {
+        x
+    }
+    #[inline]
+    fn sqrt(self) -> Self {
+        libm::sqrt(self)
+    }
+    #[inline]
+    fn max(self, other: Self) -> Self {
+        f64::max(self, other)
+    }
+    #[inline]
+    fn min(self, other: Self) -> Self {
+        f64::min(self, other)
+    }
+    #[inline]
+    fn abs(self) -> Self {
+        libm::fabs(self)
+    }
+    #[inline]
+    fn is_nan(self) -> bool {
+        f64::is_nan(self)
+    }
+    #[inline]
+    fn is_finite(self) -> bool {
+        f64::is_finite(self)
+    }
+    #[inline]
+    fn cos(self) -> Self {
+        libm::cos(self)
+    }
+    #[inline]
+    fn sin(self) -> Self {
+        libm::sin(self)
+    }
+    #[inline]
+    fn floor(self) -> Self {
+        libm::floor(self)
+    }
+    #[inline]
+    fn to_f64(self) -> f64 {
+        self
+    }
+}
+
+impl Real for f32 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    const PI: Self = core::f32::consts::PI;
+    #[inline]
+    fn of(x: f64) -> Self {
+        x as f32
+    }
+    #[inline]
+    fn sqrt(self) -> Self {
+        libm::sqrtf(self)
+    }
+    #[inline]
+    fn max(self, other: Self) -> Self {
+        f32::max(self, other)
+    }
+    #[inline]
+    fn min(self, other: Self) -> Self {
+        f32::min(self, other)
+    }
+    #[inline]
+    fn abs(self) -> Self {
+        libm::fabsf(self)
+    }
+    #[inline]
+    fn is_nan(self) -> bool {
+        f32::is_nan(self)
+    }
+    #[inline]
+    fn is_finite(self) -> bool {
+        f32::is_finite(self)
+    }
+    #[inline]
+    fn cos(self) -> Self {
+        libm::cosf(self)
+    }
+    #[inline]
+    fn sin(self) -> Self {
+        libm::sinf(self)
+    }
+    #[inline]
+    fn floor(self) -> Self {
+        libm::floorf(self)
+    }
+    #[inline]
+    fn to_f64(self) -> f64 {
+        f64::from(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hypot<T: Real>(a: T, b: T) -> T {
+        (a * a + b * b).sqrt()
+    }
+
+    #[test]
+    fn both_instantiations_agree_with_std() {
+        assert_eq!(hypot(3.0f64, 4.0), 5.0);
+        assert_eq!(hypot(3.0f32, 4.0), 5.0);
+        assert_eq!(<f32 as Real>::of(0.1), 0.1f32);
+        assert_eq!(Real::max(f64::NAN, 2.0), 2.0);
+        assert_eq!(Real::min(1.0f32, f32::NAN), 1.0);
+        assert_eq!(Real::floor(-0.5f64), -1.0);
+        assert!((Real::cos(<f32 as Real>::PI) + 1.0).abs() < 1e-7);
+        assert_eq!(Real::to_f64(0.5f32), 0.5);
+    }
+}
