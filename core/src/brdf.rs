@@ -1,4 +1,4 @@
-//! The BRDF model behind `brdf:` targets and `bake --brdf` (DESIGN.md §6).
+//! The BRDF model behind `brdf:` targets and `bake --brdf`.
 //!
 //! An isotropic dielectric in the Disney/Burley 2012 style, in a local frame whose
 //! normal is `n = +z`:
@@ -118,7 +118,7 @@ fn pow5(x: f64) -> f64 {
     x2 * x2 * x
 }
 
-/// The BRDF `f(wo, wi)` of DESIGN.md §6 (per steradian), normal `+z`.
+/// The BRDF `f(wo, wi)` of the module docs (per steradian), normal `+z`.
 ///
 /// `wo` (view) and `wi` (light) are unit vectors; it is 0 when either is at or
 /// below the horizon (`z <= 0`) or not finite. `roughness` is clamped by

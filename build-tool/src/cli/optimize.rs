@@ -59,7 +59,7 @@ pub struct OptimizeArgs {
     /// Domain: the unit square, or directions on the sphere or upper hemisphere.
     #[arg(long, value_enum, default_value = "square")]
     pub domain: DomainArg,
-    /// Target SPEC (DESIGN.md §3). Square: `uniform`, `gaussian:MX,MY,S`,
+    /// Target SPEC (grammar: docs/targets.md). Square: `uniform`, `gaussian:MX,MY,S`,
     /// `bilinear:..`, `quarter-disc`, `step-gaussian`, `image:PATH`; sphere and
     /// hemisphere: `uniform`, `cosine`, `brdf:ROUGHNESS,THETA_O_DEG`, `envmap:PATH`.
     /// Default: `gaussian:0.5,0.5,0.15` for the square, `uniform` for directions.

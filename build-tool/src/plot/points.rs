@@ -103,7 +103,7 @@ fn write_png(
 
 /// Draws `points` (in `[0,1]^2`) over `density` and writes a PNG of
 /// `size x (size + 60)` pixels to `path` atomically. The y axis points down, as
-/// image rows do (DESIGN.md §3: y grows with the row index), so an `image:` target
+/// image rows do (docs/targets.md: y grows with the row index), so an `image:` target
 /// appears upright.
 pub fn render_point_set(
     path: &Path,

@@ -1,6 +1,6 @@
 //! `envmap:PATH`: an equirectangular luminance map as a density of directions.
 //!
-//! Layout (DESIGN.md §3): `+z` up; column `c` of `W` covers
+//! Layout (docs/targets.md): `+z` up; column `c` of `W` covers
 //! `phi in [2 pi c / W, 2 pi (c+1) / W)` measured from `+x` toward `+y`; row `r` of
 //! `H` covers `theta in [pi r / H, pi (r+1) / H)` from `+z`. The density is constant
 //! on each pixel and proportional to its luminance; pixel `(c, r)` has solid angle
