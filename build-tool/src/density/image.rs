@@ -94,7 +94,7 @@ fn read_with_image_crate(path: &Path, shown: &str) -> Result<LuminanceImage, Den
         .with_guessed_format()
         .map_err(|e| io_error(shown, e))?
         .decode()
-        .map_err(|e| undecodable(one_line(e)))?;
+        .map_err(|e| undecodable(decode_reason(e)))?;
     let (width, height) = (img.width() as usize, img.height() as usize);
     let values: Vec<f64> = match &img {
         DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_) => img
@@ -118,6 +118,21 @@ fn read_with_image_crate(path: &Path, shown: &str) -> Result<LuminanceImage, Den
         height,
         values,
     })
+}
+
+/// The `image` crate's error on one line, except for an unrecognized file, which
+/// it words with an oddly quoted extension (`` `."txt"` ``).
+fn decode_reason(e: ::image::ImageError) -> String {
+    use ::image::error::{ImageFormatHint, UnsupportedErrorKind};
+    if let ::image::ImageError::Unsupported(u) = &e {
+        if let UnsupportedErrorKind::Format(ImageFormatHint::PathExtension(ext)) = u.kind() {
+            return format!(
+                "neither its content nor its extension `.{}` is PNG, JPEG, HDR or EXR",
+                ext.display()
+            );
+        }
+    }
+    one_line(e)
 }
 
 fn read_exr(path: &Path, shown: &str) -> Result<LuminanceImage, DensityError> {
@@ -470,6 +485,7 @@ mod tests {
     use super::*;
     use crate::density::check::{check_density, Checks};
     use crate::density::parse_spec;
+    use std::io::Write;
 
     /// A unique path in the system temp dir.
     fn temp_path(name: &str) -> std::path::PathBuf {
@@ -485,7 +501,6 @@ mod tests {
 
     #[test]
     fn grid_generic_checks() {
-    use std::io::Write;
         // 5x4 grid with black pixels, a black column and a black row.
         #[rustfmt::skip]
         let v = vec![
