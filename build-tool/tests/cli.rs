@@ -3,11 +3,23 @@
 
 use nuld_build_tool::pointset::AlignedBytes;
 use nuld_runtime::Blob;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn build_tool() -> Command {
     Command::new(env!("CARGO_BIN_EXE_build-tool"))
+}
+
+/// Runs `build-tool ARGS --out OUT`, which must fail; returns its stderr.
+fn failure(args: &[&str], out: &Path) -> String {
+    let o = build_tool()
+        .args(args)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    assert!(!o.status.success(), "{args:?}");
+    String::from_utf8(o.stderr).unwrap()
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -206,15 +218,7 @@ fn optimize_rejects_bad_input_with_one_line_and_writes_nothing() {
         ),
     ] {
         let out = dir.join("never");
-        let o = build_tool()
-            .arg("optimize")
-            .args(&args)
-            .arg("--out")
-            .arg(&out)
-            .output()
-            .unwrap();
-        assert!(!o.status.success(), "{args:?}");
-        let err = String::from_utf8(o.stderr).unwrap();
+        let err = failure(&[&["optimize"], &args[..]].concat(), &out);
         assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
         assert!(
             err.to_lowercase().contains(&needle.to_lowercase()),
@@ -361,14 +365,7 @@ fn negative_numbers_get_a_message_about_the_value() {
             "--lr must be positive, got -0.5",
         ),
     ] {
-        let o = build_tool()
-            .args(&args)
-            .arg("--out")
-            .arg(&out)
-            .output()
-            .unwrap();
-        assert!(!o.status.success(), "{args:?}");
-        let err = String::from_utf8(o.stderr).unwrap();
+        let err = failure(&args, &out);
         assert!(err.contains(needle), "{args:?}: {err}");
         assert!(!err.contains("unexpected argument"), "{args:?}: {err}");
         assert!(!out.exists(), "{args:?} left {out:?} behind");
@@ -386,16 +383,8 @@ fn an_unrecognized_image_names_its_extension_plainly() {
     )
     .unwrap();
     let out = dir.join("never");
-    let o = build_tool()
-        .arg("optimize")
-        .arg("--density")
-        .arg(format!("image:{}", text.display()))
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(!o.status.success());
-    let err = String::from_utf8(o.stderr).unwrap();
+    let spec = format!("image:{}", text.display());
+    let err = failure(&["optimize", "--density", &spec], &out);
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     assert!(err.contains("notes.txt"), "{err}");
     assert!(err.contains("extension `.txt`"), "{err}");

@@ -1,4 +1,4 @@
-//! Samples from a blob read at run time: `cargo run -p nuld-runtime --features std
+//! Reads a blob at run time and says what it holds: `cargo run -p nuld-runtime --features std
 //! --example load_file -- FILE.nuld`. Needs the runtime's `std` feature (or `alloc`
 //! and `AlignedBuf::from_bytes` on bytes from elsewhere).
 use nuld_runtime::{AlignedBuf, Blob};
@@ -10,23 +10,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // A `Vec<u8>` is not 16-byte aligned; `AlignedBuf` is.
     let buf = AlignedBuf::read(&path)?;
     let blob = Blob::parse(buf.as_bytes()).map_err(|e| format!("{path}: {e}"))?;
-    let meta = blob.metadata();
-    println!("{path}: {:?}, target {}", blob.kind(), meta.target);
+    println!("{path}: {:?} for {}", blob.kind(), blob.metadata().target);
     if let Ok(pts) = blob.point_set_2d() {
-        println!(
-            "{} sets of {} points; set 0, point 0: {}",
-            pts.set_count(),
-            pts.len(),
-            pts.point(0, 0)
-        );
-    }
-    if let Ok(dirs) = blob.direction_set() {
-        println!(
-            "{} sets of {} directions; set 0, direction 0: {}",
-            dirs.set_count(),
-            dirs.len(),
-            dirs.direction(0, 0)
-        );
+        println!("{} sets of {} points", pts.set_count(), pts.len());
+    } else if let Ok(dirs) = blob.direction_set() {
+        println!("{} sets of {} directions", dirs.set_count(), dirs.len());
     }
     Ok(())
 }
