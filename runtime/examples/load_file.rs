@@ -1,6 +1,7 @@
-//! Reads a blob at run time and says what it holds: `cargo run -p nuld-runtime --features std
-//! --example load_file -- FILE.nuld`. Needs the runtime's `std` feature (or `alloc`
-//! and `AlignedBuf::from_bytes` on bytes from elsewhere).
+//! Reads a blob at run time and says what it holds:
+//! `cargo run -p nuld-runtime --features std --example load_file -- FILE.nuld`.
+//! Needs the runtime's `std` feature (or `alloc` and `AlignedBuf::from_bytes` on
+//! bytes from elsewhere).
 use nuld_runtime::{AlignedBuf, Blob};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
