@@ -3,11 +3,23 @@
 
 use nuld_build_tool::pointset::AlignedBytes;
 use nuld_runtime::Blob;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn build_tool() -> Command {
     Command::new(env!("CARGO_BIN_EXE_build-tool"))
+}
+
+/// Runs `build-tool ARGS --out OUT`, which must fail; returns its stderr.
+fn failure(args: &[&str], out: &Path) -> String {
+    let o = build_tool()
+        .args(args)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    assert!(!o.status.success(), "{args:?}");
+    String::from_utf8(o.stderr).unwrap()
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -206,15 +218,7 @@ fn optimize_rejects_bad_input_with_one_line_and_writes_nothing() {
         ),
     ] {
         let out = dir.join("never");
-        let o = build_tool()
-            .arg("optimize")
-            .args(&args)
-            .arg("--out")
-            .arg(&out)
-            .output()
-            .unwrap();
-        assert!(!o.status.success(), "{args:?}");
-        let err = String::from_utf8(o.stderr).unwrap();
+        let err = failure(&[&["optimize"], &args[..]].concat(), &out);
         assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
         assert!(
             err.to_lowercase().contains(&needle.to_lowercase()),
@@ -312,4 +316,79 @@ fn bench_baselines_times_every_generator_at_every_size() {
         assert_eq!(ms.len(), 2, "{line}");
         assert!(ms.iter().all(|m| m.is_finite() && *m >= 0.0), "{line}");
     }
+}
+
+#[test]
+fn export_into_a_reader_that_stops_early_ends_quietly() {
+    use std::io::Read;
+    use std::process::Stdio;
+    let dir = scratch("pipe");
+    let file = dir.join("big.nuld");
+    // 4 sets of 4096 points: about 450 kB of CSV, far more than a pipe buffers, so
+    // the export is still writing when the reader goes away.
+    let st = build_tool()
+        .args(["sobol", "--n", "4096", "--sets", "4", "--out"])
+        .arg(&file)
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let mut child = build_tool()
+        .arg("export")
+        .arg(&file)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdout = child.stdout.take().unwrap();
+    let mut head = [0u8; 14];
+    stdout.read_exact(&mut head).unwrap();
+    assert_eq!(&head, b"set,index,x,y\n");
+    drop(stdout); // what `| head` does after its lines
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{:?}: {err}", out.status);
+    assert!(err.is_empty(), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn negative_numbers_get_a_message_about_the_value() {
+    let dir = scratch("negative");
+    let out = dir.join("never");
+    for (args, needle) in [
+        (vec!["optimize", "--n", "-5"], "-5 is negative"),
+        (vec!["optimize", "--sets", "-1"], "-1 is negative"),
+        (vec!["optimize", "--epochs", "-3"], "-3 is negative"),
+        (vec!["sobol", "--n", "-5"], "-5 is negative"),
+        (
+            vec!["optimize", "--lr", "-0.5"],
+            "--lr must be positive, got -0.5",
+        ),
+    ] {
+        let err = failure(&args, &out);
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("unexpected argument"), "{args:?}: {err}");
+        assert!(!out.exists(), "{args:?} left {out:?} behind");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn an_unrecognized_image_names_its_extension_plainly() {
+    let dir = scratch("image-ext");
+    let text = dir.join("notes.txt");
+    std::fs::write(
+        &text,
+        "not an image, and long enough to be sniffed as one\n",
+    )
+    .unwrap();
+    let out = dir.join("never");
+    let spec = format!("image:{}", text.display());
+    let err = failure(&["optimize", "--density", &spec], &out);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("notes.txt"), "{err}");
+    assert!(err.contains("extension `.txt`"), "{err}");
+    assert!(!err.contains("\"txt\""), "{err}");
+    assert!(!out.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
 }

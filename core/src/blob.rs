@@ -150,7 +150,7 @@ pub struct PointSetInfo {
 pub struct Metadata<'a> {
     /// What produced the blob, e.g. `"optimize"` or `"owen-sobol"`.
     pub generator: &'a str,
-    /// The target density SPEC (DESIGN.md §3), e.g. `"gaussian:0.5,0.5,0.15"`.
+    /// The target density SPEC (docs/targets.md), e.g. `"gaussian:0.5,0.5,0.15"`.
     pub target: &'a str,
     /// The seed the generator was run with.
     pub seed: u64,

@@ -167,7 +167,7 @@ pub fn hemisphere_to_square(d: DVec3) -> DVec2 {
 mod tests {
     use super::*;
 
-    // DESIGN.md §6's published vectors, verbatim (9 digits), hence the allow.
+    // The reference vectors of docs/metrics.md (pbrt-v4's map), verbatim (9 digits), hence the allow.
     #[allow(clippy::approx_constant)]
     const REFERENCE: [([f64; 2], [f64; 3]); 12] = [
         ([0.5, 0.5], [0.0, 0.0, 1.0]),

@@ -5,6 +5,9 @@
 //! input: every malformed blob is rejected by [`Blob::parse`] with a [`BlobError`],
 //! and every lookup on a parsed blob is total (indices wrap modulo the counts).
 //!
+//! Points and directions are [`glam`] vectors; use the re-exported
+//! [`nuld_runtime::glam`](glam) so that your glam version always matches.
+//!
 //! ```
 //! use nuld_runtime::{Blob, BlobKind};
 //! # let bytes = nuld_runtime::doc_example_blob();
@@ -14,32 +17,42 @@
 //! assert_eq!(blob.kind(), BlobKind::PointSet2D);
 //! let pts = blob.point_set_2d()?;
 //! for i in 0..pts.len() {
-//!     let p = pts.point(0, i); // glam::Vec2 in (0,1)^2
+//!     let p: nuld_runtime::glam::Vec2 = pts.point(0, i); // in (0,1)^2
 //!     assert!(p.x > 0.0 && p.x < 1.0 && p.y > 0.0 && p.y < 1.0);
 //! }
 //! # Ok::<(), nuld_runtime::BlobError>(())
 //! ```
 //!
-//! A `#![no_std]` renderer embeds a blob at compile time:
+//! Where the bytes come from:
+//! * compiled in: [`include_blob!`] (no allocation; `runtime/examples/embed.rs`);
+//! * read at run time: `AlignedBuf` with the `alloc` feature, and
+//!   `AlignedBuf::read` with `std` (`runtime/examples/load_file.rs`). Without the
+//!   features, copy the bytes into any 16-byte aligned storage of your own.
 //!
-//! ```ignore
-//! #![no_std]
-//! static SAMPLES: &[u8] = nuld_runtime::include_blob!("../assets/brdf.nuld");
-//!
-//! fn sample(pixel: u32, i: u32) -> glam::Vec2 {
-//!     match nuld_runtime::Blob::parse(SAMPLES).and_then(|b| b.point_set_2d()) {
-//!         Ok(set) => set.point(pixel as usize, i as usize),
-//!         Err(_) => glam::Vec2::splat(0.5),
-//!     }
-//! }
-//! ```
+//! ## Features
+//! * none (default): `no_std`, no allocator;
+//! * `alloc`: `AlignedBuf`, an owned aligned copy of a blob;
+//! * `std` (implies `alloc`): `AlignedBuf::read` from a file.
 #![no_std]
 #![deny(missing_docs)]
 
+#[cfg(feature = "alloc")]
+extern crate alloc;
+#[cfg(feature = "std")]
+extern crate std;
+
 mod aligned;
+#[cfg(feature = "alloc")]
+mod aligned_buf;
 mod points;
 
+/// The `glam` this crate returns its vectors in; use it instead of a `glam`
+/// dependency of your own so that the versions always match.
+pub use glam;
+
 pub use aligned::Aligned;
+#[cfg(feature = "alloc")]
+pub use aligned_buf::AlignedBuf;
 pub use nuld_core::blob::{BlobError, BlobKind, Domain, Metadata};
 pub use points::{DirectionSet, PointSet2D};
 

@@ -1,5 +1,5 @@
 //! Proof that the runtime links without `std` and without an allocator
-//! (DESIGN.md §7): build the `nuld-no-std-check` staticlib, which has its own
+//! (README.md, "no_std proof"): build the `nuld-no-std-check` staticlib, which has its own
 //! `#[panic_handler]`, under the panic=abort `nostd-check` profile, and show that
 //! the same build fails when a leak is planted on purpose.
 

@@ -9,7 +9,7 @@ use crate::seeding::rng;
 /// `n` independent uniform points in `[0,1)^2`, drawn from
 /// [`crate::seeding::rng`]`(seed, ..)` (PCG64-MCG, 53-bit floats). For `n` iid points
 /// the expected squared L2-star and average squared discrepancies are both
-/// `(5/36)/n` (DESIGN.md §5). `O(n)`.
+/// `(5/36)/n` (docs/metrics.md). `O(n)`.
 pub fn random(n: usize, seed: u64) -> Vec<DVec2> {
     let mut r = rng(seed, streams::RANDOM);
     (0..n)

@@ -209,7 +209,7 @@ pub fn sliced_optimal_transport(
 /// `O(directions (n + m) log(n + m))`.
 pub fn sliced_wasserstein(points: &[DVec2], reference: &[DVec2], directions: usize) -> f64 {
     let n = points.len();
-    assert!(n > 0 && reference.len() % n == 0 && directions > 0);
+    assert!(n > 0 && reference.len().is_multiple_of(n) && directions > 0);
     let per = reference.len() / n;
     let mut total = 0.0;
     for k in 0..directions {

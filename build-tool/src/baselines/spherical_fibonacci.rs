@@ -24,7 +24,7 @@ pub fn spherical_fibonacci(n: usize) -> Vec<DVec3> {
 mod tests {
     use super::*;
 
-    /// Spherical cap L2 discrepancy by Stolarsky's invariance (DESIGN.md §5),
+    /// Spherical cap L2 discrepancy by Stolarsky's invariance (docs/metrics.md),
     /// `D = sqrt((1/4)(4/3 - (1/N^2) sum_{j,k} |x_j - x_k|))`, `O(N^2)`.
     fn stolarsky_cap_discrepancy(x: &[DVec3]) -> f64 {
         let n = x.len() as f64;

@@ -46,11 +46,22 @@ pub fn write_csv(bytes: &[u8], out: &mut impl Write) -> Result<()> {
 }
 
 /// Runs `build-tool export`.
+///
+/// A reader that stops early (`export big.nuld | head`) closes the pipe; the
+/// resulting `BrokenPipe` write error ends the export normally, with exit code 0.
 pub fn run(a: ExportArgs) -> Result<()> {
     let bytes = AlignedBytes::read(&a.file)?;
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
-    write_csv(bytes.as_slice(), &mut out).map_err(|e| anyhow!("{}: {e}", a.file.display()))?;
-    out.flush()?;
-    Ok(())
+    let written = write_csv(bytes.as_slice(), &mut out).and_then(|()| Ok(out.flush()?));
+    match written {
+        Err(e) if is_broken_pipe(&e) => Ok(()),
+        other => other.map_err(|e| anyhow!("{}: {e}", a.file.display())),
+    }
+}
+
+/// Whether `e` is a write to a pipe whose reader has gone.
+fn is_broken_pipe(e: &anyhow::Error) -> bool {
+    e.downcast_ref::<std::io::Error>()
+        .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
 }

@@ -1,4 +1,4 @@
-//! The `build-tool` command line (DESIGN.md §3).
+//! The `build-tool` command line (README.md, "CLI").
 
 pub mod bench;
 pub mod eval;
@@ -55,6 +55,23 @@ impl From<DomainArg> for Domain {
             DomainArg::Hemisphere => Domain::Hemisphere,
         }
     }
+}
+
+/// Parses a count argument (`--n`, `--sets`, `--epochs`, ...): a whole number
+/// `>= 0`; the command's own range check (often `>= 1`) comes after. The arguments
+/// that use it accept values starting with `-`, so that `--n -5` is reported as a
+/// negative count instead of as an unknown argument `-5`.
+pub(crate) fn count(s: &str) -> Result<usize, String> {
+    s.parse::<usize>().map_err(|e| {
+        let negative = s
+            .strip_prefix('-')
+            .is_some_and(|digits| digits.parse::<u128>().is_ok());
+        if negative {
+            format!("{s} is negative; a count is a whole number >= 0")
+        } else {
+            e.to_string()
+        }
+    })
 }
 
 /// Runs a parsed command line.

@@ -15,10 +15,10 @@ pub struct SobolArgs {
     #[arg(long, value_enum, default_value = "square")]
     pub domain: super::DomainArg,
     /// Points per set.
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = 256, allow_negative_numbers = true, value_parser = super::count)]
     pub n: usize,
     /// Number of independently scrambled sets.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = super::count)]
     pub sets: usize,
     /// Seed of the scrambles.
     #[arg(long, default_value_t = 0)]

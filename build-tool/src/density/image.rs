@@ -143,7 +143,7 @@ fn read_with_image_crate(path: &Path, shown: &str) -> Result<LuminanceImage, Den
         .with_guessed_format()
         .map_err(|e| io_error(shown, e))?
         .decode()
-        .map_err(|e| undecodable(one_line(e)))?;
+        .map_err(|e| undecodable(decode_reason(e)))?;
     let (width, height) = (img.width() as usize, img.height() as usize);
     let values: Vec<f64> = match &img {
         DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_) => img
@@ -167,6 +167,21 @@ fn read_with_image_crate(path: &Path, shown: &str) -> Result<LuminanceImage, Den
         height,
         values,
     })
+}
+
+/// The `image` crate's error on one line, except for an unrecognized file, which
+/// it words with an oddly quoted extension (`` `."txt"` ``).
+fn decode_reason(e: ::image::ImageError) -> String {
+    use ::image::error::{ImageFormatHint, UnsupportedErrorKind};
+    if let ::image::ImageError::Unsupported(u) = &e {
+        if let UnsupportedErrorKind::Format(ImageFormatHint::PathExtension(ext)) = u.kind() {
+            return format!(
+                "neither its content nor its extension `.{}` is PNG, JPEG, HDR or EXR",
+                ext.display()
+            );
+        }
+    }
+    one_line(e)
 }
 
 fn read_exr(path: &Path, shown: &str) -> Result<LuminanceImage, DensityError> {
@@ -519,6 +534,7 @@ mod tests {
     use super::*;
     use crate::density::check::{check_density, Checks};
     use crate::density::parse_spec;
+    use std::io::Write;
 
     /// A unique path in the system temp dir.
     fn temp_path(name: &str) -> std::path::PathBuf {
@@ -628,7 +644,8 @@ mod tests {
     fn camera_png_if_present() {
         let path = "../../shared/data/images/camera.png";
         if !Path::new(path).exists() {
-            eprintln!("note: {path} not found; skipping the camera.png test");
+            // Straight to stderr: the test harness hides `eprintln!` of passing tests.
+            let _ = writeln!(std::io::stderr(), "skipped: {path} not found (see README)");
             return;
         }
         let d = parse_spec(&format!("image:{path}")).unwrap();
@@ -681,7 +698,7 @@ mod tests {
     fn studio_hdr_if_present() {
         let path = "../../shared/data/envmaps/studio.hdr";
         if !Path::new(path).exists() {
-            eprintln!("note: {path} not found; skipping the studio.hdr test");
+            let _ = writeln!(std::io::stderr(), "skipped: {path} not found (see README)");
             return;
         }
         let img = load_luminance(path).unwrap();

@@ -1,4 +1,4 @@
-//! Target densities on the unit square (DESIGN.md §3 SPEC grammar).
+//! Target densities on the unit square (SPEC grammar: docs/targets.md).
 //!
 //! Every density is normalized to integrate to 1 over `[0,1]^2` and exposes its
 //! pointwise value, its CDF (the measure of origin-anchored boxes), the measure of
@@ -237,7 +237,7 @@ fn parse_params(
     Ok(values)
 }
 
-/// Parses a square-domain density SPEC (DESIGN.md §3):
+/// Parses a square-domain density SPEC (docs/targets.md):
 ///
 /// * `uniform`
 /// * `gaussian:MX,MY,SIGMA` — isotropic Gaussian, truncated to the square

@@ -1,5 +1,5 @@
 //! The differentiable Monte-Carlo estimator of the average squared discrepancy
-//! (paper §3.1–3.3, DESIGN.md §4).
+//! (paper §3.1–3.3; formulas in docs/estimator.md).
 //!
 //! For M sampled anchors `u` and the four quadrant boxes `B_c(u)` spanned by `u`
 //! and each corner `c` of the square, with `M' = 4M`:
@@ -13,7 +13,7 @@
 //! sigmoid of the signed distance (positive inside) to the box, whose faces on the
 //! domain boundary are treated as absent, so each quadrant box is bounded only by
 //! the cross through `u` ([`estimator`]). The expectation of `loss` over `u` is the
-//! squared average squared discrepancy `(D2asd_mu)^2` of DESIGN.md §5.
+//! squared average squared discrepancy `(D2asd_mu)^2` of docs/metrics.md.
 
 pub mod caps;
 pub mod counting;

@@ -11,7 +11,7 @@ use serde::Serialize;
 /// Spherical cap discrepancies of a direction set (square roots).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct CapMetricSummary {
-    /// L2 cap discrepancy with `t = cos theta` uniform (DESIGN.md §5): Stolarsky's
+    /// L2 cap discrepancy with `t = cos theta` uniform (docs/metrics.md): Stolarsky's
     /// closed form for the uniform sphere, the energy-distance form with the target's
     /// quadrature rule otherwise.
     pub cap_l2: f64,

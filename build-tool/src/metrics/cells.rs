@@ -1,6 +1,6 @@
 //! Non-uniform L2 discrepancies for a piecewise-constant measure given as a
 //! [`CellGrid`]: the all-corner average squared discrepancy (kernel form) and the
-//! origin-anchored L2-star (DESIGN.md §5). Both are exact and cost
+//! origin-anchored L2-star (docs/metrics.md). Both are exact and cost
 //! `O(W H + N log N)`: the measure–measure term by separable operators on the grid,
 //! the point–measure term in `O(1)` per point from summed-area tables, the
 //! point–point term by [`super::pairs`].
@@ -81,7 +81,7 @@ fn check_grid(grid: &CellGrid) {
 /// `∫∫K dmu dmu` for the asd kernel. Per axis, the average of `(1 - |s - t|)/2` over
 /// `s` in cell `i`, `t` in cell `j` (width `h`) is `(1 - |m_i - m_j|)/2` for `i != j`
 /// (disjoint cells: the mean distance is the distance of the centres `m`) and
-/// `(1 - h/3)/2` for `i = j`; this is DESIGN's `((b-a)(d-c) - H)/2` divided by the
+/// `(1 - h/3)/2` for `i = j`; this is docs/metrics.md's `((b-a)(d-c) - H)/2` divided by the
 /// cell areas, without its cancellation. The double sum over cell pairs is then
 /// `sum M ∘ (T_y M T_x)` with Toeplitz `T`, each applied in linear time.
 fn asd_measure_term(grid: &CellGrid) -> f64 {
@@ -153,7 +153,7 @@ fn locate(x: f64, n: usize) -> (usize, f64, f64) {
     (c, c as f64 / nf, (c + 1) as f64 / nf)
 }
 
-/// Axis form of `t -> (1 - |x - t|)/2` averaged over cells (DESIGN §5 per-axis
+/// Axis form of `t -> (1 - |x - t|)/2` averaged over cells (docs/metrics.md per-axis
 /// closed form divided by the width `h`): `(1 - |x - m_c|)/2` off the own cell,
 /// `1/2 - ((x-a)^2 + (b-x)^2)/(4h)` on it.
 fn asd_axis(x: f64, n: usize) -> AxisForm {
@@ -401,7 +401,7 @@ mod tests {
         }
     }
 
-    /// DESIGN §5 per-axis formulas, evaluated cell by cell (dense reference).
+    /// docs/metrics.md's per-axis formulas, evaluated cell by cell (dense reference).
     fn g_design(x: f64, a: f64, b: f64) -> f64 {
         let g = if x <= a {
             ((b - x).powi(2) - (a - x).powi(2)) / 2.0

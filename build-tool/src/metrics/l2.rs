@@ -1,5 +1,5 @@
 //! L2 discrepancies for the uniform measure on `[0,1]^2`: Warnock's origin-anchored
-//! L2-star and the all-corner average squared discrepancy (DESIGN.md §5).
+//! L2-star and the all-corner average squared discrepancy (docs/metrics.md).
 
 use glam::DVec2;
 
@@ -68,7 +68,7 @@ mod tests {
     use super::*;
     use crate::metrics::test_util::{hammersley, random_points, SplitMix64};
 
-    /// DESIGN.md §5 reference values (sqrt), 7 significant digits.
+    /// docs/metrics.md reference values (sqrt), 7 significant digits.
     const HAMMERSLEY: [(usize, f64, f64); 4] = [
         (16, 6.929084e-2, 4.794558e-2),
         (64, 2.120511e-2, 1.533232e-2),

@@ -1,4 +1,4 @@
-//! Exact discrepancy metrics in 2D (DESIGN.md §5), used by optimizer reports and the
+//! Exact discrepancy metrics in 2D (docs/metrics.md), used by optimizer reports and the
 //! evaluation figures.
 //!
 //! * [`l2`]: uniform L2 discrepancies — Warnock's L2-star and the all-corner average
@@ -10,7 +10,7 @@
 //! * [`pairs`]: the point–point kernel means shared by the L2 metrics, fast and dense.
 //!
 //! Every `*_squared` function returns the squared discrepancy; the unsuffixed one its
-//! square root (as DESIGN's reference table and scipy do). Points lie in `[0,1]^2`.
+//! square root (as docs/metrics.md's reference table and scipy do). Points lie in `[0,1]^2`.
 //! Everything is deterministic: sequential, or parallel with fixed chunking and
 //! fixed-order (or exact, for maxima) reductions.
 

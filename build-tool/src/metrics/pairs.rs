@@ -1,5 +1,5 @@
 //! Point–point kernel means shared by the L2 discrepancies (the `(1/N^2) sum_i sum_k`
-//! terms of DESIGN.md §5), exact in `O(N log N)` by sorting and Fenwick-tree dominance
+//! terms of docs/metrics.md), exact in `O(N log N)` by sorting and Fenwick-tree dominance
 //! sums, with dense `O(N^2)` references.
 
 use glam::DVec2;

@@ -16,7 +16,7 @@ const L_CHUNK: usize = 128;
 /// `D* = sup_a |#{x_i in [0,a)}/N - F(a)|`, equal to the same supremum over closed
 /// boxes `[0,a]`.
 ///
-/// Bundschuh–Zhu (DESIGN.md §5): sort by `x` with sentinels `x_0 = 0`, `x_{N+1} = 1`;
+/// Bundschuh–Zhu (docs/metrics.md): sort by `x` with sentinels `x_0 = 0`, `x_{N+1} = 1`;
 /// for `l = 0..=N` let `xi_{l,1..=l}` be the sorted `y` of the first `l` points,
 /// `xi_{l,0} = 0`, `xi_{l,l+1} = 1`; then
 /// `D* = max_l max_{k<=l} max(k/N - F(x_l, xi_{l,k}), F(x_{l+1}, xi_{l,k+1}) - k/N)`.
@@ -134,7 +134,7 @@ mod tests {
     use super::*;
     use crate::metrics::test_util::{hammersley, random_points, SplitMix64};
 
-    /// Best-known (optimal) star discrepancy for N = 1..20, DESIGN.md §5 (4 decimals).
+    /// Best-known (optimal) star discrepancy for N = 1..20, docs/metrics.md (4 decimals).
     const FLOOR: [f64; 20] = [
         0.6180, 0.3660, 0.2847, 0.2500, 0.2000, 0.1667, 0.1500, 0.1328, 0.1235, 0.1111, 0.1030,
         0.0952, 0.0889, 0.0837, 0.0782, 0.0739, 0.0699, 0.0666, 0.0634, 0.0604,

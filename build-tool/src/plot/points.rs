@@ -17,13 +17,15 @@ fn err(e: impl std::fmt::Display) -> anyhow::Error {
 
 /// Fills the plotting area of a `[lo, hi]^2` chart with `shade(x, y)` (grayscale,
 /// white = high, scaled to the 99th percentile so a sharp peak does not wash out the
-/// rest; `None` = outside the domain, drawn white) and draws `points` on top.
+/// rest; `None` = outside the domain, drawn white), draws the polyline `outline`
+/// (the domain's edge where the chart's frame is not) and `points` on top.
 fn draw_panel(
     area: &Area<'_>,
     caption: &str,
     (lo, hi): (f64, f64),
     axes: Option<(&str, &str)>,
     shade: &dyn Fn(f64, f64) -> Option<f64>,
+    outline: &[(f64, f64)],
     points: &[(f64, f64)],
 ) -> Result<()> {
     let mut builder = ChartBuilder::on(area);
@@ -73,6 +75,10 @@ fn draw_panel(
                 .map_err(err)?;
         }
     }
+    if !outline.is_empty() {
+        plot.draw(&PathElement::new(outline.to_vec(), BLACK.stroke_width(1)))
+            .map_err(err)?;
+    }
     let radius = if points.len() > 2000 { 1 } else { 2 };
     for &p in points {
         plot.draw(&Circle::new(p, radius, RGBColor(220, 30, 30).filled()))
@@ -103,7 +109,7 @@ fn write_png(
 
 /// Draws `points` (in `[0,1]^2`) over `density` and writes a PNG of
 /// `size x (size + 60)` pixels to `path` atomically. The y axis points down, as
-/// image rows do (DESIGN.md §3: y grows with the row index), so an `image:` target
+/// image rows do (docs/targets.md: y grows with the row index), so an `image:` target
 /// appears upright.
 pub fn render_point_set(
     path: &Path,
@@ -120,15 +126,17 @@ pub fn render_point_set(
             (0.0, 1.0),
             Some(("x", "y (down)")),
             &|x, y| Some(density(DVec2::new(x, 1.0 - y))),
+            &[],
             &flipped,
         )
     })
 }
 
-/// Draws a direction set three ways, side by side: its points in the domain's
-/// equal-area square over the density, and orthographic views of the sphere from
-/// `+z` and from `-z` (the latter mirrored, as seen from below), each over the
-/// density of the visible half. Writes a PNG of `3 size x (size + 60)` pixels.
+/// Draws a direction set side by side: its points in the domain's equal-area square
+/// over the density, and orthographic views of the sphere from `+z` and, if the
+/// domain reaches below the horizon, from `-z` (mirrored, as seen from below), each
+/// over the density of the visible half and outlined by the unit circle. Writes a
+/// PNG of `3 size x (size + 60)` pixels (`2 size` wide for the hemisphere).
 ///
 /// `to_direction` is the domain's equal-area map; `density` is per solid angle.
 pub fn render_direction_set(
@@ -141,20 +149,36 @@ pub fn render_direction_set(
 ) -> Result<()> {
     let dirs: Vec<DVec3> = square_points.iter().map(|&p| to_direction(p)).collect();
     let flipped: Vec<(f64, f64)> = square_points.iter().map(|p| (p.x, 1.0 - p.y)).collect();
-    write_png(path, (3 * size, size + 60), |root| {
-        let panels = root.split_evenly((1, 3));
+    // The map tells the domain: the sphere's map sends the square's corners to -z,
+    // the hemisphere's sends the whole square to z >= 0. A 9 x 9 grid includes the
+    // corners.
+    let has_lower_half = (0..81)
+        .any(|k| to_direction(DVec2::new((k % 9) as f64 / 8.0, (k / 9) as f64 / 8.0)).z < 0.0);
+    let views: &[(f64, &str)] = if has_lower_half {
+        &[
+            (1.0, "seen from +z (x right, y up)"),
+            (-1.0, "seen from -z (x left, y up)"),
+        ]
+    } else {
+        &[(1.0, "seen from +z (x right, y up)")]
+    };
+    let circle: Vec<(f64, f64)> = (0..=360)
+        .map(|k| (k as f64).to_radians())
+        .map(|t| (t.cos(), t.sin()))
+        .collect();
+    let columns = 1 + views.len();
+    write_png(path, (columns as u32 * size, size + 60), |root| {
+        let panels = root.split_evenly((1, columns));
         draw_panel(
             &panels[0],
             title,
             (0.0, 1.0),
             Some(("equal-area square x", "y (down)")),
             &|x, y| Some(density(to_direction(DVec2::new(x, 1.0 - y)))),
+            &[],
             &flipped,
         )?;
-        for (panel, sign, caption) in [
-            (&panels[1], 1.0, "seen from +z (x right, y up)"),
-            (&panels[2], -1.0, "seen from -z (x left, y up)"),
-        ] {
+        for (panel, &(sign, caption)) in panels[1..].iter().zip(views) {
             let visible: Vec<(f64, f64)> = dirs
                 .iter()
                 .filter(|d| d.z * sign >= 0.0)
@@ -169,6 +193,7 @@ pub fn render_direction_set(
                     let r2 = a * a + b * b;
                     (r2 <= 1.0).then(|| density(DVec3::new(sign * a, b, sign * (1.0 - r2).sqrt())))
                 },
+                &circle,
                 &visible,
             )?;
         }

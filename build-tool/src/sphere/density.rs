@@ -1,4 +1,4 @@
-//! Target densities of directions (DESIGN.md §3 sphere SPECs): `uniform`, `cosine`,
+//! Target densities of directions (docs/targets.md sphere SPECs): `uniform`, `cosine`,
 //! `brdf:ROUGHNESS,THETA_O_DEG` (glTF 2.0; `brdf-burley:` for Burley's BRDF) and
 //! `envmap:PATH`, on the sphere or the upper hemisphere.
 //!
@@ -234,7 +234,7 @@ pub(crate) fn domain_name(d: Domain) -> &'static str {
     }
 }
 
-/// Parses a direction density SPEC (DESIGN.md §3) for `domain`
+/// Parses a direction density SPEC (docs/targets.md) for `domain`
 /// ([`Domain::Sphere`] or [`Domain::Hemisphere`]):
 ///
 /// * `uniform` — uniform on the domain (on the hemisphere: over `z >= 0`);

@@ -2,7 +2,7 @@
 //! targets, and small helpers (random directions, tangent frames).
 //!
 //! A cap is `C(w, t) = {x : <w, x> >= t}` with unit centre `w` and `t = cos theta`,
-//! `theta` its angular radius (DESIGN.md §4, paper Eq. 7).
+//! `theta` its angular radius (docs/estimator.md, paper Eq. 7).
 
 use glam::DVec3;
 use rand::{Rng, RngCore};

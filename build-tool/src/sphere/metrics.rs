@@ -1,4 +1,4 @@
-//! Spherical cap discrepancy of direction sets (DESIGN.md §5, paper Eqs. 7–9).
+//! Spherical cap discrepancy of direction sets (docs/metrics.md, paper Eqs. 7–9).
 //!
 //! Two conventions for the cap radius appear in the literature; every function
 //! states which one it uses:
@@ -84,7 +84,7 @@ pub fn cap_l2_uniform(points: &[DVec3]) -> f64 {
 }
 
 /// Squared cos-uniform cap L2 discrepancy against a general measure `mu`, by the
-/// energy-distance form (DESIGN.md §5):
+/// energy-distance form (docs/metrics.md):
 /// `D^2 = (1/4)[(2/N) sum_i ∫|x_i - y| dmu(y) - ∫∫|x - y| dmu dmu - (1/N^2) sum_{j,k} |x_j - x_k|]`,
 /// with the `mu`-integrals by the weighted rule `quadrature` (`(y_k, w_k)`, weights
 /// summing to 1, e.g. [`DirectionDensity::quadrature`]). Cost
@@ -628,7 +628,7 @@ mod tests {
 
     const SPHERE: UniformDirections = UniformDirections { hemisphere: false };
 
-    /// Spherical Fibonacci points as DESIGN.md §5 defines them:
+    /// Spherical Fibonacci points as docs/metrics.md defines them:
     /// `z_i = 1 - 2(i + 0.5)/N`, `phi_i = pi (1 + sqrt 5) i` (reduced mod 2 pi).
     fn spherical_fibonacci(n: usize) -> Vec<DVec3> {
         let golden = 0.5 * (1.0 + 5f64.sqrt());

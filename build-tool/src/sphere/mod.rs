@@ -1,6 +1,6 @@
 //! Directions on the sphere and the upper hemisphere: target densities, their
-//! samplers and cap measures, and spherical cap discrepancy metrics (DESIGN.md §3,
-//! §5, §6; paper §2.1 Eqs. 7–9 and §3.5).
+//! samplers and cap measures, and spherical cap discrepancy metrics (docs/targets.md,
+//! docs/metrics.md; paper §2.1 Eqs. 7–9 and §3.5).
 //!
 //! * [`density`]: the [`DirectionDensity`] trait and [`parse_direction_spec`] for the
 //!   SPECs `uniform`, `cosine`, `brdf:ROUGHNESS,THETA_O_DEG` (`brdf-burley:...`),
