@@ -6,6 +6,8 @@
 //! * [`sphere`]: the equal-area maps between the unit square and the sphere
 //!   (octahedral, Clarberg 2008) and the hemisphere (concentric disk lifted to the
 //!   hemisphere), with their inverses and the edge wrapping used by optimizers;
+//! * [`warp`]: the warps baselines sample with (concentric disk, cosine hemisphere,
+//!   GGX visible normals), each beside its density and its inverse;
 //! * [`quantize`]: the u16 unorm and f16 codecs blobs store values with;
 //! * [`blob`]: the byte layout of a `.nuld` blob (format v1): header, section table,
 //!   checksum, metadata, and a writer that fills a caller-provided buffer.
@@ -27,3 +29,4 @@ pub mod blob;
 pub mod brdf;
 pub mod quantize;
 pub mod sphere;
+pub mod warp;
