@@ -18,6 +18,8 @@
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
 
+pub use crate::domain::Domain;
+
 /// First eight bytes of every blob.
 pub const MAGIC: [u8; 8] = *b"NULDBLOB";
 /// The format version this crate reads and writes.
@@ -104,30 +106,6 @@ pub enum SectionTag {
     PointSetInfo = 1,
     /// `set_count * len * 2` u16 unorm coordinates, set-major, then index, then axis.
     Points = 2,
-}
-
-/// Where the points of a point or direction set live.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[repr(u32)]
-pub enum Domain {
-    /// The unit square `[0,1)^2`.
-    Square = 0,
-    /// The unit sphere, through [`crate::sphere::square_to_sphere`].
-    Sphere = 1,
-    /// The upper hemisphere `z >= 0`, through [`crate::sphere::square_to_hemisphere`].
-    Hemisphere = 2,
-}
-
-impl Domain {
-    /// The domain with this code, if any.
-    pub fn from_code(code: u32) -> Option<Self> {
-        match code {
-            0 => Some(Self::Square),
-            1 => Some(Self::Sphere),
-            2 => Some(Self::Hemisphere),
-            _ => None,
-        }
-    }
 }
 
 /// Contents of the [`SectionTag::PointSetInfo`] section.
