@@ -2,8 +2,10 @@
 //! samplers and cap measures, and spherical cap discrepancy metrics (DESIGN.md §3,
 //! §5, §6; paper §2.1 Eqs. 7–9 and §3.5).
 //!
-//! * [`density`]: the [`DirectionDensity`] trait and [`parse_direction_spec`] for the
-//!   SPECs `uniform`, `cosine`, `brdf:ROUGHNESS,THETA_O_DEG`, `envmap:PATH`;
+//! * [`target`]: the [`DirectionDensity`] trait, its error and shared helpers;
+//! * [`spec`]: [`parse_direction_spec`] for the SPECs `uniform`, `cosine`,
+//!   `brdf:ROUGHNESS,THETA_O_DEG`, `envmap:PATH`;
+//! * [`closed_form`]: the `uniform` and `cosine` targets;
 //! * [`brdf_target`], [`envmap`]: the two tabulated targets;
 //! * [`geometry`]: closed-form cap measures (uniform sphere and hemisphere, cosine);
 //! * [`cap_table`]: [`CapMeasureTable`], fast cap sums over a weighted point rule;
@@ -11,20 +13,22 @@
 //!   Monte Carlo in the paper's theta-uniform convention) and a lower bound of the
 //!   cap star discrepancy.
 //!
+//! Imports run one way: [`target`] <- the targets <- [`spec`].
+//!
 //! A cap is `C(w, t) = {x : <w, x> >= t}`, `t = cos theta`.
 
 pub mod brdf_target;
 pub mod cap_table;
-pub mod density;
+pub mod closed_form;
 pub mod envmap;
 pub mod geometry;
 pub mod metrics;
+pub mod spec;
+pub mod target;
 
-pub use brdf_target::{sample_ggx_vndf, BrdfTarget};
+pub use brdf_target::BrdfTarget;
 pub use cap_table::CapMeasureTable;
-pub use density::{
-    parse_direction_spec, CosineDirections, DirectionDensity, DirectionSpecError, UniformDirections,
-};
+pub use closed_form::{CosineDirections, UniformDirections};
 pub use envmap::EnvmapDensity;
 pub use geometry::{
     cosine_cap_measure, random_direction, uniform_hemisphere_cap_measure,
@@ -36,3 +40,5 @@ pub use metrics::{
     cap_l2_uniform_squared, cap_star_estimate, cap_star_estimate_with, CapRadius, CapStarEstimate,
     CapStarOptions,
 };
+pub use spec::parse_direction_spec;
+pub use target::{DirectionDensity, DirectionSpecError};
