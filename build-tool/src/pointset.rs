@@ -75,8 +75,7 @@ impl PointSets {
             Domain::Square => BlobKind::PointSet2D,
             _ => BlobKind::DirectionSet,
         };
-        write(out.as_mut_slice(), kind, &meta_bytes, &sections)
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        write(out.as_mut_slice(), kind, &meta_bytes, &sections)?;
         Ok(out)
     }
 
