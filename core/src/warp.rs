@@ -97,7 +97,7 @@ pub fn square_to_disk(u: DVec2) -> DVec2 {
 /// non-finite input give the centre `(1/2, 1/2)`.
 pub fn disk_to_square(d: DVec2) -> DVec2 {
     let r = libm::sqrt(d.x * d.x + d.y * d.y);
-    if !(r > 0.0) || !r.is_finite() {
+    if r == 0.0 || !r.is_finite() {
         return DVec2::splat(0.5);
     }
     concentric_polar_inverse(r.min(1.0), libm::atan2(d.y, d.x))
