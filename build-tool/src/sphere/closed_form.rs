@@ -10,6 +10,15 @@ use nuld_core::blob::Domain;
 use nuld_core::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use std::f64::consts::PI;
 
+/// [`Domain::Hemisphere`] or [`Domain::Sphere`].
+fn direction_domain(hemisphere: bool) -> Domain {
+    if hemisphere {
+        Domain::Hemisphere
+    } else {
+        Domain::Sphere
+    }
+}
+
 /// `uniform`: `1/(4 pi)` on the sphere, `1/(2 pi)` on `z >= 0` for the hemisphere.
 /// Warp: the domain's equal-area map (exact). Cap measure: closed form
 /// (`(1 - t)/2`, or the cap–hemisphere intersection area over `2 pi`).
@@ -29,11 +38,7 @@ impl DirectionDensity for UniformDirections {
     }
 
     fn domain(&self) -> Domain {
-        if self.hemisphere {
-            Domain::Hemisphere
-        } else {
-            Domain::Sphere
-        }
+        direction_domain(self.hemisphere)
     }
 
     fn pdf(&self, w: DVec3) -> f64 {
@@ -78,11 +83,7 @@ impl DirectionDensity for CosineDirections {
     }
 
     fn domain(&self) -> Domain {
-        if self.hemisphere {
-            Domain::Hemisphere
-        } else {
-            Domain::Sphere
-        }
+        direction_domain(self.hemisphere)
     }
 
     fn pdf(&self, w: DVec3) -> f64 {
