@@ -2,12 +2,11 @@
 //! one definition of the layout).
 
 use anyhow::{bail, Context, Result};
-use glam::{DVec2, DVec3};
+use glam::DVec2;
 use nuld_core::blob::{
     encoded_len, write, BlobKind, Domain, Metadata, PointSetInfo, SectionSpec, SectionTag,
 };
 use nuld_core::quantize::unorm16_encode;
-use nuld_core::sphere::{square_to_hemisphere, square_to_sphere};
 use std::path::Path;
 
 /// `sets.len()` sets of equally many points, each point in `[0,1]^2`: the point
@@ -35,14 +34,6 @@ impl PointSets {
     /// Number of sets.
     pub fn set_count(&self) -> usize {
         self.sets.len()
-    }
-
-    /// The unit direction of a square point, for a direction domain.
-    pub fn direction_of(domain: Domain, p: DVec2) -> DVec3 {
-        match domain {
-            Domain::Hemisphere => square_to_hemisphere(p),
-            _ => square_to_sphere(p),
-        }
     }
 
     /// Encodes the sets as a blob: coordinates quantized to cell-centred u16 unorm.
@@ -84,8 +75,7 @@ impl PointSets {
             Domain::Square => BlobKind::PointSet2D,
             _ => BlobKind::DirectionSet,
         };
-        write(out.as_mut_slice(), kind, &meta_bytes, &sections)
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        write(out.as_mut_slice(), kind, &meta_bytes, &sections)?;
         Ok(out)
     }
 

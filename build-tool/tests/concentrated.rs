@@ -246,16 +246,14 @@ fn optimized_set_resolves_the_concentration(
     epochs: usize,
 ) {
     use nuld_build_tool::metrics::cap_summary::CapMetricSummary;
-    use nuld_build_tool::optimize::directions::{
-        optimize_directions, to_direction, DirectionConfig,
-    };
+    use nuld_build_tool::optimize::directions::{optimize_directions, DirectionConfig};
     let cfg = DirectionConfig {
         epochs,
         ..DirectionConfig::default()
     };
     let ours: Vec<DVec3> = optimize_directions(density, n, &cfg, &mut |_| {})
         .into_iter()
-        .map(|p| to_direction(density.domain(), p))
+        .map(|p| density.domain().to_direction(p))
         .collect();
     let target = CapTarget::new(density);
     let baselines: Vec<Vec<DVec3>> = (0..4u32)

@@ -18,6 +18,8 @@
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
 
+pub use crate::domain::Domain;
+
 /// First eight bytes of every blob.
 pub const MAGIC: [u8; 8] = *b"NULDBLOB";
 /// The format version this crate reads and writes.
@@ -106,30 +108,6 @@ pub enum SectionTag {
     Points = 2,
 }
 
-/// Where the points of a point or direction set live.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[repr(u32)]
-pub enum Domain {
-    /// The unit square `[0,1)^2`.
-    Square = 0,
-    /// The unit sphere, through [`crate::sphere::square_to_sphere`].
-    Sphere = 1,
-    /// The upper hemisphere `z >= 0`, through [`crate::sphere::square_to_hemisphere`].
-    Hemisphere = 2,
-}
-
-impl Domain {
-    /// The domain with this code, if any.
-    pub fn from_code(code: u32) -> Option<Self> {
-        match code {
-            0 => Some(Self::Square),
-            1 => Some(Self::Sphere),
-            2 => Some(Self::Hemisphere),
-            _ => None,
-        }
-    }
-}
-
 /// Contents of the [`SectionTag::PointSetInfo`] section.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
@@ -156,7 +134,13 @@ pub struct Metadata<'a> {
     pub seed: u64,
 }
 
-/// Everything that can be wrong with a blob.
+/// Everything that can be wrong with a blob: one variant per failed check, carrying
+/// the numbers that failed it. [`Layout::read`] produces the variants up to
+/// [`BlobError::SectionsOverlap`]; the kind, metadata and point-set variants come
+/// from the runtime's `Blob::parse`, the last two from [`write`].
+///
+/// `Display` writes one line; the type implements [`core::error::Error`], so `?`
+/// converts it into `Box<dyn std::error::Error>` or `anyhow::Error`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BlobError {
     /// Fewer bytes than the header or than `total_len` says.
@@ -166,6 +150,12 @@ pub enum BlobError {
         /// Bytes present.
         got: u64,
     },
+    /// The slice does not start at a 16-byte aligned address.
+    Misaligned,
+    /// The first eight bytes are not [`MAGIC`].
+    BadMagic,
+    /// A format version this reader does not know.
+    UnsupportedVersion(u32),
     /// More bytes than `total_len` says.
     TrailingBytes {
         /// Length the header declares.
@@ -173,12 +163,6 @@ pub enum BlobError {
         /// Bytes present.
         got: u64,
     },
-    /// The slice does not start at a 16-byte aligned address.
-    Misaligned,
-    /// The first eight bytes are not [`MAGIC`].
-    BadMagic,
-    /// A format version this reader does not know.
-    UnsupportedVersion(u32),
     /// The checksum does not match the contents.
     ChecksumMismatch {
         /// Value stored in the header.
@@ -186,8 +170,121 @@ pub enum BlobError {
         /// Value computed from the bytes.
         computed: u64,
     },
+    /// More sections than [`MAX_SECTIONS`] (in a header, or given to [`write`]).
+    TooManySections {
+        /// Sections declared or given.
+        count: u64,
+        /// [`MAX_SECTIONS`].
+        max: u32,
+    },
+    /// The section table runs past the end of the blob.
+    SectionTablePastEnd {
+        /// Byte offset where the table ends.
+        table_end: u64,
+        /// Length of the blob.
+        len: u64,
+    },
+    /// The metadata starts inside the header or the section table.
+    MetadataOverlapsTable {
+        /// The metadata offset.
+        meta_offset: u64,
+        /// Byte offset where the section table ends.
+        table_end: u64,
+    },
+    /// The metadata runs past the end of the blob.
+    MetadataPastEnd {
+        /// Byte offset where the metadata ends.
+        meta_end: u64,
+        /// Length of the blob.
+        len: u64,
+    },
+    /// A section's `offset + len` overflows `u64`.
+    SectionRangeOverflow {
+        /// Row of the section table.
+        index: u32,
+    },
+    /// A section starts before the end of the metadata.
+    SectionOverlapsMetadata {
+        /// Row of the section table.
+        index: u32,
+        /// The section's offset.
+        offset: u64,
+        /// Byte offset where the metadata ends.
+        meta_end: u64,
+    },
+    /// A section runs past the end of the blob.
+    SectionPastEnd {
+        /// Row of the section table.
+        index: u32,
+        /// Byte offset where the section ends.
+        end: u64,
+        /// Length of the blob.
+        len: u64,
+    },
+    /// A section's offset is not a multiple of [`ALIGN`].
+    SectionMisaligned {
+        /// Row of the section table.
+        index: u32,
+        /// The section's offset.
+        offset: u64,
+    },
+    /// A section declares an element size of zero.
+    ZeroElementSize {
+        /// Row of the section table.
+        index: u32,
+    },
+    /// A section's length is not a whole number of elements.
+    PartialElement {
+        /// Row of the section table.
+        index: u32,
+        /// The section's length in bytes.
+        len: u64,
+        /// Its element size in bytes.
+        elem_size: u32,
+    },
+    /// Two sections share bytes.
+    SectionsOverlap {
+        /// Row of the earlier section in the table.
+        first: u32,
+        /// Row of the later one.
+        second: u32,
+    },
     /// An unknown [`BlobKind`] code.
     UnknownKind(u32),
+    /// The metadata does not decode.
+    BadMetadata,
+    /// A required section is absent.
+    MissingSection(SectionTag),
+    /// The [`SectionTag::PointSetInfo`] section is not one [`PointSetInfo`] long.
+    PointSetInfoSize {
+        /// Its length in bytes.
+        got: u64,
+        /// `size_of::<PointSetInfo>()`.
+        expected: u64,
+    },
+    /// [`PointSetInfo::len`] is zero.
+    NoPoints,
+    /// [`PointSetInfo::set_count`] is zero.
+    NoSets,
+    /// [`PointSetInfo::domain`] is not a [`Domain`] code.
+    UnknownDomain(u32),
+    /// The domain does not fit the kind (a 2D point set must be on the square, a
+    /// direction set on the sphere or hemisphere).
+    DomainMismatch {
+        /// The blob's kind.
+        kind: BlobKind,
+        /// The domain its info section names.
+        domain: Domain,
+    },
+    /// The [`SectionTag::Points`] elements are not 4 bytes (2 x u16).
+    PointElementSize(u32),
+    /// The [`SectionTag::Points`] length is not `len * set_count * 4` bytes.
+    PointsLength {
+        /// Bytes the counts call for.
+        expected: u64,
+        /// Bytes present.
+        got: u64,
+    },
     /// The blob holds something other than what was asked for.
     WrongKind {
         /// The kind asked for.
@@ -195,14 +292,8 @@ pub enum BlobError {
         /// The kind the blob holds.
         found: BlobKind,
     },
-    /// A count, offset or length is out of range or inconsistent.
-    OutOfRange(&'static str),
-    /// A section is not 16-byte aligned or its length is not a whole number of elements.
-    BadSection(&'static str),
-    /// A required section is absent.
-    MissingSection(SectionTag),
-    /// The metadata does not decode.
-    BadMetadata,
+    /// The sizes given to [`write`] overflow the blob's `u64` length.
+    SizeOverflow,
     /// The output buffer passed to [`write`] has the wrong size.
     BufferSize {
         /// Bytes needed.
@@ -214,39 +305,107 @@ pub enum BlobError {
 
 impl core::fmt::Display for BlobError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match self {
+        match *self {
             Self::Truncated { needed, got } => {
                 write!(f, "blob truncated: {got} bytes, needs {needed}")
             }
+            Self::Misaligned => write!(f, "blob bytes are not {ALIGN}-byte aligned"),
+            Self::BadMagic => write!(f, "not a nuld blob (bad magic)"),
+            Self::UnsupportedVersion(v) => write!(
+                f,
+                "unsupported blob format version {v} (reader knows {FORMAT_VERSION})"
+            ),
             Self::TrailingBytes { declared, got } => {
                 write!(f, "blob has {got} bytes but its header declares {declared}")
-            }
-            Self::Misaligned => write!(f, "blob bytes are not 16-byte aligned"),
-            Self::BadMagic => write!(f, "not a nuld blob (bad magic)"),
-            Self::UnsupportedVersion(v) => {
-                write!(
-                    f,
-                    "unsupported blob format version {v} (reader knows {FORMAT_VERSION})"
-                )
             }
             Self::ChecksumMismatch { stored, computed } => write!(
                 f,
                 "blob checksum mismatch (stored {stored:#018x}, computed {computed:#018x})"
             ),
+            Self::TooManySections { count, max } => {
+                write!(f, "blob has {count} sections, at most {max} allowed")
+            }
+            Self::SectionTablePastEnd { table_end, len } => write!(
+                f,
+                "blob section table ends at byte {table_end}, past the blob's {len} bytes"
+            ),
+            Self::MetadataOverlapsTable {
+                meta_offset,
+                table_end,
+            } => write!(
+                f,
+                "blob metadata starts at byte {meta_offset}, inside the header and section table (which end at {table_end})"
+            ),
+            Self::MetadataPastEnd { meta_end, len } => write!(
+                f,
+                "blob metadata ends at byte {meta_end}, past the blob's {len} bytes"
+            ),
+            Self::SectionRangeOverflow { index } => {
+                write!(f, "blob section {index}: offset + length overflows")
+            }
+            Self::SectionOverlapsMetadata {
+                index,
+                offset,
+                meta_end,
+            } => write!(
+                f,
+                "blob section {index} starts at byte {offset}, before the metadata ends ({meta_end})"
+            ),
+            Self::SectionPastEnd { index, end, len } => write!(
+                f,
+                "blob section {index} ends at byte {end}, past the blob's {len} bytes"
+            ),
+            Self::SectionMisaligned { index, offset } => write!(
+                f,
+                "blob section {index} starts at byte {offset}, not a multiple of {ALIGN}"
+            ),
+            Self::ZeroElementSize { index } => {
+                write!(f, "blob section {index} has element size 0")
+            }
+            Self::PartialElement {
+                index,
+                len,
+                elem_size,
+            } => write!(
+                f,
+                "blob section {index} is {len} bytes, not a whole number of {elem_size}-byte elements"
+            ),
+            Self::SectionsOverlap { first, second } => {
+                write!(f, "blob sections {first} and {second} overlap")
+            }
             Self::UnknownKind(k) => write!(f, "unknown blob kind {k}"),
+            Self::BadMetadata => write!(f, "blob metadata does not decode"),
+            Self::MissingSection(tag) => write!(f, "blob lacks the {tag:?} section"),
+            Self::PointSetInfoSize { got, expected } => write!(
+                f,
+                "blob point set info section is {got} bytes, not {expected}"
+            ),
+            Self::NoPoints => write!(f, "blob point sets have 0 points"),
+            Self::NoSets => write!(f, "blob holds 0 point sets"),
+            Self::UnknownDomain(d) => write!(f, "unknown blob domain code {d}"),
+            Self::DomainMismatch { kind, domain } => {
+                write!(f, "blob of kind {kind:?} cannot hold points on the {}", domain.name())
+            }
+            Self::PointElementSize(s) => write!(
+                f,
+                "blob points section has {s}-byte elements, not 4 (2 x u16)"
+            ),
+            Self::PointsLength { expected, got } => write!(
+                f,
+                "blob points section is {got} bytes, the counts call for {expected}"
+            ),
             Self::WrongKind { expected, found } => {
                 write!(f, "blob holds {found:?}, not {expected:?}")
             }
-            Self::OutOfRange(what) => write!(f, "blob field out of range: {what}"),
-            Self::BadSection(what) => write!(f, "bad blob section: {what}"),
-            Self::MissingSection(tag) => write!(f, "blob lacks the {tag:?} section"),
-            Self::BadMetadata => write!(f, "blob metadata does not decode"),
+            Self::SizeOverflow => write!(f, "blob size overflows u64"),
             Self::BufferSize { needed, got } => {
                 write!(f, "output buffer has {got} bytes, blob needs {needed}")
             }
         }
     }
 }
+
+impl core::error::Error for BlobError {}
 
 /// FNV-1a 64 of `bytes`, skipping (reading as zero) the header's checksum field.
 ///
@@ -311,16 +470,20 @@ pub fn write(
     meta: &[u8],
     sections: &[SectionSpec<'_>],
 ) -> Result<Header, BlobError> {
-    let needed = encoded_len(meta, sections);
-    if out.len() != needed || sections.len() > MAX_SECTIONS as usize {
+    if sections.len() > MAX_SECTIONS as usize {
+        return Err(BlobError::TooManySections {
+            count: sections.len() as u64,
+            max: MAX_SECTIONS,
+        });
+    }
+    let (table_end, total) = plan(meta.len(), sections).ok_or(BlobError::SizeOverflow)?;
+    if out.len() as u64 != total {
         return Err(BlobError::BufferSize {
-            needed: needed as u64,
+            needed: total,
             got: out.len() as u64,
         });
     }
     out.fill(0);
-    let (table_end, total) =
-        plan(meta.len(), sections).ok_or(BlobError::OutOfRange("blob size overflows"))?;
     let meta_offset = table_end as usize;
     out[meta_offset..meta_offset + meta.len()].copy_from_slice(meta);
     let mut cursor = (table_end + meta.len() as u64) as usize;
@@ -408,38 +571,74 @@ impl<'a> Layout<'a> {
             });
         }
         if header.section_count > MAX_SECTIONS {
-            return Err(BlobError::OutOfRange("section count"));
+            return Err(BlobError::TooManySections {
+                count: header.section_count as u64,
+                max: MAX_SECTIONS,
+            });
         }
         let table_end = HEADER_LEN as u64 + header.section_count as u64 * SECTION_ENTRY_LEN as u64;
         if table_end > got {
-            return Err(BlobError::OutOfRange("section table extends past the end"));
+            return Err(BlobError::SectionTablePastEnd {
+                table_end,
+                len: got,
+            });
         }
-        let meta_end = header.meta_offset as u64 + header.meta_len as u64;
-        if (header.meta_offset as u64) < table_end || meta_end > got {
-            return Err(BlobError::OutOfRange("metadata range"));
+        let meta_offset = header.meta_offset as u64;
+        let meta_end = meta_offset + header.meta_len as u64;
+        if meta_offset < table_end {
+            return Err(BlobError::MetadataOverlapsTable {
+                meta_offset,
+                table_end,
+            });
+        }
+        if meta_end > got {
+            return Err(BlobError::MetadataPastEnd { meta_end, len: got });
         }
         let layout = Self { bytes, header };
-        for k in 0..header.section_count as usize {
-            let e = layout.entry(k);
+        // `k < section_count <= MAX_SECTIONS`, so the row index fits a u32.
+        for k in 0..header.section_count {
+            let e = layout.entry(k as usize);
             let end = e
                 .offset
                 .checked_add(e.len)
-                .ok_or(BlobError::OutOfRange("section range overflows"))?;
-            if e.offset < meta_end || end > got {
-                return Err(BlobError::OutOfRange("section range"));
+                .ok_or(BlobError::SectionRangeOverflow { index: k })?;
+            if e.offset < meta_end {
+                return Err(BlobError::SectionOverlapsMetadata {
+                    index: k,
+                    offset: e.offset,
+                    meta_end,
+                });
+            }
+            if end > got {
+                return Err(BlobError::SectionPastEnd {
+                    index: k,
+                    end,
+                    len: got,
+                });
             }
             if e.offset % ALIGN as u64 != 0 {
-                return Err(BlobError::BadSection("section offset not 16-byte aligned"));
+                return Err(BlobError::SectionMisaligned {
+                    index: k,
+                    offset: e.offset,
+                });
             }
-            if e.elem_size == 0 || e.len % e.elem_size as u64 != 0 {
-                return Err(BlobError::BadSection(
-                    "length not a whole number of elements",
-                ));
+            if e.elem_size == 0 {
+                return Err(BlobError::ZeroElementSize { index: k });
+            }
+            if e.len % e.elem_size as u64 != 0 {
+                return Err(BlobError::PartialElement {
+                    index: k,
+                    len: e.len,
+                    elem_size: e.elem_size,
+                });
             }
             for j in 0..k {
-                let o = layout.entry(j);
+                let o = layout.entry(j as usize);
                 if e.offset < o.offset + o.len && o.offset < end {
-                    return Err(BlobError::BadSection("sections overlap"));
+                    return Err(BlobError::SectionsOverlap {
+                        first: j,
+                        second: k,
+                    });
                 }
             }
         }
@@ -480,13 +679,18 @@ impl<'a> Layout<'a> {
 
     /// The first section with this tag, as its table row and its bytes.
     pub fn section(&self, tag: SectionTag) -> Result<(SectionEntry, &'a [u8]), BlobError> {
-        for k in 0..self.header.section_count as usize {
-            let e = self.entry(k);
+        for k in 0..self.header.section_count {
+            let e = self.entry(k as usize);
             if e.tag == tag as u32 {
-                let bytes = self
-                    .bytes
-                    .get(e.offset as usize..(e.offset + e.len) as usize)
-                    .ok_or(BlobError::OutOfRange("section range"))?;
+                // In range by `Layout::read`; `get` keeps the lookup panic-free.
+                let end = e.offset.saturating_add(e.len);
+                let bytes = self.bytes.get(e.offset as usize..end as usize).ok_or(
+                    BlobError::SectionPastEnd {
+                        index: k,
+                        end,
+                        len: self.bytes.len() as u64,
+                    },
+                )?;
                 return Ok((e, bytes));
             }
         }

@@ -8,6 +8,9 @@
 //!   hemisphere), with their inverses and the edge wrapping used by optimizers;
 //! * [`brdf`]: the glTF 2.0 BRDF of `brdf:` targets and conditional samplers, over
 //!   [`real::Real`] so that `f32` and `f64` share one formula;
+//! * [`warp`]: the warps baselines sample with (concentric disk, cosine hemisphere,
+//!   GGX visible normals), each beside its density and its inverse;
+//! * [`domain`]: where a set's points live and the map from square to direction;
 //! * [`quantize`]: the u16 unorm and f16 codecs blobs store values with;
 //! * [`blob`]: the byte layout of a `.nuld` blob (format v1): header, section table,
 //!   checksum, metadata, and a writer that fills a caller-provided buffer.
@@ -27,6 +30,8 @@
 
 pub mod blob;
 pub mod brdf;
+pub mod domain;
 pub mod quantize;
 pub mod real;
 pub mod sphere;
+pub mod warp;

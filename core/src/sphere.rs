@@ -9,15 +9,9 @@
 //!
 //! Everything is computed in `f64`; the runtime converts the result to `f32` once.
 
-use core::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+use crate::warp::{concentric_polar, concentric_polar_inverse, safe_sqrt};
+use core::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 use glam::{DVec2, DVec3};
-
-/// `sqrt(max(x, 0))`: rounding can push an argument that is mathematically
-/// non-negative slightly below zero.
-#[inline]
-fn safe_sqrt(x: f64) -> f64 {
-    libm::sqrt(x.max(0.0))
-}
 
 /// Equal-area octahedral map from `[0,1]^2` to the unit sphere (Clarberg 2008, as
 /// pbrt-v4's `EqualAreaSquareToSphere`).
@@ -111,8 +105,8 @@ pub fn wrap_octahedral(mut p: DVec2) -> DVec2 {
 
 /// Equal-area map from `[0,1]^2` to the upper hemisphere `z >= 0`.
 ///
-/// Shirley–Chiu's concentric map takes the square to the unit disk preserving area
-/// (up to the factor `pi`); the lift `(x, y) -> (x s, y s, 1 - r^2)` with
+/// Shirley–Chiu's concentric map ([`crate::warp::square_to_disk`]) takes the square to
+/// the unit disk preserving area (up to the factor `pi`); the lift `(x, y) -> (x s, y s, 1 - r^2)` with
 /// `s = sqrt(2 - r^2)` takes the disk to the hemisphere preserving area (factor 2).
 /// The square's centre maps to `+z`, its boundary to the equator.
 ///
@@ -123,15 +117,8 @@ pub fn wrap_octahedral(mut p: DVec2) -> DVec2 {
 /// assert!((e - DVec3::X).length() < 1e-12);
 /// ```
 pub fn square_to_hemisphere(p: DVec2) -> DVec3 {
-    let a = 2.0 * p.x - 1.0;
-    let b = 2.0 * p.y - 1.0;
-    if a == 0.0 && b == 0.0 {
+    let Some((r, theta)) = concentric_polar(p) else {
         return DVec3::Z;
-    }
-    let (r, theta) = if a.abs() > b.abs() {
-        (a, FRAC_PI_4 * (b / a))
-    } else {
-        (b, FRAC_PI_2 - FRAC_PI_4 * (a / b))
     };
     let r2 = r * r;
     let s = r * safe_sqrt(2.0 - r2);
@@ -147,25 +134,13 @@ pub fn hemisphere_to_square(d: DVec3) -> DVec2 {
     if r == 0.0 || planar == 0.0 {
         return DVec2::splat(0.5);
     }
-    let mut phi = libm::atan2(d.y, d.x);
-    if phi < -FRAC_PI_4 {
-        phi += 2.0 * PI;
-    }
-    let (a, b) = if phi < FRAC_PI_4 {
-        (r, phi * r / FRAC_PI_4)
-    } else if phi < 3.0 * FRAC_PI_4 {
-        (-(phi - FRAC_PI_2) * r / FRAC_PI_4, r)
-    } else if phi < 5.0 * FRAC_PI_4 {
-        (-r, -(phi - PI) * r / FRAC_PI_4)
-    } else {
-        ((phi - 3.0 * FRAC_PI_2) * r / FRAC_PI_4, -r)
-    };
-    DVec2::new(0.5 * (a + 1.0), 0.5 * (b + 1.0))
+    concentric_polar_inverse(r, libm::atan2(d.y, d.x))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use core::f64::consts::PI;
 
     // The reference vectors of docs/metrics.md (pbrt-v4's map), verbatim (9 digits), hence the allow.
     #[allow(clippy::approx_constant)]

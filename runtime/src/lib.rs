@@ -145,34 +145,47 @@ impl<'a> Blob<'a> {
     /// The info section and the coordinate array, validated against each other.
     fn points_view(&self) -> Result<(PointSetInfo, &'a [[u16; 2]]), BlobError> {
         let (_, info_bytes) = self.layout.section(SectionTag::PointSetInfo)?;
-        if info_bytes.len() != core::mem::size_of::<PointSetInfo>() {
-            return Err(BlobError::BadSection("point set info has the wrong size"));
+        let info_len = core::mem::size_of::<PointSetInfo>();
+        if info_bytes.len() != info_len {
+            return Err(BlobError::PointSetInfoSize {
+                got: info_bytes.len() as u64,
+                expected: info_len as u64,
+            });
         }
         let info: PointSetInfo = bytemuck::pod_read_unaligned(info_bytes);
-        if info.len == 0 || info.set_count == 0 {
-            return Err(BlobError::OutOfRange("point or set count is zero"));
+        if info.len == 0 {
+            return Err(BlobError::NoPoints);
         }
-        let domain =
-            Domain::from_code(info.domain).ok_or(BlobError::OutOfRange("unknown domain code"))?;
+        if info.set_count == 0 {
+            return Err(BlobError::NoSets);
+        }
+        let domain = Domain::from_code(info.domain).ok_or(BlobError::UnknownDomain(info.domain))?;
         let domain_ok = match self.kind {
             BlobKind::PointSet2D => domain == Domain::Square,
             BlobKind::DirectionSet => domain != Domain::Square,
         };
         if !domain_ok {
-            return Err(BlobError::OutOfRange("domain does not match the blob kind"));
+            return Err(BlobError::DomainMismatch {
+                kind: self.kind,
+                domain,
+            });
         }
         let (entry, bytes) = self.layout.section(SectionTag::Points)?;
         if entry.elem_size != 4 {
-            return Err(BlobError::BadSection("points must be 2 x u16 per element"));
+            return Err(BlobError::PointElementSize(entry.elem_size));
         }
         let expected = (info.len as u64) * (info.set_count as u64) * 4;
         if bytes.len() as u64 != expected {
-            return Err(BlobError::OutOfRange(
-                "points section does not match the counts",
-            ));
+            return Err(BlobError::PointsLength {
+                expected,
+                got: bytes.len() as u64,
+            });
         }
-        let coords: &[[u16; 2]] = bytemuck::try_cast_slice(bytes)
-            .map_err(|_| BlobError::BadSection("points section is misaligned"))?;
+        // The length is a whole number of 4-byte elements (checked above) and the
+        // section starts 16-byte aligned in an aligned blob (`Layout::read`), so the
+        // cast cannot fail; were the bytes misaligned, that would be the cause.
+        let coords: &[[u16; 2]] =
+            bytemuck::try_cast_slice(bytes).map_err(|_| BlobError::Misaligned)?;
         Ok((info, coords))
     }
 }

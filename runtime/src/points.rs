@@ -3,7 +3,6 @@
 use glam::{Vec2, Vec3};
 use nuld_core::blob::Domain;
 use nuld_core::quantize::{unorm16_decode, unorm16_decode_f64};
-use nuld_core::sphere::{square_to_hemisphere, square_to_sphere};
 
 /// `set_count` sets of `len` points each in the unit square, stored as cell-centred
 /// u16 unorm coordinates (so every point lies strictly inside `(0,1)^2`).
@@ -123,11 +122,7 @@ impl<'a> DirectionSet<'a> {
     pub fn direction(&self, set: usize, i: usize) -> Vec3 {
         let [x, y] = self.square.raw(set, i);
         let p = glam::DVec2::new(unorm16_decode_f64(x), unorm16_decode_f64(y));
-        let d = match self.domain {
-            Domain::Hemisphere => square_to_hemisphere(p),
-            _ => square_to_sphere(p),
-        };
-        d.as_vec3()
+        self.domain.to_direction(p).as_vec3()
     }
 
     /// The square parameterization of direction `i` of set `set`, in `(0,1)^2`.

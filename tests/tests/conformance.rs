@@ -2,7 +2,6 @@
 //! quantization step.
 
 use glam::{DVec2, DVec3};
-use nuld_build_tool::pointset::PointSets;
 use nuld_core::blob::{BlobKind, Domain};
 use nuld_core::quantize::{unorm16_decode_f64, unorm16_encode, UNORM16_MAX_ERROR};
 use nuld_runtime::{Blob, BlobError};
@@ -58,7 +57,7 @@ fn direction_sets_round_trip_through_the_equal_area_maps() {
                         unorm16_decode_f64(unorm16_encode(p.x)),
                         unorm16_decode_f64(unorm16_encode(p.y)),
                     );
-                    let want = PointSets::direction_of(domain, q);
+                    let want = domain.to_direction(q);
                     // f32 rounding of a unit vector.
                     assert!((got - want).length() < 2e-7, "{domain:?} {s} {i}");
                     assert!((got.length() - 1.0).abs() < 2e-7);
@@ -67,7 +66,7 @@ fn direction_sets_round_trip_through_the_equal_area_maps() {
                     }
                     // And close to the tool's unquantized direction: both maps stretch
                     // distances by at most ~2*pi, half a cell is 2^-17 per axis.
-                    let exact: DVec3 = PointSets::direction_of(domain, *p);
+                    let exact: DVec3 = domain.to_direction(*p);
                     assert!((got - exact).length() < 1e-4, "{domain:?} {s} {i}");
                 }
             }
@@ -99,7 +98,7 @@ fn embedded_blob_through_the_aligned_helper() {
     for s in 0..2 {
         for i in 0..64 {
             assert_eq!(dirs.direction(s, i), fresh.direction(s, i));
-            let exact = PointSets::direction_of(Domain::Sphere, ps.sets[s][i]);
+            let exact = Domain::Sphere.to_direction(ps.sets[s][i]);
             assert!((dirs.direction(s, i).as_dvec3() - exact).length() < 1e-4);
         }
     }

@@ -8,6 +8,7 @@
 //! * [`cosine_hemisphere`]: Malley's method (concentric disk, then lift).
 
 use glam::{DVec2, DVec3};
+use nuld_core::warp::square_to_cosine_hemisphere;
 
 use super::BELOW_ONE;
 use crate::density::{CellGrid, Density2D};
@@ -119,32 +120,13 @@ pub fn hierarchical_warp(points: &[DVec2], grid: &CellGrid) -> Vec<DVec2> {
 }
 
 /// Cosine-weighted hemisphere directions (density `cos(theta) / pi` about `+z`) by
-/// Malley's method: Shirley–Chiu concentric map of `u` to the unit disk, then lift to
-/// `z = sqrt(1 - r^2)` (as pbrt's `SampleCosineHemisphere`). Unit vectors with
-/// `z >= 0`. `O(n)`.
+/// Malley's method ([`nuld_core::warp::square_to_cosine_hemisphere`]). Unit vectors
+/// with `z >= 0`. `O(n)`.
 pub fn cosine_hemisphere(points: &[DVec2]) -> Vec<DVec3> {
     points
         .iter()
-        .map(|u| {
-            let d = concentric_disk(*u);
-            DVec3::new(d.x, d.y, (1.0 - d.length_squared()).max(0.0).sqrt())
-        })
+        .map(|u| square_to_cosine_hemisphere(*u))
         .collect()
-}
-
-/// Shirley–Chiu concentric square-to-disk map (area preserving).
-fn concentric_disk(u: DVec2) -> DVec2 {
-    use std::f64::consts::FRAC_PI_4;
-    let o = 2.0 * u - DVec2::ONE;
-    if o.x == 0.0 && o.y == 0.0 {
-        return DVec2::ZERO;
-    }
-    let (r, theta) = if o.x.abs() > o.y.abs() {
-        (o.x, FRAC_PI_4 * (o.y / o.x))
-    } else {
-        (o.y, 2.0 * FRAC_PI_4 - FRAC_PI_4 * (o.x / o.y))
-    };
-    r * DVec2::new(theta.cos(), theta.sin())
 }
 
 #[cfg(test)]

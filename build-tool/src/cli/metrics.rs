@@ -9,7 +9,7 @@ use crate::sphere::parse_direction_spec;
 use anyhow::{anyhow, Context, Result};
 use clap::Args;
 use glam::{DVec2, DVec3};
-use nuld_runtime::{Blob, BlobKind};
+use nuld_runtime::{Blob, BlobKind, Domain};
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -60,7 +60,7 @@ pub fn run(a: MetricsArgs) -> Result<()> {
             let out = MetricsOutput {
                 file,
                 density: &a.density,
-                domain: "square".into(),
+                domain: Domain::Square.name().into(),
                 n: pts.len(),
                 method: target.method(),
                 mean: MetricSummary::mean(&per_set),
@@ -90,7 +90,7 @@ pub fn run(a: MetricsArgs) -> Result<()> {
             let out = MetricsOutput {
                 file,
                 density: &a.density,
-                domain: format!("{:?}", dirs.domain()).to_lowercase(),
+                domain: dirs.domain().name().into(),
                 n: dirs.len(),
                 method: target.method(),
                 mean: CapMetricSummary::mean(&per_set),

@@ -7,9 +7,7 @@ use crate::density::{parse_spec, Density2D};
 use crate::discrepancy::GradientPath;
 use crate::metrics::cap_summary::{CapMetricSummary, CapTarget};
 use crate::metrics::summary::{MetricSummary, Target};
-use crate::optimize::directions::{
-    initial_square_points, optimize_directions, to_direction, DirectionConfig,
-};
+use crate::optimize::directions::{initial_square_points, optimize_directions, DirectionConfig};
 use crate::optimize::{
     initial_parameters, optimize, to_points, AnchorSampling, AreaOption, EpochReport,
     OptimizeConfig, Parameterization,
@@ -372,7 +370,7 @@ fn run_square(a: &OptimizeArgs) -> Result<()> {
     let spec = density.spec();
     let report = Report {
         density: &spec,
-        domain: "square",
+        domain: Domain::Square.name(),
         n: a.n,
         sets: a.sets,
         seed: a.seed,
@@ -443,7 +441,7 @@ fn run_directions(a: &OptimizeArgs) -> Result<()> {
         optimize_directions(density.as_ref(), a.n, &cfg, on_epoch)
     });
     let dirs_of = |square: &[DVec2]| -> Vec<DVec3> {
-        square.iter().map(|&p| to_direction(domain, p)).collect()
+        square.iter().map(|&p| domain.to_direction(p)).collect()
     };
     let target = CapTarget::new(density.as_ref());
     let evaluate = |square: &[DVec2]| target.evaluate(&dirs_of(square));
@@ -472,11 +470,7 @@ fn run_directions(a: &OptimizeArgs) -> Result<()> {
     let spec = density.spec();
     let report = Report {
         density: &spec,
-        domain: if domain == Domain::Hemisphere {
-            "hemisphere"
-        } else {
-            "sphere"
-        },
+        domain: domain.name(),
         n: a.n,
         sets: a.sets,
         seed: a.seed,
@@ -515,7 +509,7 @@ fn run_directions(a: &OptimizeArgs) -> Result<()> {
                 path,
                 &title,
                 &|d| density.pdf(d),
-                &|p| to_direction(domain, p),
+                &|p| domain.to_direction(p),
                 &ps.sets[0],
                 700,
             )

@@ -271,10 +271,7 @@ pub fn panels(figure: Figure, s: &EvalSettings) -> Result<(Vec<Panel>, Vec<Skipp
                 b(Baseline::Random),
             ]
         };
-        let domain = match density.domain() {
-            Domain::Hemisphere => "hemisphere",
-            _ => "sphere",
-        };
+        let domain = density.domain().name();
         let mut notes = sphere_notes(uniform, s);
         if !density.has_closed_form_caps() {
             notes.push(TABLE_NOTE.into());

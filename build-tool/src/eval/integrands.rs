@@ -6,8 +6,8 @@
 //! and GBN (they are optimized towards it), the *warp's* density for warped
 //! baselines. All warps here are exact (so `p = q`) except the BRDF's standard
 //! sampler (GGX visible normals mixed with a cosine lobe, [`BrdfTarget::sample`]),
-//! whose mixture density [`brdf_warp_pdf`] is used for it. Terms with `f = 0` count
-//! 0 even where `p = 0` (points outside the target's support).
+//! whose mixture density [`DirectionDensity::sample_pdf`] is used for it. Terms with
+//! `f = 0` count 0 even where `p = 0` (points outside the target's support).
 //!
 //! 2D (domain `[0,1]^2`, Lebesgue measure):
 //! * `quarter-disc`: `f = 1[x^2 + y^2 < 2/pi]`, uniform samples; `I = 1/2`.
@@ -31,7 +31,6 @@ use crate::density::special::erf;
 use crate::density::{parse_spec, Density2D};
 use crate::sphere::{BrdfTarget, DirectionDensity, EnvmapDensity, UniformDirections};
 use glam::{DVec2, DVec3};
-use nuld_core::brdf::{alpha, ggx_d, smith_g1};
 use rayon::prelude::*;
 use std::f64::consts::{PI, TAU};
 
@@ -126,32 +125,6 @@ impl SquareIntegrand {
     }
 }
 
-/// Density of directions produced by the BRDF target's standard sampler
-/// ([`BrdfTarget::sample`]): with `p_s = A_spec / A` the VNDF lobe
-/// (`G1(wo) D(h) / (4 n.wo)`, `h = normalize(wo + wi)`) and otherwise Malley's
-/// cosine lobe, VNDF directions below the horizon mirrored to `z -> -z` (so both
-/// `w` and its mirror image contribute):
-/// `p(w) = p_s [v(w) + v(w')] + (1 - p_s) max(z, 0) / pi`, `w' = (x, y, -z)`.
-pub fn brdf_warp_pdf(target: &BrdfTarget, w: DVec3) -> f64 {
-    if w.z < 0.0 {
-        return 0.0;
-    }
-    let wo = target.view();
-    let a = alpha(target.roughness());
-    let (_, spec) = target.albedo_parts();
-    let ps = spec / target.albedo();
-    let vndf = |wi: DVec3| {
-        let h = (wo + wi).normalize_or_zero();
-        if h.z <= 0.0 {
-            0.0
-        } else {
-            smith_g1(wo.z, a) * ggx_d(h.z, a) / (4.0 * wo.z)
-        }
-    };
-    let mirror = DVec3::new(w.x, w.y, -w.z);
-    ps * (vndf(w) + vndf(mirror)) + (1.0 - ps) * w.z / PI
-}
-
 /// The directional integrands' kinds.
 enum SphereKind {
     AbsZ(UniformDirections),
@@ -239,7 +212,7 @@ impl SphereIntegrand {
                 if q == 0.0 {
                     return 0.0;
                 }
-                q * 4.0 * PI * env.pdf(w) / brdf_warp_pdf(brdf, w)
+                q * 4.0 * PI * env.pdf(w) / brdf.sample_pdf(w)
             }
             _ => self.ratio_target(w),
         }
@@ -474,30 +447,8 @@ mod tests {
     }
 
     #[test]
-    fn brdf_warp_pdf_is_the_density_of_the_standard_sampler() {
+    fn brdf_envmap_with_a_constant_map_integrates_the_brdf_target() {
         let brdf = BrdfTarget::new(0.3, 45.0, Domain::Hemisphere).unwrap();
-        // It integrates to 1 over the hemisphere (midpoint rule on the equal-area map).
-        let m = 1024;
-        let mut total = 0.0;
-        for j in 0..m {
-            for i in 0..m {
-                let p = DVec2::new((i as f64 + 0.5) / m as f64, (j as f64 + 0.5) / m as f64);
-                total += brdf_warp_pdf(&brdf, nuld_core::sphere::square_to_hemisphere(p));
-            }
-        }
-        total *= 2.0 * PI / (m * m) as f64;
-        assert!((total - 1.0).abs() < 2e-3, "{total}");
-        // E_p[q / p] = ∫ q = 1 for samples of the warp: checks p against sample().
-        let mut g = rng(3, 2);
-        let k = 400_000;
-        let s: f64 = (0..k)
-            .map(|_| {
-                let w = brdf.sample(DVec2::new(g.random(), g.random()));
-                brdf.pdf(w) / brdf_warp_pdf(&brdf, w)
-            })
-            .sum::<f64>()
-            / k as f64;
-        assert!((s - 1.0).abs() < 5e-3, "{s}");
         // With a constant map the brdf-envmap integral is ∫ q_brdf = 1 and the warp
         // estimate of it is unbiased.
         let flat = EnvmapDensity::from_luminance(

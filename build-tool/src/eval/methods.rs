@@ -10,7 +10,7 @@ use crate::baselines::{
 };
 use crate::density::{Density2D, TabulatedDensity};
 use crate::optimize::directions::{
-    optimize_directions, optimize_directions_scheduled, to_direction, CapSchedule, DirectionConfig,
+    optimize_directions, optimize_directions_scheduled, CapSchedule, DirectionConfig,
 };
 use crate::optimize::{optimize, AreaOption, OptimizeConfig};
 use crate::seeding::derive_seed;
@@ -174,7 +174,7 @@ impl SquareSampler<'_> {
         Ok(match method {
             Method::Ours => {
                 let spec = self.density.spec();
-                let group = ours_group("square", &spec);
+                let group = ours_group(Domain::Square.name(), &spec);
                 let fp = format!("v1;{spec};{}", method_fingerprint(method, self.epochs));
                 if let Some(p) = self.cache.get_points(&group, n, seed, &fp) {
                     return Ok(p);
@@ -227,7 +227,7 @@ pub fn projected_density(density: &dyn DirectionDensity) -> Result<TabulatedDens
                 ((i % m) as f64 + 0.5) / m as f64,
                 ((i / m) as f64 + 0.5) / m as f64,
             );
-            density.pdf(to_direction(domain, p))
+            density.pdf(domain.to_direction(p))
         })
         .collect();
     Ok(TabulatedDensity::from_grid(m, m, values)?)
@@ -282,18 +282,13 @@ impl DirectionSampler<'_> {
         let domain = self.density.domain();
         let map = |p: &[DVec2]| {
             p.iter()
-                .map(|q| to_direction(domain, *q))
+                .map(|q| domain.to_direction(*q))
                 .collect::<Vec<_>>()
         };
         Ok(match method {
             Method::Ours => {
                 let spec = self.density.spec();
-                let dom = if domain == Domain::Hemisphere {
-                    "hemisphere"
-                } else {
-                    "sphere"
-                };
-                let group = ours_group(dom, &spec);
+                let group = ours_group(domain.name(), &spec);
                 let fp = format!(
                     "v1;{spec};{};area={:?}",
                     method_fingerprint(method, self.epochs),

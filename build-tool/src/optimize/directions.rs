@@ -11,9 +11,7 @@ use crate::seeding::{derive_seed, rng};
 use crate::sphere::{CapMeasureTable, DirectionDensity};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
-use nuld_core::sphere::{
-    hemisphere_to_square, sphere_to_square, square_to_hemisphere, square_to_sphere, wrap_octahedral,
-};
+use nuld_core::sphere::wrap_octahedral;
 use serde::Serialize;
 
 /// Settings of a direction-set optimization. Defaults chosen by experiment
@@ -90,22 +88,6 @@ fn local_factor(area_of_domain: f64, pdf: f64) -> f64 {
     }
 }
 
-/// The direction of a square point of `domain`'s equal-area map.
-pub fn to_direction(domain: Domain, p: DVec2) -> DVec3 {
-    match domain {
-        Domain::Hemisphere => square_to_hemisphere(p),
-        _ => square_to_sphere(p),
-    }
-}
-
-/// The square point of a direction under `domain`'s equal-area map.
-pub fn to_square(domain: Domain, d: DVec3) -> DVec2 {
-    match domain {
-        Domain::Hemisphere => hemisphere_to_square(d),
-        _ => sphere_to_square(d),
-    }
-}
-
 /// Brings a square point that left `[0,1]^2` back: across the octahedral seam for
 /// the sphere, clamped onto the equator's square boundary for the hemisphere.
 fn fold(domain: Domain, p: DVec2) -> DVec2 {
@@ -119,7 +101,7 @@ fn fold(domain: Domain, p: DVec2) -> DVec2 {
 /// differences through the fold (so the seam is crossed continuously).
 fn map_jacobian(domain: Domain, p: DVec2) -> (DVec3, DVec3) {
     let h = 1e-7;
-    let f = |q: DVec2| to_direction(domain, fold(domain, q));
+    let f = |q: DVec2| domain.to_direction(fold(domain, q));
     (
         (f(p + DVec2::X * h) - f(p - DVec2::X * h)) / (2.0 * h),
         (f(p + DVec2::Y * h) - f(p - DVec2::Y * h)) / (2.0 * h),
@@ -132,7 +114,7 @@ pub fn initial_square_points(density: &dyn DirectionDensity, n: usize, seed: u64
     let domain = density.domain();
     super::initial_parameters(n, seed)
         .into_iter()
-        .map(|u| to_square(domain, density.sample(u)))
+        .map(|u| domain.to_square(density.sample(u)))
         .collect()
 }
 
@@ -306,7 +288,7 @@ fn run(
                 CapArea::MonteCarlo(&sample_tree)
             }
         };
-        let dirs: Vec<DVec3> = params.iter().map(|&p| to_direction(domain, p)).collect();
+        let dirs: Vec<DVec3> = params.iter().map(|&p| domain.to_direction(p)).collect();
         if config.local_units {
             for (f, (s, &x)) in local.iter_mut().zip(step.iter_mut().zip(&dirs)) {
                 *f = local_factor(area_of_domain, density.pdf(x));
@@ -386,7 +368,7 @@ mod tests {
                 .iter()
                 .all(|p| (0.0..=1.0).contains(&p.x) && (0.0..=1.0).contains(&p.y)));
             if domain == Domain::Hemisphere {
-                assert!(pts.iter().all(|&p| to_direction(domain, p).z >= 0.0));
+                assert!(pts.iter().all(|&p| domain.to_direction(p).z >= 0.0));
             }
             let head: f64 = losses[..30].iter().sum::<f64>() / 30.0;
             let tail: f64 = losses[losses.len() - 30..].iter().sum::<f64>() / 30.0;

@@ -29,14 +29,15 @@
 
 use super::brdf_albedo::directional_albedo;
 use super::cap_table::{profile_of_rule, CapMeasureTable};
-use super::density::{
-    domain_name, malley, normalize_rule, spec_num, DirectionDensity, DirectionSpecError,
-};
+use super::target::{normalize_rule, spec_num, DirectionDensity, DirectionSpecError};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
 use nuld_core::brdf::{
-    alpha, ggx_d, smith_g1, view_direction, BrdfModel, F0, MAX_ROUGHNESS, MAX_THETA_O_DEG,
-    MIN_ROUGHNESS,
+    alpha, view_direction, BrdfModel, F0, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS,
+};
+use nuld_core::warp::{
+    cosine_hemisphere_pdf, ggx_vndf_reflected_pdf, sample_ggx_vndf_reflected,
+    square_to_cosine_hemisphere,
 };
 use rand::{Rng, RngCore};
 use std::f64::consts::PI;
@@ -111,7 +112,7 @@ impl BrdfTarget {
         if total <= 0.0 {
             return Err(DirectionSpecError::ZeroMass {
                 what,
-                domain: domain_name(domain),
+                domain: domain.name(),
             });
         }
         let c_d = match model {
@@ -178,23 +179,18 @@ impl BrdfTarget {
 
     /// Density of `wi` under VNDF sampling: `G1(wo) D(h) / (4 n.wo)`.
     fn pdf_vndf(&self, wi: DVec3) -> f64 {
-        let h = (self.wo + wi).normalize_or_zero();
-        if h.z <= 0.0 {
-            return 0.0;
-        }
-        smith_g1(self.wo.z, self.alpha) * ggx_d(h.z, self.alpha) / (4.0 * self.wo.z)
+        ggx_vndf_reflected_pdf(self.wo, self.alpha, wi)
     }
 
     /// Density of the rejection proposal.
     fn pdf_proposal(&self, wi: DVec3) -> f64 {
         let w = self.proposal_spec_weight();
-        w * self.pdf_vndf(wi) + (1.0 - w) * wi.z.max(0.0) / PI
+        w * self.pdf_vndf(wi) + (1.0 - w) * cosine_hemisphere_pdf(wi)
     }
 
     /// `wi` from VNDF sampling with `u` (may lie below the horizon).
     fn vndf_direction(&self, u: DVec2) -> DVec3 {
-        let h = sample_ggx_vndf(self.wo, self.alpha, u);
-        2.0 * self.wo.dot(h) * h - self.wo
+        sample_ggx_vndf_reflected(self.wo, self.alpha, u)
     }
 
     /// The balance-heuristic rule with about `k` points, and the raw weight sum
@@ -223,7 +219,7 @@ impl BrdfTarget {
                     push(if spec {
                         self.vndf_direction(u)
                     } else {
-                        malley(u)
+                        square_to_cosine_hemisphere(u)
                     });
                 }
             }
@@ -262,9 +258,23 @@ impl DirectionDensity for BrdfTarget {
             self.vndf_direction(DVec2::new((ux / ps).min(1.0), u.y))
         } else {
             let r = ((ux - ps) / (1.0 - ps)).clamp(0.0, 1.0);
-            malley(DVec2::new(r, u.y))
+            square_to_cosine_hemisphere(DVec2::new(r, u.y))
         };
         DVec3::new(wi.x, wi.y, wi.z.abs()).normalize()
+    }
+
+    /// Density of [`BrdfTarget::sample`]: with `p_s = A_spec / A` the VNDF lobe
+    /// ([`ggx_vndf_reflected_pdf`]) and otherwise the cosine lobe
+    /// ([`cosine_hemisphere_pdf`]); VNDF directions below the horizon are mirrored to
+    /// `z -> -z`, so both `w` and its mirror image `w' = (x, y, -z)` contribute:
+    /// `p(w) = p_s [v(w) + v(w')] + (1 - p_s) max(z, 0) / pi`, 0 for `z < 0`.
+    fn sample_pdf(&self, w: DVec3) -> f64 {
+        if w.z < 0.0 {
+            return 0.0;
+        }
+        let ps = self.specular_albedo / self.albedo();
+        let mirror = DVec3::new(w.x, w.y, -w.z);
+        ps * (self.pdf_vndf(w) + self.pdf_vndf(mirror)) + (1.0 - ps) * cosine_hemisphere_pdf(w)
     }
 
     /// Exact sampling by rejection (module docs).
@@ -275,7 +285,7 @@ impl DirectionDensity for BrdfTarget {
             let wi = if rng.random::<f64>() < w {
                 self.vndf_direction(u)
             } else {
-                malley(u)
+                square_to_cosine_hemisphere(u)
             };
             if wi.z <= 0.0 {
                 continue;
@@ -301,28 +311,6 @@ impl DirectionDensity for BrdfTarget {
     }
 }
 
-/// GGX visible-normal sampling (Heitz 2018, "Sampling the GGX Distribution of
-/// Visible Normals"), isotropic `alpha`: a microfacet normal `h` distributed by
-/// `G1(wo) max(wo.h, 0) D(h) / (n.wo)` for `u` uniform in `[0,1)^2`.
-pub fn sample_ggx_vndf(wo: DVec3, alpha: f64, u: DVec2) -> DVec3 {
-    let vh = DVec3::new(alpha * wo.x, alpha * wo.y, wo.z).normalize();
-    let lensq = vh.x * vh.x + vh.y * vh.y;
-    let t1 = if lensq > 0.0 {
-        DVec3::new(-vh.y, vh.x, 0.0) / lensq.sqrt()
-    } else {
-        DVec3::X
-    };
-    let t2 = vh.cross(t1);
-    let r = u.x.clamp(0.0, 1.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    let p1 = r * phi.cos();
-    let mut p2 = r * phi.sin();
-    let s = 0.5 * (1.0 + vh.z);
-    p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * p2;
-    let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * vh;
-    DVec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(0.0)).normalize()
-}
-
 /// The SPEC kind of `model`: `brdf` (glTF 2.0, the default) or `brdf-burley`.
 pub fn spec_kind(model: BrdfModel) -> &'static str {
     match model {
@@ -336,7 +324,7 @@ mod tests {
     use super::*;
     use crate::seeding::rng;
     use crate::sphere::geometry::random_direction;
-    use nuld_core::sphere::square_to_sphere;
+    use nuld_core::sphere::{square_to_hemisphere, square_to_sphere};
 
     /// `∫ g dω` over the sphere by the midpoint rule on an `m x m` sphere-map grid.
     fn sphere_integral(m: usize, g: impl Fn(DVec3) -> f64) -> f64 {
@@ -415,6 +403,33 @@ mod tests {
             assert!((b.cap_measure(DVec3::Z, -1.0) - 1.0).abs() < 1e-12);
             assert!((b.cap_measure(DVec3::Z, 0.0) - 1.0).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn sample_pdf_is_the_density_of_the_baseline_warp() {
+        let brdf = BrdfTarget::new(0.3, 45.0, Domain::Hemisphere).unwrap();
+        // It integrates to 1 over the hemisphere (midpoint rule on the equal-area map).
+        let m = 1024;
+        let mut total = 0.0;
+        for j in 0..m {
+            for i in 0..m {
+                let p = DVec2::new((i as f64 + 0.5) / m as f64, (j as f64 + 0.5) / m as f64);
+                total += brdf.sample_pdf(square_to_hemisphere(p));
+            }
+        }
+        total *= 2.0 * PI / (m * m) as f64;
+        assert!((total - 1.0).abs() < 2e-3, "{total}");
+        // E_p[q / p] = ∫ q = 1 for samples of the warp: checks p against sample().
+        let mut g = rng(3, 2);
+        let k = 400_000;
+        let s: f64 = (0..k)
+            .map(|_| {
+                let w = brdf.sample(DVec2::new(g.random(), g.random()));
+                brdf.pdf(w) / brdf.sample_pdf(w)
+            })
+            .sum::<f64>()
+            / k as f64;
+        assert!((s - 1.0).abs() < 5e-3, "{s}");
     }
 
     #[test]

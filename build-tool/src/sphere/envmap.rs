@@ -38,8 +38,8 @@
 //!   use a `2^15`-point rule (coarser than `cap_measure`).
 
 use super::cap_table::profile_of_rule;
-use super::density::{domain_name, normalize_rule, DirectionDensity, DirectionSpecError};
 use super::geometry::unit_or_z;
+use super::target::{normalize_rule, DirectionDensity, DirectionSpecError};
 use crate::density::image::{load_luminance, LuminanceImage, NegativePixels};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
@@ -203,7 +203,7 @@ impl EnvmapDensity {
         if total <= 0.0 {
             return Err(DirectionSpecError::ZeroMass {
                 what,
-                domain: domain_name(domain),
+                domain: domain.name(),
             });
         }
         mass.iter_mut().for_each(|m| *m /= total);

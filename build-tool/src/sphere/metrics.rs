@@ -19,8 +19,8 @@
 //! Parallel sums use fixed chunks combined in a fixed order, so every result is
 //! bit-identical whatever the number of threads.
 
-use super::density::DirectionDensity;
 use super::geometry::{random_direction, tangent_frame, unit_or_z};
+use super::target::DirectionDensity;
 use crate::seeding::rng;
 use glam::DVec3;
 use rand::Rng;
@@ -623,7 +623,7 @@ pub fn cap_star_estimate_screened(
 mod tests {
     use super::*;
     use crate::sphere::brdf_target::BrdfTarget;
-    use crate::sphere::density::{CosineDirections, UniformDirections};
+    use crate::sphere::closed_form::{CosineDirections, UniformDirections};
     use nuld_core::blob::Domain;
 
     const SPHERE: UniformDirections = UniformDirections { hemisphere: false };

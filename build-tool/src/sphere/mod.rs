@@ -2,9 +2,10 @@
 //! samplers and cap measures, and spherical cap discrepancy metrics (docs/targets.md,
 //! docs/metrics.md; paper §2.1 Eqs. 7–9 and §3.5).
 //!
-//! * [`density`]: the [`DirectionDensity`] trait and [`parse_direction_spec`] for the
-//!   SPECs `uniform`, `cosine`, `brdf:ROUGHNESS,THETA_O_DEG` (`brdf-burley:...`),
-//!   `envmap:PATH`;
+//! * [`target`]: the [`DirectionDensity`] trait, its error and shared helpers;
+//! * [`spec`]: [`parse_direction_spec`] for the SPECs `uniform`, `cosine`,
+//!   `brdf:ROUGHNESS,THETA_O_DEG` (`brdf-burley:...`), `envmap:PATH`;
+//! * [`closed_form`]: the `uniform` and `cosine` targets;
 //! * [`brdf_target`], [`envmap`]: the two tabulated targets;
 //! * [`brdf_albedo`]: the BRDF's directional albedo (the `brdf` normalizer and the
 //!   per-condition sample weight) and tables of it;
@@ -14,21 +15,23 @@
 //!   Monte Carlo in the paper's theta-uniform convention) and a lower bound of the
 //!   cap star discrepancy.
 //!
+//! Imports run one way: [`target`] <- the targets <- [`spec`].
+//!
 //! A cap is `C(w, t) = {x : <w, x> >= t}`, `t = cos theta`.
 
 pub mod brdf_albedo;
 pub mod brdf_target;
 pub mod cap_table;
-pub mod density;
+pub mod closed_form;
 pub mod envmap;
 pub mod geometry;
 pub mod metrics;
+pub mod spec;
+pub mod target;
 
-pub use brdf_target::{sample_ggx_vndf, BrdfTarget};
+pub use brdf_target::BrdfTarget;
 pub use cap_table::CapMeasureTable;
-pub use density::{
-    parse_direction_spec, CosineDirections, DirectionDensity, DirectionSpecError, UniformDirections,
-};
+pub use closed_form::{CosineDirections, UniformDirections};
 pub use envmap::EnvmapDensity;
 pub use geometry::{
     cosine_cap_measure, random_direction, uniform_hemisphere_cap_measure,
@@ -40,3 +43,5 @@ pub use metrics::{
     cap_l2_uniform_squared, cap_star_estimate, cap_star_estimate_screened, cap_star_estimate_with,
     root_with_stderr, CapRadius, CapStarEstimate, CapStarOptions, EnergyReference, MeasuredCaps,
 };
+pub use spec::parse_direction_spec;
+pub use target::{DirectionDensity, DirectionSpecError};

@@ -1,0 +1,412 @@
+//! Warps of the unit square, each beside its density and its inverse: what a
+//! baseline sampler applies to a uniform point `u` in `[0,1)^2`.
+//!
+//! | warp | density of the image (`u` uniform) | inverse |
+//! |---|---|---|
+//! | [`square_to_disk`] (Shirley–Chiu concentric map) | [`DISK_PDF`] `= 1/pi` per unit area | [`disk_to_square`] |
+//! | [`square_to_cosine_hemisphere`] (Malley's method) | [`cosine_hemisphere_pdf`] `= max(z,0)/pi` per steradian | [`cosine_hemisphere_to_square`] |
+//! | [`sample_ggx_vndf`] (GGX visible normals, Heitz 2018) | [`ggx_vndf_pdf`] `= G1(v) max(0,v.h) D(h) / v.z` per steradian | [`ggx_vndf_to_square`] |
+//! | [`sample_ggx_vndf_reflected`] (`v` reflected about a visible normal) | [`ggx_vndf_reflected_pdf`] `= D_v(h) / (4 |v.h|)` per steradian | [`ggx_vndf_reflected_to_square`] |
+//!
+//! The equal-area maps of [`crate::sphere`] are warps too (constant density
+//! `1/(4 pi)` and `1/(2 pi)`); the hemisphere map lifts the concentric disk of this
+//! module.
+//!
+//! Everything is `f64` and `no_std` (math through `libm`). The runtime evaluates the
+//! maps in `f64` as well and rounds the result to `f32` once, so one precision serves
+//! both the tool and the runtime. Nothing here panics; each function says what it
+//! does off its domain.
+
+use crate::brdf::{ggx_d, smith_g1};
+use core::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
+use glam::{DVec2, DVec3};
+
+/// `sqrt(max(x, 0))`: rounding can push an argument that is mathematically
+/// non-negative slightly below zero.
+#[inline]
+pub(crate) fn safe_sqrt(x: f64) -> f64 {
+    libm::sqrt(x.max(0.0))
+}
+
+/// Density per unit area of [`square_to_disk`]'s image of a uniform point: `1/pi`
+/// (the map preserves area up to the factor `pi`).
+pub const DISK_PDF: f64 = 1.0 / PI;
+
+/// Signed polar form `(r, theta)` of the concentric map (Shirley and Chiu 1997, "A
+/// Low Distortion Map Between Disk and Square", as pbrt-v4's `SampleUniformDiskConcentric`):
+/// the disk point is `r (cos theta, sin theta)`, `r` in `[-1, 1]`,
+/// `theta` in `[-pi/4, 3pi/4]`; `None` at the square's centre. Shared by
+/// [`square_to_disk`] and [`crate::sphere::square_to_hemisphere`], which lifts it.
+#[inline]
+pub(crate) fn concentric_polar(u: DVec2) -> Option<(f64, f64)> {
+    let a = 2.0 * u.x - 1.0;
+    let b = 2.0 * u.y - 1.0;
+    if a == 0.0 && b == 0.0 {
+        return None;
+    }
+    Some(if a.abs() > b.abs() {
+        (a, FRAC_PI_4 * (b / a))
+    } else {
+        (b, FRAC_PI_2 - FRAC_PI_4 * (a / b))
+    })
+}
+
+/// Inverse of [`concentric_polar`] from a radius `r` in `[0, 1]` and an angle `phi`
+/// in `(-pi, pi]` (as `atan2` returns it) to the square point.
+#[inline]
+pub(crate) fn concentric_polar_inverse(r: f64, mut phi: f64) -> DVec2 {
+    if phi < -FRAC_PI_4 {
+        phi += 2.0 * PI;
+    }
+    let (a, b) = if phi < FRAC_PI_4 {
+        (r, phi * r / FRAC_PI_4)
+    } else if phi < 3.0 * FRAC_PI_4 {
+        (-(phi - FRAC_PI_2) * r / FRAC_PI_4, r)
+    } else if phi < 5.0 * FRAC_PI_4 {
+        (-r, -(phi - PI) * r / FRAC_PI_4)
+    } else {
+        ((phi - 3.0 * FRAC_PI_2) * r / FRAC_PI_4, -r)
+    };
+    DVec2::new(0.5 * (a + 1.0), 0.5 * (b + 1.0))
+}
+
+/// Shirley–Chiu concentric map of `[0,1]^2` onto the unit disk: concentric squares
+/// go to concentric circles, area is preserved up to the factor `pi` (density
+/// [`DISK_PDF`]).
+///
+/// The centre maps to the origin, the edge midpoints `(1, 1/2)`, `(1/2, 1)`, ... to
+/// `(1, 0)`, `(0, 1)`, ..., the corner `(1, 1)` to `(1, 1)/sqrt 2`. Inputs outside
+/// `[0,1]^2` are not clamped; they land outside the disk.
+///
+/// ```
+/// # use nuld_core::warp::square_to_disk; use glam::DVec2;
+/// assert_eq!(square_to_disk(DVec2::new(0.5, 0.5)), DVec2::ZERO);
+/// assert!((square_to_disk(DVec2::new(0.75, 0.5)) - DVec2::new(0.5, 0.0)).length() < 1e-15);
+/// let c = square_to_disk(DVec2::ONE);
+/// assert!((c - DVec2::splat(core::f64::consts::FRAC_1_SQRT_2)).length() < 1e-15);
+/// ```
+pub fn square_to_disk(u: DVec2) -> DVec2 {
+    match concentric_polar(u) {
+        None => DVec2::ZERO,
+        Some((r, theta)) => r * DVec2::new(libm::cos(theta), libm::sin(theta)),
+    }
+}
+
+/// Inverse of [`square_to_disk`]. Points outside the unit disk are first pulled
+/// radially onto its rim (so the result is always in `[0,1]^2`); the origin and
+/// non-finite input give the centre `(1/2, 1/2)`.
+pub fn disk_to_square(d: DVec2) -> DVec2 {
+    let r = libm::sqrt(d.x * d.x + d.y * d.y);
+    if r == 0.0 || !r.is_finite() {
+        return DVec2::splat(0.5);
+    }
+    concentric_polar_inverse(r.min(1.0), libm::atan2(d.y, d.x))
+}
+
+/// Cosine-weighted directions about `+z` by Malley's method (as pbrt-v4's
+/// `SampleCosineHemisphere`): [`square_to_disk`], then the lift
+/// `z = sqrt(1 - x^2 - y^2)`. Density [`cosine_hemisphere_pdf`]; unit vectors with
+/// `z >= 0` for `u` in `[0,1]^2` (outside, the disk point leaves the disk and `z`
+/// is 0).
+///
+/// ```
+/// # use nuld_core::warp::square_to_cosine_hemisphere; use glam::{DVec2, DVec3};
+/// assert_eq!(square_to_cosine_hemisphere(DVec2::splat(0.5)), DVec3::Z);
+/// let d = square_to_cosine_hemisphere(DVec2::new(0.75, 0.5));
+/// assert!((d - DVec3::new(0.5, 0.0, 0.75f64.sqrt())).length() < 1e-15);
+/// ```
+pub fn square_to_cosine_hemisphere(u: DVec2) -> DVec3 {
+    let d = square_to_disk(u);
+    DVec3::new(d.x, d.y, safe_sqrt(1.0 - d.length_squared()))
+}
+
+/// Density per steradian of [`square_to_cosine_hemisphere`]: `max(z, 0) / pi` for a
+/// unit vector `d` (0 below the horizon and for NaN `z`).
+#[inline]
+pub fn cosine_hemisphere_pdf(d: DVec3) -> f64 {
+    d.z.max(0.0) / PI
+}
+
+/// Inverse of [`square_to_cosine_hemisphere`]: [`disk_to_square`] of `(d.x, d.y)`.
+/// A direction below the horizon gives the point of its mirror image `(x, y, -z)`.
+pub fn cosine_hemisphere_to_square(d: DVec3) -> DVec2 {
+    disk_to_square(d.truncate())
+}
+
+/// The stretched view direction `V_h` and the orthonormal frame `(T1, T2, V_h)` of
+/// Heitz 2018, Listing 1 (isotropic `alpha`).
+#[inline]
+fn vndf_frame(wo: DVec3, alpha: f64) -> (DVec3, DVec3, DVec3) {
+    let vh = DVec3::new(alpha * wo.x, alpha * wo.y, wo.z).normalize();
+    let lensq = vh.x * vh.x + vh.y * vh.y;
+    let t1 = if lensq > 0.0 {
+        DVec3::new(-vh.y, vh.x, 0.0) / libm::sqrt(lensq)
+    } else {
+        DVec3::X
+    };
+    (vh, t1, vh.cross(t1))
+}
+
+/// GGX visible-normal sampling (Heitz 2018, "Sampling the GGX Distribution of
+/// Visible Normals", JCGT 7(4), Listing 1), isotropic width `alpha`: a microfacet
+/// normal `h` (unit, `h.z >= 0`) distributed by [`ggx_vndf_pdf`]
+/// `D_v(h) = G1(v) max(0, v.h) D(h) / v.z` when `u` is uniform in `[0,1)^2`.
+///
+/// `wo` is the view direction `v`, a unit vector with `wo.z > 0`; `alpha > 0`
+/// ([`crate::brdf::alpha`]). `u.x` is clamped into `[0, 1]`, `u.y` is an angle
+/// fraction (any value). A zero `wo` or `alpha` gives NaN, not a panic.
+///
+/// ```
+/// # use nuld_core::warp::sample_ggx_vndf; use glam::{DVec2, DVec3};
+/// // alpha = 1, v = +z: D_v(h) = h.z / pi, and the warp is the polar map
+/// // h = (sqrt(u.x) cos 2 pi u.y, sqrt(u.x) sin 2 pi u.y, sqrt(1 - u.x)).
+/// let h = sample_ggx_vndf(DVec3::Z, 1.0, DVec2::new(0.36, 0.25));
+/// assert!((h - DVec3::new(0.0, 0.6, 0.8)).length() < 1e-15);
+/// ```
+pub fn sample_ggx_vndf(wo: DVec3, alpha: f64, u: DVec2) -> DVec3 {
+    let (vh, t1, t2) = vndf_frame(wo, alpha);
+    let r = libm::sqrt(u.x.clamp(0.0, 1.0));
+    let phi = 2.0 * PI * u.y;
+    let p1 = r * libm::cos(phi);
+    let mut p2 = r * libm::sin(phi);
+    // Squash the disk's lower half onto the part of the projected hemisphere that
+    // the stretched view direction sees (Heitz 2018, §4.2).
+    let s = 0.5 * (1.0 + vh.z);
+    p2 = (1.0 - s) * safe_sqrt(1.0 - p1 * p1) + s * p2;
+    let nh = p1 * t1 + p2 * t2 + safe_sqrt(1.0 - p1 * p1 - p2 * p2) * vh;
+    DVec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(0.0)).normalize()
+}
+
+/// Density per steradian of [`sample_ggx_vndf`]'s normals: the distribution of
+/// visible normals `D_v(h) = G1(v) max(0, v.h) D(h) / v.z` (Heitz 2018, Eq. 1) with
+/// [`crate::brdf::ggx_d`] and [`crate::brdf::smith_g1`]; `wo = v` and `h` unit.
+/// 0 for `h.z <= 0`, `v.h <= 0` or `v.z <= 0`.
+pub fn ggx_vndf_pdf(wo: DVec3, alpha: f64, h: DVec3) -> f64 {
+    let wo_h = wo.dot(h);
+    if !(wo.z > 0.0 && h.z > 0.0 && wo_h > 0.0) {
+        return 0.0;
+    }
+    smith_g1(wo.z, alpha) * wo_h * ggx_d(h.z, alpha) / wo.z
+}
+
+/// Inverse of [`sample_ggx_vndf`]: the `u` in `[0,1]^2` whose normal is `h` (a unit
+/// vector with `h.z > 0` and `wo.h > 0`, i.e. in the support of [`ggx_vndf_pdf`]).
+/// It undoes each step of the warp: unstretch `h`, project onto the frame, unsquash,
+/// and read the disk point's polar coordinates (`u.y` in `[0, 1)`). Outside the
+/// support the result is clamped into `[0,1]^2` but does not map back to `h`.
+pub fn ggx_vndf_to_square(wo: DVec3, alpha: f64, h: DVec3) -> DVec2 {
+    let (vh, t1, t2) = vndf_frame(wo, alpha);
+    let nh = DVec3::new(h.x / alpha, h.y / alpha, h.z.max(0.0)).normalize_or_zero();
+    let p1 = nh.dot(t1);
+    let s = 0.5 * (1.0 + vh.z);
+    let p2 = (nh.dot(t2) - (1.0 - s) * safe_sqrt(1.0 - p1 * p1)) / s;
+    let mut phi = libm::atan2(p2, p1);
+    if phi < 0.0 {
+        phi += TAU;
+    }
+    let ux = p1 * p1 + p2 * p2;
+    let uy = phi / TAU;
+    let clamp = |x: f64| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+    DVec2::new(clamp(ux), clamp(uy))
+}
+
+/// The view direction `wo` reflected about a visible normal from [`sample_ggx_vndf`]:
+/// `wi = 2 (wo.h) h - wo`, the light direction of GGX importance sampling. Density
+/// [`ggx_vndf_reflected_pdf`]; `wi` may lie below the horizon (`wi.z < 0`), where
+/// the BRDF is zero.
+pub fn sample_ggx_vndf_reflected(wo: DVec3, alpha: f64, u: DVec2) -> DVec3 {
+    let h = sample_ggx_vndf(wo, alpha, u);
+    2.0 * wo.dot(h) * h - wo
+}
+
+/// Density per steradian of [`sample_ggx_vndf_reflected`]:
+/// `D_v(h) / (4 |wo.h|) = G1(wo) D(h) / (4 wo.z)` with `h = normalize(wo + wi)`
+/// (Heitz 2018, Eq. 17; the reflection's Jacobian is `1 / (4 |wo.h|)`). Defined on
+/// the whole sphere of `wi` (0 where `h.z <= 0`, `wo.h <= 0` or `wo.z <= 0`).
+pub fn ggx_vndf_reflected_pdf(wo: DVec3, alpha: f64, wi: DVec3) -> f64 {
+    let h = (wo + wi).normalize_or_zero();
+    if !(wo.z > 0.0 && h.z > 0.0 && wo.dot(h) > 0.0) {
+        return 0.0;
+    }
+    smith_g1(wo.z, alpha) * ggx_d(h.z, alpha) / (4.0 * wo.z)
+}
+
+/// Inverse of [`sample_ggx_vndf_reflected`]: [`ggx_vndf_to_square`] of the half
+/// vector `normalize(wo + wi)`; same support and clamping.
+pub fn ggx_vndf_reflected_to_square(wo: DVec3, alpha: f64, wi: DVec3) -> DVec2 {
+    ggx_vndf_to_square(wo, alpha, (wo + wi).normalize_or_zero())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sphere::{square_to_hemisphere, square_to_sphere};
+
+    /// Interior points of an `n x n` grid, kept away from the creases of the maps
+    /// (the concentric map's diagonals, `u.y = 0`) where central differences straddle
+    /// a kink.
+    fn grid(n: usize) -> impl Iterator<Item = DVec2> {
+        (0..n).flat_map(move |i| {
+            (0..n).map(move |j| {
+                DVec2::new((i as f64 + 0.37) / n as f64, (j as f64 + 0.61) / n as f64)
+            })
+        })
+    }
+
+    /// `|df/du x df/dv|` by central differences: the area (or, for unit vectors,
+    /// solid-angle) element of the map at `p`, per unit area of the square.
+    fn element3(f: impl Fn(DVec2) -> DVec3, p: DVec2, h: f64) -> f64 {
+        let du = (f(p + DVec2::X * h) - f(p - DVec2::X * h)) / (2.0 * h);
+        let dv = (f(p + DVec2::Y * h) - f(p - DVec2::Y * h)) / (2.0 * h);
+        du.cross(dv).length()
+    }
+
+    /// `∫ g dω` over the sphere (or the upper hemisphere) by the midpoint rule on an
+    /// `m x m` grid of the equal-area map.
+    fn integrate(m: usize, hemisphere: bool, g: impl Fn(DVec3) -> f64) -> f64 {
+        let mut s = 0.0;
+        for k in 0..m * m {
+            let p = DVec2::new(
+                ((k % m) as f64 + 0.5) / m as f64,
+                ((k / m) as f64 + 0.5) / m as f64,
+            );
+            s += g(if hemisphere {
+                square_to_hemisphere(p)
+            } else {
+                square_to_sphere(p)
+            });
+        }
+        let area = if hemisphere { 2.0 * PI } else { 4.0 * PI };
+        s * area / (m * m) as f64
+    }
+
+    /// View directions and widths the GGX tests run over (normal to grazing view;
+    /// smooth to rough).
+    const VIEWS: [(f64, f64); 6] = [
+        (0.0, 0.3),
+        (30.0, 0.5),
+        (60.0, 0.2),
+        (75.0, 1.0),
+        (85.0, 0.6),
+        (45.0, 0.05),
+    ];
+
+    fn view(theta_deg: f64) -> DVec3 {
+        let t = theta_deg.to_radians();
+        DVec3::new(libm::sin(t), 0.0, libm::cos(t))
+    }
+
+    #[test]
+    fn disk_round_trips_and_has_area_element_pi() {
+        for p in grid(61) {
+            let d = square_to_disk(p);
+            assert!(d.length() <= 1.0 + 1e-15);
+            let q = disk_to_square(d);
+            assert!((p - q).length() < 1e-12, "{p:?} -> {d:?} -> {q:?}");
+            let lift = |u: DVec2| square_to_disk(u).extend(0.0);
+            let a = element3(lift, p, 1e-6);
+            assert!((a * DISK_PDF - 1.0).abs() < 1e-6, "{p:?}: {a}");
+        }
+        assert_eq!(disk_to_square(DVec2::ZERO), DVec2::splat(0.5));
+        assert_eq!(disk_to_square(DVec2::splat(f64::NAN)), DVec2::splat(0.5));
+        // Outside the disk: pulled onto the rim, so the edge midpoint.
+        assert!((disk_to_square(DVec2::new(3.0, 0.0)) - DVec2::new(1.0, 0.5)).length() < 1e-15);
+    }
+
+    #[test]
+    fn cosine_hemisphere_round_trips_and_pdf_is_the_jacobian() {
+        for p in grid(61) {
+            let d = square_to_cosine_hemisphere(p);
+            assert!((d.length() - 1.0).abs() < 1e-14 && d.z >= 0.0);
+            let q = cosine_hemisphere_to_square(d);
+            assert!((p - q).length() < 1e-12, "{p:?} -> {d:?} -> {q:?}");
+            // Solid angle per unit square area is 1 / pdf (near the rim, z -> 0, the
+            // lift's derivative grows like 1/z, so the step is kept small).
+            let a = element3(square_to_cosine_hemisphere, p, 1e-7);
+            let pdf = cosine_hemisphere_pdf(d);
+            assert!((a * pdf - 1.0).abs() < 1e-4, "{p:?}: {a} {pdf}");
+        }
+        let mirror = cosine_hemisphere_to_square(DVec3::new(0.6, 0.0, -0.8));
+        assert_eq!(
+            mirror,
+            cosine_hemisphere_to_square(DVec3::new(0.6, 0.0, 0.8))
+        );
+        assert_eq!(cosine_hemisphere_pdf(DVec3::new(0.0, 1.0, -0.0)), 0.0);
+    }
+
+    #[test]
+    fn cosine_hemisphere_pdf_integrates_to_one() {
+        // The kink at z = 0 lies on cell boundaries of the octahedral grid; the
+        // error is O(m^-2) (-3.8e-6 at m = 1024).
+        let s = integrate(1024, false, cosine_hemisphere_pdf);
+        assert!((s - 1.0).abs() < 1e-5, "{s}");
+    }
+
+    #[test]
+    fn vndf_round_trips() {
+        for (t, a) in VIEWS {
+            let wo = view(t);
+            for p in grid(41) {
+                let h = sample_ggx_vndf(wo, a, p);
+                assert!((h.length() - 1.0).abs() < 1e-14 && h.z >= 0.0);
+                assert!(wo.dot(h) >= -1e-15, "t={t} a={a}: {h:?} invisible");
+                let q = ggx_vndf_to_square(wo, a, h);
+                assert!((p - q).length() < 1e-9, "t={t} a={a}: {p:?} -> {q:?}");
+                let wi = sample_ggx_vndf_reflected(wo, a, p);
+                let q = ggx_vndf_reflected_to_square(wo, a, wi);
+                assert!((p - q).length() < 1e-9, "t={t} a={a}: {p:?} -> {q:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn vndf_pdfs_are_the_jacobians_of_the_warps() {
+        for (t, a) in VIEWS {
+            let wo = view(t);
+            for p in grid(23) {
+                let h = sample_ggx_vndf(wo, a, p);
+                let pdf = ggx_vndf_pdf(wo, a, h);
+                let el = element3(|u| sample_ggx_vndf(wo, a, u), p, 1e-7);
+                assert!(
+                    (el * pdf - 1.0).abs() < 1e-4,
+                    "t={t} a={a} {p:?}: {el} {pdf}"
+                );
+                let wi = sample_ggx_vndf_reflected(wo, a, p);
+                let pdf = ggx_vndf_reflected_pdf(wo, a, wi);
+                let el = element3(|u| sample_ggx_vndf_reflected(wo, a, u), p, 1e-7);
+                assert!(
+                    (el * pdf - 1.0).abs() < 1e-4,
+                    "t={t} a={a} {p:?}: {el} {pdf}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn vndf_pdfs_integrate_to_one() {
+        // Wide lobes, which the equal-area grids resolve.
+        for (t, a) in [(0.0, 0.5), (40.0, 1.0), (70.0, 0.6)] {
+            let wo = view(t);
+            // O(m^-2): about 1e-6 at m = 1024.
+            let s = integrate(1024, true, |h| ggx_vndf_pdf(wo, a, h));
+            assert!((s - 1.0).abs() < 1e-5, "t={t} a={a}: {s}");
+            // Reflected directions cover the whole sphere, below the horizon too. The
+            // density jumps to 0 where the half vector reaches the horizon, a curve
+            // the grid cells straddle, so the midpoint rule is only O(1/m) there
+            // (|error| about 2e-4 at m = 1024).
+            let s = integrate(1024, false, |wi| ggx_vndf_reflected_pdf(wo, a, wi));
+            assert!((s - 1.0).abs() < 6e-4, "t={t} a={a}: {s}");
+        }
+    }
+
+    #[test]
+    fn vndf_pdfs_are_zero_off_their_support() {
+        let wo = view(30.0);
+        assert_eq!(ggx_vndf_pdf(wo, 0.5, DVec3::new(0.0, 0.0, -1.0)), 0.0);
+        // A normal facing away from the view.
+        let back = DVec3::new(-0.99, 0.0, 0.141).normalize();
+        assert_eq!(ggx_vndf_pdf(wo, 0.5, back), 0.0);
+        assert_eq!(ggx_vndf_reflected_pdf(wo, 0.5, -wo), 0.0);
+        assert_eq!(ggx_vndf_pdf(DVec3::new(1.0, 0.0, 0.0), 0.5, DVec3::Z), 0.0);
+    }
+}
