@@ -1,0 +1,45 @@
+#!/usr/bin/env python3
+"""Writes the synthetic 1024x512 Radiance HDR maps of the README's concentrated-target
+table (no dependencies): sun50.hdr (a constant map whose 2x2-pixel block holds half
+the light), lowsun.hdr (a 3x3-pixel sun 4 degrees above the horizon holding 80 %),
+lamps.hdr (a dark room with four 2x1-pixel lamps of 15 % each).
+Usage: scripts/synthetic-maps.py OUT_DIR"""
+import math, os, sys
+out=sys.argv[1] if len(sys.argv)>1 else 'out/maps'
+os.makedirs(out,exist_ok=True)
+W,H=1024,512
+def rgbe(v):
+    if v<=1e-32: return b'\0\0\0\0'
+    m,e=math.frexp(v)
+    x=min(int(m*256.0),255)
+    return bytes([x,x,x,e+128])
+def write(path,f):
+    out=bytearray()
+    out+=b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y %d +X %d\n"%(H,W)
+    for r in range(H):
+        row=bytearray()
+        for c in range(W):
+            row+=rgbe(f(c,r))
+        out+=row
+    open(path,'wb').write(out)
+def omega(r): return (2*math.pi/W)*(math.cos(math.pi*r/H)-math.cos(math.pi*(r+1)/H))
+# 1. uniform + 2x2 block with 50% of mass
+rows=[118,119]; cols=[613,614]
+bg=4*math.pi
+blockom=sum(omega(r) for r in rows)*2
+Ls=(bg-blockom)/blockom  # block mass = Ls*blockom = bg - blockom -> half of total
+write(os.path.join(out,'sun50.hdr'), lambda c,r: Ls if (r in rows and c in cols) else 1.0)
+# 2. low sun: sky 1.0 above horizon, ground 0.2, sun 3x3 at row 244..246 col 300..302 holding ~80%
+srows=[244,245,246]; scols=[300,301,302]
+sky=sum(omega(r) for r in range(256))*W*1.0+sum(omega(r) for r in range(256,512))*W*0.2
+som=sum(omega(r) for r in srows)*3
+Ls2=4*sky/som
+write(os.path.join(out,'lowsun.hdr'), lambda c,r: Ls2 if (r in srows and c in scols) else (1.0 if r<256 else 0.2))
+# 3. lamps: dark room 0.05, 4 lamps 2x1 px each holding ~15% each
+lamps=[(100,60),(400,150),(700,200),(900,90)]
+base=0.05*4*math.pi
+def lampf(c,r):
+    for (lc,lr) in lamps:
+        if r==lr and c in (lc,lc+1): return 0.15/0.4*base/(2*omega(lr))
+    return 0.05
+write(os.path.join(out,'lamps.hdr'), lampf)
