@@ -8,7 +8,7 @@ use super::methods::{
     method_fingerprint, projected_density, realization_seed, DirectionSampler, Method,
     SquareSampler, SquareWarp,
 };
-use super::report::Row;
+use super::rows::Row;
 use super::{stats, EvalSettings, Figure};
 use crate::baselines::HierarchicalWarp;
 use crate::metrics::summary::{Target, TABULATION_RESOLUTION};
@@ -195,17 +195,6 @@ fn evaluator<'a>(
     })
 }
 
-/// Realizations of `method`: one for deterministic methods.
-pub fn realizations(method: Method, s: &EvalSettings) -> usize {
-    if method.is_deterministic() {
-        1
-    } else if method == Method::Ours {
-        s.realizations_ours
-    } else {
-        s.realizations_baseline
-    }
-}
-
 /// Evaluates `panel` for every method and size, through `cache`, and returns its
 /// rows ordered by metric, then method (panel order), then N.
 pub fn run_panel(
@@ -220,7 +209,7 @@ pub fn run_panel(
     let total: usize = panel
         .methods
         .iter()
-        .map(|m| realizations(*m, s) * sizes.len())
+        .map(|m| m.realizations(s) * sizes.len())
         .sum();
     let bar = ProgressBar::new(total as u64);
     bar.set_style(
@@ -262,7 +251,7 @@ pub fn run_panel(
                 bar.inc(1);
                 Ok(v)
             };
-            let count = realizations(method, s);
+            let count = method.realizations(s);
             let values: Vec<Values> = if method == Method::Ours {
                 (0..count).map(one).collect::<Result<_>>()?
             } else {
