@@ -12,13 +12,13 @@ use super::rows::Row;
 use super::{stats, EvalSettings, Figure};
 use crate::baselines::HierarchicalWarp;
 use crate::metrics::summary::{Target, TABULATION_RESOLUTION};
+use crate::progress::Progress;
 use crate::seeding::derive_seed;
 use crate::sphere::{
     cap_l2_mc_squared, cap_l2_uniform, cap_star_estimate_with, CapRadius, CapStarOptions,
     DirectionDensity,
 };
 use anyhow::{anyhow, Result};
-use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
@@ -211,13 +211,11 @@ pub fn run_panel(
         .iter()
         .map(|m| m.realizations(s) * sizes.len())
         .sum();
-    let bar = ProgressBar::new(total as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} {prefix} [{bar:30}] {pos}/{len}  {msg}  ETA {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
+    let progress = Progress::stderr(
+        &format!("{figure} {}", panel.target),
+        total as u64,
+        "realization",
     );
-    bar.set_prefix(format!("{figure} {}", panel.target));
     let hits = AtomicUsize::new(0);
     let sphere = matches!(
         panel.kind,
@@ -228,7 +226,7 @@ pub fn run_panel(
     for (mi, &method) in panel.methods.iter().enumerate() {
         let fp = format!("{panel_fp};{}", method_fingerprint(method, epochs));
         for &n in &sizes {
-            bar.set_message(format!("{method} N={n}"));
+            progress.set_context(format!("{method} N={n}"));
             let one = |r: usize| -> Result<Values> {
                 let key = CacheKey {
                     figure: figure.name().into(),
@@ -248,7 +246,7 @@ pub fn run_panel(
                         v
                     }
                 };
-                bar.inc(1);
+                progress.inc(1);
                 Ok(v)
             };
             let count = method.realizations(s);
@@ -285,13 +283,11 @@ pub fn run_panel(
             }
         }
     }
-    bar.finish_and_clear();
-    eprintln!(
-        "{figure} {}: {total} realizations ({} from the cache) in {:.1} s",
-        panel.target,
+    progress.finish_with(&format!(
+        "{total} realizations ({} from the cache) in {:.1} s",
         hits.load(Ordering::Relaxed),
         started.elapsed().as_secs_f64()
-    );
+    ));
     rows.sort_by_key(|(k, _)| *k);
     Ok(rows.into_iter().map(|(_, r)| r).collect())
 }
