@@ -1,6 +1,7 @@
 //! The metrics of one direction set against one target, as `optimize` and
 //! `metrics` report them for the sphere and hemisphere domains.
 
+use super::aggregate::Summary;
 use crate::sphere::{
     cap_l2_for_density, cap_l2_theta_uniform_estimate, cap_l2_uniform, cap_star_estimate,
     CapMeasureTable, DirectionDensity,
@@ -24,10 +25,15 @@ pub struct CapMetricSummary {
     pub cap_star_lower_bound: f64,
 }
 
-impl CapMetricSummary {
-    /// The element-wise mean of several summaries (standard errors combined as for
-    /// a mean of independent estimates).
-    pub fn mean(items: &[CapMetricSummary]) -> CapMetricSummary {
+impl Summary for CapMetricSummary {
+    const LABELS: &'static [&'static str] = &["cap L2", "theta-unif", "cap D* >="];
+
+    fn values(&self) -> Vec<f64> {
+        vec![self.cap_l2, self.cap_l2_theta, self.cap_star_lower_bound]
+    }
+
+    /// Standard errors are combined as for a mean of independent estimates.
+    fn mean(items: &[CapMetricSummary]) -> CapMetricSummary {
         let n = items.len().max(1) as f64;
         let avg = |f: fn(&CapMetricSummary) -> f64| items.iter().map(f).sum::<f64>() / n;
         CapMetricSummary {
@@ -40,6 +46,15 @@ impl CapMetricSummary {
                 .sqrt()
                 / n,
             cap_star_lower_bound: avg(|m| m.cap_star_lower_bound),
+        }
+    }
+
+    fn ratio(&self, baseline: &CapMetricSummary) -> CapMetricSummary {
+        CapMetricSummary {
+            cap_l2: self.cap_l2 / baseline.cap_l2,
+            cap_l2_theta: self.cap_l2_theta / baseline.cap_l2_theta,
+            cap_l2_theta_stderr: f64::NAN,
+            cap_star_lower_bound: self.cap_star_lower_bound / baseline.cap_star_lower_bound,
         }
     }
 }

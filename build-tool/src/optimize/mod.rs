@@ -5,6 +5,8 @@
 
 pub mod adam;
 pub mod directions;
+pub mod report;
+pub mod run;
 
 use crate::baselines::seeded_owen_sobol;
 use crate::density::Density2D;
