@@ -127,7 +127,11 @@ impl PointSets {
         Ok(PointSets {
             domain,
             sets: (0..square.set_count())
-                .map(|s| (0..square.len()).map(|i| decode(square.raw(s, i))).collect())
+                .map(|s| {
+                    (0..square.len())
+                        .map(|i| decode(square.raw(s, i)))
+                        .collect()
+                })
                 .collect(),
         })
     }

@@ -57,7 +57,13 @@ impl Progress {
             );
             Self::with_display(phase, total, unit, Display::Bar(bar))
         } else {
-            Self::lines(phase, total, unit, Box::new(std::io::stderr()), LINE_INTERVAL)
+            Self::lines(
+                phase,
+                total,
+                unit,
+                Box::new(std::io::stderr()),
+                LINE_INTERVAL,
+            )
         }
     }
 
@@ -229,7 +235,13 @@ mod tests {
     #[test]
     fn plain_lines_give_count_percentage_context_message_and_a_done_line() {
         let sink = Shared::default();
-        let p = Progress::lines("optimize", 4, "epoch", Box::new(sink.clone()), Duration::ZERO);
+        let p = Progress::lines(
+            "optimize",
+            4,
+            "epoch",
+            Box::new(sink.clone()),
+            Duration::ZERO,
+        );
         p.set_context("set 1/1");
         p.set_message("loss 1.5e-3");
         p.inc(1);
@@ -244,7 +256,10 @@ mod tests {
             "{text}"
         );
         // The last step is reported by the done line, not a 100% status line.
-        assert!(lines[2].starts_with("optimize: done, 4 epochs in "), "{text}");
+        assert!(
+            lines[2].starts_with("optimize: done, 4 epochs in "),
+            "{text}"
+        );
     }
 
     #[test]

@@ -41,8 +41,8 @@ pub use random::random;
 pub use sobol_cp::{sobol_cranley_patterson, sobol_points, SOBOL_CP_MAX_POINTS};
 pub use sot::{sliced_optimal_transport, sliced_wasserstein, SOT_DEFAULT_ITERATIONS};
 pub use spherical_fibonacci::spherical_fibonacci;
-pub use warped::{seeded_owen_sobol, warped_owen_sobol};
 pub use warp::{cosine_hemisphere, hierarchical_warp, warp_inverse_cdf, HierarchicalWarp};
+pub use warped::{seeded_owen_sobol, warped_owen_sobol};
 
 /// The largest `f64` below 1: generators clamp coordinates to `[0, BELOW_ONE]` so that
 /// points stay in `[0,1)^2`.

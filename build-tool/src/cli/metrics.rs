@@ -54,11 +54,25 @@ pub fn run(a: MetricsArgs) -> Result<()> {
     match points.domain {
         Domain::Square => {
             let problem = SquareProblem::parse(&spec).with_context(context)?;
-            print(&a, file, &spec, source, &points, &measure(&problem, &points))
+            print(
+                &a,
+                file,
+                &spec,
+                source,
+                &points,
+                &measure(&problem, &points),
+            )
         }
         domain => {
             let problem = DirectionProblem::parse(&spec, domain).with_context(context)?;
-            print(&a, file, &spec, source, &points, &measure(&problem, &points))
+            print(
+                &a,
+                file,
+                &spec,
+                source,
+                &points,
+                &measure(&problem, &points),
+            )
         }
     }
 }

@@ -6,7 +6,9 @@ use super::DomainArg;
 use crate::discrepancy::GradientPath;
 use crate::metrics::Summary;
 use crate::optimize::directions::DirectionConfig;
-use crate::optimize::run::{run as run_problem, DirectionProblem, Problem, RunSettings, SquareProblem};
+use crate::optimize::run::{
+    run as run_problem, DirectionProblem, Problem, RunSettings, SquareProblem,
+};
 use crate::optimize::{AnchorSampling, AreaOption, OptimizeConfig, Parameterization};
 use anyhow::{ensure, Context, Result};
 use clap::{Args, ValueEnum};

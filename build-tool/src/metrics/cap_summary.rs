@@ -208,7 +208,10 @@ impl<'a> CapTarget<'a> {
                 refine: 0,
                 ..star_options()
             };
-            let by = MeasuredBy { density, measure: m };
+            let by = MeasuredBy {
+                density,
+                measure: m,
+            };
             cap_star_estimate_with(&one, &by, &random_only, STAR_SEED);
         });
         target

@@ -115,11 +115,7 @@ mod tests {
     use crate::metrics::summary::MetricSummary;
 
     fn m(l2_star: f64, asd: f64, star: f64) -> MetricSummary {
-        MetricSummary {
-            l2_star,
-            asd,
-            star,
-        }
+        MetricSummary { l2_star, asd, star }
     }
 
     #[test]
