@@ -171,11 +171,7 @@ impl Progress {
     /// extrapolates the mean rate so far.
     fn status_line(&self, done: u64) -> String {
         let (context, message) = lock(&self.text).clone();
-        let pct = if self.total == 0 {
-            100
-        } else {
-            100 * done / self.total
-        };
+        let pct = (100 * done).checked_div(self.total).unwrap_or(100);
         let mut line = format!(
             "{}: {} {done}/{} ({pct}%)",
             self.phase, self.unit, self.total

@@ -27,12 +27,15 @@ use std::time::Instant;
 /// Stream of [`derive_seed`] for the baseline sets, apart from the optimized sets'.
 const BASELINE_STREAM: u64 = 0xba5e;
 
+/// Measures one set of square points.
+type Evaluate<'a, M> = Box<dyn Fn(&[DVec2]) -> M + Sync + 'a>;
+
 /// The metrics of square points (directions in their equal-area square) against a
 /// prepared target.
 pub struct Metrics<'a, M> {
     /// How the metrics are computed, for reports.
     pub method: String,
-    evaluate: Box<dyn Fn(&[DVec2]) -> M + Sync + 'a>,
+    evaluate: Evaluate<'a, M>,
 }
 
 impl<M> Metrics<'_, M> {
