@@ -14,5 +14,6 @@ pub mod optimize;
 pub mod output;
 pub mod plot;
 pub mod pointset;
+pub mod progress;
 pub mod seeding;
 pub mod sphere;

@@ -6,7 +6,7 @@ use glam::DVec2;
 use nuld_core::blob::{
     encoded_len, write, BlobKind, Domain, Metadata, PointSetInfo, SectionSpec, SectionTag,
 };
-use nuld_core::quantize::unorm16_encode;
+use nuld_core::quantize::{unorm16_decode_f64, unorm16_encode};
 use std::path::Path;
 
 /// `sets.len()` sets of equally many points, each point in `[0,1]^2`: the point
@@ -83,6 +83,48 @@ impl PointSets {
     pub fn write_blob(&self, path: &Path, meta: &Metadata<'_>) -> Result<()> {
         crate::output::write_atomic(path, self.to_blob(meta)?.as_slice())
     }
+
+    /// The sets as a blob stores them: each coordinate moved to the centre of its
+    /// u16 cell, `unorm16_decode_f64(unorm16_encode(x))` (at most 2^-17 away), which
+    /// is what [`PointSets::from_blob`] reads back from [`PointSets::to_blob`].
+    pub fn quantized(&self) -> PointSets {
+        let cell = |x: f64| unorm16_decode_f64(unorm16_encode(x));
+        PointSets {
+            domain: self.domain,
+            sets: self
+                .sets
+                .iter()
+                .map(|s| s.iter().map(|p| DVec2::new(cell(p.x), cell(p.y))).collect())
+                .collect(),
+        }
+    }
+
+    /// The sets of a parsed blob, decoded exactly in `f64` (directions as their
+    /// square parameterization, the stored form).
+    pub fn from_blob(blob: &nuld_runtime::Blob<'_>) -> Result<PointSets> {
+        let (domain, square) = match blob.kind() {
+            BlobKind::PointSet2D => (Domain::Square, blob.point_set_2d()),
+            BlobKind::DirectionSet => {
+                let dirs = blob.direction_set();
+                (
+                    dirs.as_ref().map_or(Domain::Sphere, |d| d.domain()),
+                    dirs.map(|d| d.square_points()),
+                )
+            }
+        };
+        let square = square.map_err(|e| anyhow::anyhow!("{e}"))?;
+        let decode = |[x, y]: [u16; 2]| DVec2::new(unorm16_decode_f64(x), unorm16_decode_f64(y));
+        Ok(PointSets {
+            domain,
+            sets: (0..square.set_count())
+                .map(|s| {
+                    (0..square.len())
+                        .map(|i| decode(square.raw(s, i)))
+                        .collect()
+                })
+                .collect(),
+        })
+    }
 }
 
 /// A heap byte buffer whose start is 16-byte aligned (backed by `u128`s), as
@@ -124,5 +166,48 @@ impl AlignedBytes {
     /// The bytes, mutably.
     pub fn as_mut_slice(&mut self) -> &mut [u8] {
         &mut bytemuck::cast_slice_mut(&mut self.words)[..self.len]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nuld_runtime::Blob;
+
+    #[test]
+    fn a_blob_reads_back_as_the_quantized_sets() {
+        let meta = Metadata {
+            generator: "test",
+            target: "uniform",
+            seed: 0,
+        };
+        for domain in [Domain::Square, Domain::Sphere, Domain::Hemisphere] {
+            let ps = PointSets {
+                domain,
+                sets: (0..3)
+                    .map(|s| {
+                        (0..5)
+                            .map(|i| DVec2::new(0.17 * i as f64 + 0.01 * s as f64, 0.999_999))
+                            .collect()
+                    })
+                    .collect(),
+            };
+            let bytes = ps.to_blob(&meta).unwrap();
+            let blob = Blob::parse(bytes.as_slice()).unwrap();
+            let read = PointSets::from_blob(&blob).unwrap();
+            let stored = ps.quantized();
+            assert_eq!(read, stored, "{domain:?}");
+            // Within half a u16 cell of the input, and what the runtime decodes.
+            let square = match domain {
+                Domain::Square => blob.point_set_2d().unwrap(),
+                _ => blob.direction_set().unwrap().square_points(),
+            };
+            for (s, set) in stored.sets.iter().enumerate() {
+                for (i, p) in set.iter().enumerate() {
+                    assert!((*p - ps.sets[s][i]).abs().max_element() <= 0.5 / 65536.0);
+                    assert_eq!(*p, square.point(s, i).as_dvec2());
+                }
+            }
+        }
     }
 }

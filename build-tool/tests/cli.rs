@@ -142,6 +142,17 @@ fn optimize_writes_blob_report_and_picture() {
         "{}",
         String::from_utf8_lossy(&st.stderr)
     );
+    // stderr is a pipe here, not a terminal: plain progress lines for both phases
+    // (2 sets x 200 epochs; 2 optimized + 2 starting + 4 baseline sets measured).
+    let log = String::from_utf8_lossy(&st.stderr);
+    for needle in [
+        "optimize: epoch 0/400 (0%)",
+        "optimize: done, 400 epochs in ",
+        "report: set 0/8 (0%)",
+        "report: done, 8 sets in ",
+    ] {
+        assert!(log.contains(needle), "no `{needle}` in\n{log}");
+    }
     let bytes = AlignedBytes::read(&out.join("set.nuld")).unwrap();
     let blob = Blob::parse(bytes.as_slice()).unwrap();
     let pts = blob.point_set_2d().unwrap();
@@ -176,20 +187,64 @@ fn optimize_writes_blob_report_and_picture() {
     names.sort();
     assert_eq!(names, ["report.json", "set.nuld", "set.png"]);
 
-    // `metrics` reads the blob back and agrees with the report's numbers up to
-    // quantization.
+    // `metrics` measures against the target recorded in the blob and prints the
+    // report's numbers exactly: both measure the points as stored.
+    assert_metrics_match_report(&out);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Runs `metrics` on `out/set.nuld` without `--density` and checks that it used
+/// the recorded target and that every per-set value equals the report's `after`.
+fn assert_metrics_match_report(out: &std::path::Path) {
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
     let m = build_tool()
         .arg("metrics")
         .arg(out.join("set.nuld"))
-        .args(["--density", "quarter-disc", "--json"])
+        .arg("--json")
         .output()
         .unwrap();
     assert!(m.status.success(), "{}", String::from_utf8_lossy(&m.stderr));
     let m: serde_json::Value = serde_json::from_slice(&m.stdout).unwrap();
-    let a = m["mean"]["asd"].as_f64().unwrap();
-    let b = report["optimized_mean"]["asd"].as_f64().unwrap();
-    assert!((a - b).abs() < 0.02 * b, "{a} vs {b}");
-    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(m["density"], report["density"]);
+    assert_eq!(m["density_source"], "recorded in the blob");
+    let sets = report["per_set"].as_array().unwrap();
+    assert_eq!(m["per_set"].as_array().unwrap().len(), sets.len());
+    for (s, set) in sets.iter().enumerate() {
+        let after = set["after"].as_object().unwrap();
+        for (key, value) in after {
+            if key.ends_with("stderr") {
+                continue;
+            }
+            assert_eq!(m["per_set"][s][key], *value, "set {s} {key}");
+        }
+    }
+    assert_eq!(m["mean"], report["optimized_mean"]);
+
+    // The table says which target it used; `--density` overrides it.
+    let table = build_tool()
+        .arg("metrics")
+        .arg(out.join("set.nuld"))
+        .output()
+        .unwrap();
+    let text = String::from_utf8(table.stdout).unwrap();
+    let density = report["density"].as_str().unwrap();
+    assert_eq!(
+        text.lines().next(),
+        Some(format!("target: {density} (recorded in the blob)").as_str()),
+        "{text}"
+    );
+    let other = build_tool()
+        .arg("metrics")
+        .arg(out.join("set.nuld"))
+        .args(["--density", "uniform", "--json"])
+        .output()
+        .unwrap();
+    let other: serde_json::Value = serde_json::from_slice(&other.stdout).unwrap();
+    assert_eq!(
+        (&other["density"], &other["density_source"]),
+        (&"uniform".into(), &"--density".into())
+    );
 }
 
 #[test]
@@ -278,6 +333,7 @@ fn optimize_directions_writes_a_direction_blob() {
             png.width() >= 3 * png.height() / 2,
             "three panels side by side"
         );
+        assert_metrics_match_report(&out);
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

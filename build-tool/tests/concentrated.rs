@@ -246,6 +246,7 @@ fn optimized_set_resolves_the_concentration(
     epochs: usize,
 ) {
     use nuld_build_tool::metrics::cap_summary::CapMetricSummary;
+    use nuld_build_tool::metrics::Summary;
     use nuld_build_tool::optimize::directions::{optimize_directions, DirectionConfig};
     let cfg = DirectionConfig {
         epochs,

@@ -2,9 +2,10 @@
 //! the mean of 32 Owen-scrambled Sobol sets (uniform target) and of 32 inverse-CDF
 //! warped Owen-Sobol sets (non-uniform targets) in the exact metrics.
 
-use nuld_build_tool::cli::optimize::warped_owen_sobol;
+use nuld_build_tool::baselines::warped_owen_sobol;
 use nuld_build_tool::density::parse_spec;
 use nuld_build_tool::metrics::summary::{MetricSummary, Target};
+use nuld_build_tool::metrics::Summary;
 use nuld_build_tool::optimize::{optimize, OptimizeConfig};
 use nuld_build_tool::seeding::derive_seed;
 

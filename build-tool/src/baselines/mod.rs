@@ -15,6 +15,8 @@
 //! * [`gaussian_blue_noise`]: Ahmed, Ren, Wonka 2022 Gaussian blue noise.
 //! * [`spherical_fibonacci`]: spherical Fibonacci directions.
 //! * [`warp`]: the warps baselines use for non-uniform targets.
+//! * [`warped_owen_sobol`]: the standard 2D baseline, Owen-Sobol through the
+//!   target's inverse CDF (the optimizer's start).
 //! * [`Baseline`]: an enum over the uniform 2D methods, for evaluation loops.
 
 mod gbn;
@@ -28,6 +30,7 @@ mod sobol_cp;
 mod sot;
 mod spherical_fibonacci;
 pub mod warp;
+mod warped;
 
 pub use gbn::{gaussian_blue_noise, gaussian_blue_noise_energy, GBN_DEFAULT_ITERATIONS};
 pub use halton::scrambled_halton;
@@ -39,6 +42,7 @@ pub use sobol_cp::{sobol_cranley_patterson, sobol_points, SOBOL_CP_MAX_POINTS};
 pub use sot::{sliced_optimal_transport, sliced_wasserstein, SOT_DEFAULT_ITERATIONS};
 pub use spherical_fibonacci::spherical_fibonacci;
 pub use warp::{cosine_hemisphere, hierarchical_warp, warp_inverse_cdf, HierarchicalWarp};
+pub use warped::{seeded_owen_sobol, warped_owen_sobol};
 
 /// The largest `f64` below 1: generators clamp coordinates to `[0, BELOW_ONE]` so that
 /// points stay in `[0,1)^2`.

@@ -1,15 +1,13 @@
 //! `build-tool metrics`: discrepancies of a blob's point or direction sets against a
-//! target. The domain is read from the blob.
+//! target, by default the one recorded in the blob. The domain is read from the blob.
 
-use crate::density::parse_spec;
-use crate::metrics::cap_summary::{CapMetricSummary, CapTarget};
-use crate::metrics::summary::{MetricSummary, Target};
-use crate::pointset::AlignedBytes;
-use crate::sphere::parse_direction_spec;
+use crate::metrics::Summary;
+use crate::optimize::run::{measure, DirectionProblem, Measured, SquareProblem};
+use crate::pointset::{AlignedBytes, PointSets};
 use anyhow::{anyhow, Context, Result};
 use clap::Args;
-use glam::{DVec2, DVec3};
-use nuld_runtime::{Blob, BlobKind, Domain};
+use nuld_core::blob::Domain;
+use nuld_runtime::Blob;
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -19,9 +17,9 @@ pub struct MetricsArgs {
     /// The blob to evaluate.
     pub file: PathBuf,
     /// Target SPEC the points are meant to follow (2D or direction SPEC, matching
-    /// the blob's domain).
-    #[arg(long, default_value = "uniform")]
-    pub density: String,
+    /// the blob's domain). Default: the target recorded in the blob.
+    #[arg(long)]
+    pub density: Option<String>,
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -31,6 +29,8 @@ pub struct MetricsArgs {
 struct MetricsOutput<'a, M: Serialize> {
     file: String,
     density: &'a str,
+    /// `recorded in the blob` or `--density`.
+    density_source: &'static str,
     domain: String,
     n: usize,
     method: String,
@@ -41,92 +41,79 @@ struct MetricsOutput<'a, M: Serialize> {
 /// Runs `build-tool metrics`.
 pub fn run(a: MetricsArgs) -> Result<()> {
     let bytes = AlignedBytes::read(&a.file)?;
-    let blob = Blob::parse(bytes.as_slice()).map_err(|e| anyhow!("{}: {e}", a.file.display()))?;
     let file = a.file.display().to_string();
-    match blob.kind() {
-        BlobKind::PointSet2D => {
-            let density =
-                parse_spec(&a.density).with_context(|| format!("--density {}", a.density))?;
-            let pts = blob.point_set_2d().map_err(|e| anyhow!("{file}: {e}"))?;
-            // The metrics of exactly what a renderer reads: the decoded points.
-            let target = Target::new(density.as_ref());
-            let per_set: Vec<MetricSummary> = (0..pts.set_count())
-                .map(|s| {
-                    let set: Vec<DVec2> =
-                        (0..pts.len()).map(|i| pts.point(s, i).as_dvec2()).collect();
-                    target.evaluate(&set)
-                })
-                .collect();
-            let out = MetricsOutput {
+    let blob = Blob::parse(bytes.as_slice()).map_err(|e| anyhow!("{file}: {e}"))?;
+    // The metrics of exactly what the blob stores, decoded in f64: the same points
+    // `optimize` measured for its report.
+    let points = PointSets::from_blob(&blob).with_context(|| file.clone())?;
+    let (spec, source) = match &a.density {
+        Some(spec) => (spec.clone(), "--density"),
+        None => (blob.metadata().target.to_string(), "recorded in the blob"),
+    };
+    let context = || format!("target {spec} ({source}; --density overrides)");
+    match points.domain {
+        Domain::Square => {
+            let problem = SquareProblem::parse(&spec).with_context(context)?;
+            print(
+                &a,
                 file,
-                density: &a.density,
-                domain: Domain::Square.name().into(),
-                n: pts.len(),
-                method: target.method(),
-                mean: MetricSummary::mean(&per_set),
-                per_set,
-            };
-            if a.json {
-                println!("{}", serde_json::to_string_pretty(&out)?);
-            } else {
-                print_table(&out, &["D2asd", "L2-star", "D*"], |m| {
-                    vec![m.asd, m.l2_star, m.star]
-                });
-            }
+                &spec,
+                source,
+                &points,
+                &measure(&problem, &points),
+            )
         }
-        BlobKind::DirectionSet => {
-            let dirs = blob.direction_set().map_err(|e| anyhow!("{file}: {e}"))?;
-            let density = parse_direction_spec(&a.density, dirs.domain())
-                .with_context(|| format!("--density {}", a.density))?;
-            let target = CapTarget::new(density.as_ref());
-            let per_set: Vec<CapMetricSummary> = (0..dirs.set_count())
-                .map(|s| {
-                    let set: Vec<DVec3> = (0..dirs.len())
-                        .map(|i| dirs.direction(s, i).as_dvec3().normalize())
-                        .collect();
-                    target.evaluate(&set)
-                })
-                .collect();
-            let out = MetricsOutput {
+        domain => {
+            let problem = DirectionProblem::parse(&spec, domain).with_context(context)?;
+            print(
+                &a,
                 file,
-                density: &a.density,
-                domain: dirs.domain().name().into(),
-                n: dirs.len(),
-                method: target.method(),
-                mean: CapMetricSummary::mean(&per_set),
-                per_set,
-            };
-            if a.json {
-                println!("{}", serde_json::to_string_pretty(&out)?);
-            } else {
-                print_table(&out, &["cap L2", "theta-unif", "cap D* >="], |m| {
-                    vec![m.cap_l2, m.cap_l2_theta, m.cap_star_lower_bound]
-                });
-            }
+                &spec,
+                source,
+                &points,
+                &measure(&problem, &points),
+            )
         }
     }
-    Ok(())
 }
 
-fn print_table<M: Serialize>(
-    out: &MetricsOutput<'_, M>,
-    names: &[&str],
-    values: impl Fn(&M) -> Vec<f64>,
-) {
+/// Prints the metrics as JSON or as a table headed by the target used.
+fn print<M: Summary>(
+    a: &MetricsArgs,
+    file: String,
+    spec: &str,
+    source: &'static str,
+    points: &PointSets,
+    measured: &Measured<M>,
+) -> Result<()> {
+    let out = MetricsOutput {
+        file,
+        density: spec,
+        density_source: source,
+        domain: format!("{:?}", points.domain).to_lowercase(),
+        n: points.len(),
+        method: measured.method.clone(),
+        per_set: measured.per_set.clone(),
+        mean: measured.mean,
+    };
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&out)?);
+        return Ok(());
+    }
+    println!("target: {spec} ({source})");
     println!(
-        "{} ({} set(s) x {} points, {}) against {}",
+        "{} ({} set(s) x {} points, {})",
         out.file,
         out.per_set.len(),
         out.n,
-        out.domain,
-        out.density
+        out.domain
     );
     print!("{:>5}", "set");
-    names.iter().for_each(|n| print!(" {n:>12}"));
+    M::LABELS.iter().for_each(|n| print!(" {n:>12}"));
     println!();
     let row = |label: String, m: &M| {
         print!("{label:>5}");
-        values(m).iter().for_each(|v| print!(" {v:>12.5e}"));
+        m.values().iter().for_each(|v| print!(" {v:>12.5e}"));
         println!();
     };
     for (s, m) in out.per_set.iter().enumerate() {
@@ -134,4 +121,5 @@ fn print_table<M: Serialize>(
     }
     row("mean".into(), &out.mean);
     println!("({})", out.method);
+    Ok(())
 }

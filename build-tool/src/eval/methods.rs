@@ -4,6 +4,7 @@
 //! projection to the square for directions), and spherical Fibonacci.
 
 use super::cache::Cache;
+use super::EvalSettings;
 use crate::baselines::{
     gaussian_blue_noise, sliced_optimal_transport, spherical_fibonacci, Baseline, HierarchicalWarp,
     GBN_DEFAULT_ITERATIONS, SOT_DEFAULT_ITERATIONS,
@@ -60,6 +61,18 @@ impl Method {
     /// Whether every realization is the same set (only one is computed).
     pub fn is_deterministic(self) -> bool {
         self == Method::SphericalFibonacci
+    }
+
+    /// Realizations evaluated per N under `s`: one for a deterministic method,
+    /// `s.realizations_ours` for ours, `s.realizations_baseline` otherwise.
+    pub fn realizations(self, s: &EvalSettings) -> usize {
+        if self.is_deterministic() {
+            1
+        } else if self == Method::Ours {
+            s.realizations_ours
+        } else {
+            s.realizations_baseline
+        }
     }
 
     /// Whether the points are optimized against the target itself (ours, SOT,

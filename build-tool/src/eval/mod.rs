@@ -11,8 +11,8 @@
 //!
 //! [`figures`] defines every figure's panels (targets, methods, metrics),
 //! [`runner`] evaluates them with an on-disk [`cache`] of per-realization results
-//! (reruns skip finished work and reproduce the output byte for byte), and
-//! [`report`] writes `figN.csv`, `figN.json`, `figN-<target>-<metric>.png` and
+//! (reruns skip finished work and reproduce the output byte for byte) into
+//! [`rows`], and [`report`] writes `figN.csv`, `figN.json`, `figN-<target>-<metric>.png` and
 //! `figN-summary.md` ([`summary`]: ours against the best other method).
 //! Everything is deterministic given the seeds ([`methods::realization_seed`]).
 
@@ -21,6 +21,7 @@ pub mod figures;
 pub mod integrands;
 pub mod methods;
 pub mod report;
+pub mod rows;
 pub mod runner;
 pub mod stats;
 pub mod summary;

@@ -4,7 +4,7 @@
 use super::cache::sanitize;
 use super::figures::{MetricDef, Panel, Skipped};
 use super::methods::EVAL_SEED;
-use super::runner::realizations;
+use super::rows::{Row, CSV_COLUMNS};
 use super::{EvalSettings, Figure};
 use crate::plot::{render_loglog, Series};
 use anyhow::Result;
@@ -12,38 +12,8 @@ use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// Columns of `figN.csv`, in order.
-pub const CSV_COLUMNS: [&str; 7] = [
-    "target",
-    "metric",
-    "method",
-    "n",
-    "mean",
-    "stderr",
-    "realizations",
-];
-
 /// Size of the plots.
 pub const PLOT_SIZE: (u32, u32) = (1000, 700);
-
-/// One aggregated value: a CSV line.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Row {
-    /// Panel (target or integrand) name.
-    pub target: String,
-    /// Metric key (`l2-star`, `asd`, `star`, `cap-l2`, `cap-star`, `rmse`).
-    pub metric: String,
-    /// Method name.
-    pub method: String,
-    /// Number of points.
-    pub n: usize,
-    /// The aggregate: the mean over realizations, or the RMSE for `rmse`.
-    pub mean: f64,
-    /// Its standard error (0 for one realization).
-    pub stderr: f64,
-    /// Realizations aggregated.
-    pub realizations: usize,
-}
 
 /// A method as the JSON report lists it.
 #[derive(Clone, Debug, Serialize)]
@@ -172,7 +142,7 @@ impl FigureReport {
                         .map(|m| MethodReport {
                             name: m.name().into(),
                             description: m.description(sphere),
-                            realizations: realizations(*m, s),
+                            realizations: m.realizations(s),
                         })
                         .collect(),
                     plots: p

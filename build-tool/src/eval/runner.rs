@@ -8,17 +8,17 @@ use super::methods::{
     method_fingerprint, projected_density, realization_seed, DirectionSampler, Method,
     SquareSampler, SquareWarp,
 };
-use super::report::Row;
+use super::rows::Row;
 use super::{stats, EvalSettings, Figure};
 use crate::baselines::HierarchicalWarp;
 use crate::metrics::summary::{Target, TABULATION_RESOLUTION};
+use crate::progress::Progress;
 use crate::seeding::derive_seed;
 use crate::sphere::{
     cap_l2_mc_squared, cap_l2_uniform, cap_star_estimate_with, CapRadius, CapStarOptions,
     DirectionDensity,
 };
 use anyhow::{anyhow, Result};
-use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
@@ -195,17 +195,6 @@ fn evaluator<'a>(
     })
 }
 
-/// Realizations of `method`: one for deterministic methods.
-pub fn realizations(method: Method, s: &EvalSettings) -> usize {
-    if method.is_deterministic() {
-        1
-    } else if method == Method::Ours {
-        s.realizations_ours
-    } else {
-        s.realizations_baseline
-    }
-}
-
 /// Evaluates `panel` for every method and size, through `cache`, and returns its
 /// rows ordered by metric, then method (panel order), then N.
 pub fn run_panel(
@@ -220,15 +209,13 @@ pub fn run_panel(
     let total: usize = panel
         .methods
         .iter()
-        .map(|m| realizations(*m, s) * sizes.len())
+        .map(|m| m.realizations(s) * sizes.len())
         .sum();
-    let bar = ProgressBar::new(total as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} {prefix} [{bar:30}] {pos}/{len}  {msg}  ETA {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
+    let progress = Progress::stderr(
+        &format!("{figure} {}", panel.target),
+        total as u64,
+        "realization",
     );
-    bar.set_prefix(format!("{figure} {}", panel.target));
     let hits = AtomicUsize::new(0);
     let sphere = matches!(
         panel.kind,
@@ -239,7 +226,7 @@ pub fn run_panel(
     for (mi, &method) in panel.methods.iter().enumerate() {
         let fp = format!("{panel_fp};{}", method_fingerprint(method, epochs));
         for &n in &sizes {
-            bar.set_message(format!("{method} N={n}"));
+            progress.set_context(format!("{method} N={n}"));
             let one = |r: usize| -> Result<Values> {
                 let key = CacheKey {
                     figure: figure.name().into(),
@@ -259,10 +246,10 @@ pub fn run_panel(
                         v
                     }
                 };
-                bar.inc(1);
+                progress.inc(1);
                 Ok(v)
             };
-            let count = realizations(method, s);
+            let count = method.realizations(s);
             let values: Vec<Values> = if method == Method::Ours {
                 (0..count).map(one).collect::<Result<_>>()?
             } else {
@@ -296,13 +283,11 @@ pub fn run_panel(
             }
         }
     }
-    bar.finish_and_clear();
-    eprintln!(
-        "{figure} {}: {total} realizations ({} from the cache) in {:.1} s",
-        panel.target,
+    progress.finish_with(&format!(
+        "{total} realizations ({} from the cache) in {:.1} s",
         hits.load(Ordering::Relaxed),
         started.elapsed().as_secs_f64()
-    );
+    ));
     rows.sort_by_key(|(k, _)| *k);
     Ok(rows.into_iter().map(|(_, r)| r).collect())
 }

@@ -2,7 +2,7 @@
 //! method at the largest N, and at how many N ours is the lowest — the paper's
 //! qualitative claims, checked on the computed rows (`figN-summary.md`).
 
-use super::report::Row;
+use super::rows::Row;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 

@@ -1,6 +1,7 @@
 //! The exact metrics of one point set against one target, as `optimize`,
 //! `metrics` and the reports show them.
 
+use super::aggregate::Summary;
 use crate::density::{CellGrid, Density2D};
 use glam::DVec2;
 use serde::Serialize;
@@ -17,14 +18,28 @@ pub struct MetricSummary {
     pub star: f64,
 }
 
-impl MetricSummary {
-    /// The element-wise mean of several summaries.
-    pub fn mean(items: &[MetricSummary]) -> MetricSummary {
+impl Summary for MetricSummary {
+    const LABELS: &'static [&'static str] = &["D2asd", "L2-star", "D*"];
+
+    fn values(&self) -> Vec<f64> {
+        vec![self.asd, self.l2_star, self.star]
+    }
+
+    fn mean(items: &[MetricSummary]) -> MetricSummary {
         let n = items.len().max(1) as f64;
+        let avg = |f: fn(&MetricSummary) -> f64| items.iter().map(f).sum::<f64>() / n;
         MetricSummary {
-            l2_star: items.iter().map(|m| m.l2_star).sum::<f64>() / n,
-            asd: items.iter().map(|m| m.asd).sum::<f64>() / n,
-            star: items.iter().map(|m| m.star).sum::<f64>() / n,
+            l2_star: avg(|m| m.l2_star),
+            asd: avg(|m| m.asd),
+            star: avg(|m| m.star),
+        }
+    }
+
+    fn ratio(&self, baseline: &MetricSummary) -> MetricSummary {
+        MetricSummary {
+            l2_star: self.l2_star / baseline.l2_star,
+            asd: self.asd / baseline.asd,
+            star: self.star / baseline.star,
         }
     }
 }

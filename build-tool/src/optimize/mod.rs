@@ -5,8 +5,10 @@
 
 pub mod adam;
 pub mod directions;
+pub mod report;
+pub mod run;
 
-use crate::baselines::owen_sobol;
+use crate::baselines::seeded_owen_sobol;
 use crate::density::Density2D;
 use crate::discrepancy::{
     loss_and_gradient, quadrant_measures, residuals, AreaModel, GradientPath,
@@ -114,7 +116,7 @@ pub struct EpochReport {
 /// The initial point set of a run: the first `n` Owen-scrambled Sobol points of the
 /// run's seed, in the parameter space (`u`).
 pub fn initial_parameters(n: usize, seed: u64) -> Vec<DVec2> {
-    owen_sobol(n, derive_seed(seed, 0x1417) as u32)
+    seeded_owen_sobol(n, seed)
 }
 
 /// Maps parameters to points: the identity for [`Parameterization::Direct`], the
