@@ -47,6 +47,9 @@ pub struct RunReport<C, M> {
     pub report_time_s: f64,
     /// How the metrics were computed.
     pub metric_method: String,
+    /// What the user should know about how the target was built from its input
+    /// (e.g. negative pixels of a map set to 0); also printed on stderr.
+    pub notes: Vec<String>,
     /// Per set: the start and the optimized result.
     pub per_set: Vec<SetReport<M>>,
     /// Mean over sets of the optimized metrics.
@@ -80,6 +83,8 @@ pub struct RunInfo<C> {
     pub report_time_s: f64,
     /// How the metrics were computed.
     pub metric_method: String,
+    /// Notes on how the target was built ([`RunReport::notes`]).
+    pub notes: Vec<String>,
 }
 
 impl<C, M: Summary> RunReport<C, M> {
@@ -100,6 +105,7 @@ impl<C, M: Summary> RunReport<C, M> {
             optimize_time_s: info.optimize_time_s,
             report_time_s: info.report_time_s,
             metric_method: info.metric_method,
+            notes: info.notes,
             per_set,
             optimized_mean: optimized,
             baseline_warped_owen_sobol_mean: base,
@@ -129,6 +135,7 @@ mod tests {
             optimize_time_s: 2.0,
             report_time_s: 0.5,
             metric_method: "closed forms".into(),
+            notes: Vec::new(),
         };
         let set = |after| SetReport {
             seed: 0,

@@ -70,6 +70,11 @@ pub trait Problem: Sync {
     fn baseline(&self, n: usize, seed: u64) -> Vec<DVec2>;
     /// The target prepared for measuring sets (tabulated once).
     fn metrics(&self) -> Metrics<'_, Self::Summary>;
+    /// Notes on how the target was built from its input (e.g. negative pixels of a
+    /// map set to 0); none by default.
+    fn notes(&self) -> Vec<String> {
+        Vec::new()
+    }
     /// Draws `points` over the target's density into a PNG at `path`.
     fn render(&self, path: &Path, title: &str, points: &[DVec2]) -> Result<()>;
 }
@@ -154,6 +159,10 @@ impl DirectionProblem {
 impl Problem for DirectionProblem {
     type Config = DirectionConfig;
     type Summary = CapMetricSummary;
+
+    fn notes(&self) -> Vec<String> {
+        self.density.notes()
+    }
 
     fn domain(&self) -> Domain {
         self.density.domain()
@@ -248,6 +257,10 @@ pub fn run<P: Problem>(
         seed,
         baseline_sets,
     } = settings;
+    let notes = problem.notes();
+    for note in &notes {
+        eprintln!("note: {note}");
+    }
     let epochs = P::epochs(config);
     let progress = Progress::stderr("optimize", (sets * epochs) as u64, "epoch");
     let mut optimized = Vec::with_capacity(sets);
@@ -314,6 +327,7 @@ pub fn run<P: Problem>(
         optimize_time_s,
         report_time_s: measuring.elapsed().as_secs_f64(),
         metric_method: metrics.method.clone(),
+        notes,
     };
     Run {
         report: RunReport::new(info, per_set, &measured[2 * sets..]),
