@@ -90,7 +90,7 @@ fn print<M: Summary>(
         file,
         density: spec,
         density_source: source,
-        domain: format!("{:?}", points.domain).to_lowercase(),
+        domain: points.domain.name().into(),
         n: points.len(),
         method: measured.method.clone(),
         per_set: measured.per_set.clone(),

@@ -48,47 +48,47 @@ pub struct OptimizeArgs {
     /// Domain: the unit square, or directions on the sphere or upper hemisphere.
     #[arg(long, value_enum, default_value = "square")]
     pub domain: DomainArg,
-    /// Target SPEC (DESIGN.md §3). Square: `uniform`, `gaussian:MX,MY,S`,
+    /// Target SPEC (grammar: docs/targets.md). Square: `uniform`, `gaussian:MX,MY,S`,
     /// `bilinear:..`, `quarter-disc`, `step-gaussian`, `image:PATH`; sphere and
     /// hemisphere: `uniform`, `cosine`, `brdf:ROUGHNESS,THETA_O_DEG`, `envmap:PATH`.
     /// Default: `gaussian:0.5,0.5,0.15` for the square, `uniform` for directions.
     #[arg(long)]
     pub density: Option<String>,
     /// Points per set.
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = 256, allow_negative_numbers = true, value_parser = super::count)]
     pub n: usize,
     /// Independently seeded sets in the blob.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = super::count)]
     pub sets: usize,
     /// Seed; fixes the output bit for bit whatever the thread count.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Epochs (gradient steps). Default 1000 (square), 5000 (directions).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = super::count)]
     pub epochs: Option<usize>,
     /// Square: anchors per epoch (M; four boxes each). Default 4096.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = super::count)]
     pub anchors: Option<usize>,
     /// Directions: caps per epoch. Default 1024.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = super::count)]
     pub caps: Option<usize>,
     /// How anchors are drawn each epoch.
     #[arg(long, value_enum, default_value = "owen-sobol")]
     pub anchor_sampling: AnchorArg,
     /// Initial Adam step, in units of the point spacing (see README). Default 0.02.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub lr: Option<f64>,
     /// Sigmoid sharpness at the start, in inverse point spacings. Default 8.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub alpha_start: Option<f64>,
     /// Sigmoid sharpness at the end, in inverse point spacings. Default 128.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub alpha_end: Option<f64>,
     /// How box measures are computed.
     #[arg(long, value_enum, default_value = "exact")]
     pub area: AreaArg,
     /// Shared samples per epoch for `--area mc`.
-    #[arg(long, default_value_t = 65536)]
+    #[arg(long, default_value_t = 65536, allow_negative_numbers = true, value_parser = super::count)]
     pub mc_samples: usize,
     /// Parameterization.
     #[arg(long, value_enum, default_value = "inverse-cdf")]
@@ -97,7 +97,7 @@ pub struct OptimizeArgs {
     #[arg(long)]
     pub dense: bool,
     /// Warped Owen-Sobol sets averaged for the baseline in the report.
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = 8, allow_negative_numbers = true, value_parser = super::count)]
     pub baseline_sets: usize,
     /// Output directory: set.nuld, report.json, set.png.
     #[arg(long)]
