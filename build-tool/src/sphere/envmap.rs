@@ -318,6 +318,8 @@ impl EnvmapDensity {
         };
         let row_angle = PI / self.height as f64;
         let mut sum = 0.0;
+        // Integration breakpoints of the current row, reused across rows.
+        let mut cuts: Vec<f64> = Vec::new();
         for r in 0..self.height {
             let rm = self.row_mass(r);
             let dz = self.z_hi[r] - self.z_lo[r];
@@ -350,7 +352,8 @@ impl EnvmapDensity {
                 // Where an arc end crosses an edge of a bright pixel the arc mass
                 // has a strong kink: integrate between those angles, adaptively.
                 let bright = &self.bright_cols[r];
-                let mut cuts = vec![p0, p1];
+                cuts.clear();
+                cuts.extend([p0, p1]);
                 for &c in bright {
                     for edge in [c, c + 1] {
                         let phi_c = TAU * edge as f64 / self.width as f64;
