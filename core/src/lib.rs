@@ -11,6 +11,8 @@
 //! * [`warp`]: the warps baselines sample with (concentric disk, cosine hemisphere,
 //!   GGX visible normals), each beside its density and its inverse;
 //! * [`domain`]: where a set's points live and the map from square to direction;
+//! * [`network`]: the conditional sampler's network (features, forward pass), one
+//!   formula for the trainer and the runtime;
 //! * [`quantize`]: the u16 unorm and f16 codecs blobs store values with;
 //! * [`blob`]: the byte layout of a `.nuld` blob (format v1): header, section table,
 //!   checksum, metadata, and a writer that fills a caller-provided buffer.
@@ -31,6 +33,7 @@
 pub mod blob;
 pub mod brdf;
 pub mod domain;
+pub mod network;
 pub mod quantize;
 pub mod real;
 pub mod sphere;

@@ -48,6 +48,8 @@ pub trait Real:
     fn sin(self) -> Self;
     /// Rounded towards negative infinity.
     fn floor(self) -> Self;
+    /// `e^self`.
+    fn exp(self) -> Self;
     /// The value as `f64` (exact).
     fn to_f64(self) -> f64;
 }
@@ -95,6 +97,10 @@ impl Real for f64 {
     #[inline]
     fn floor(self) -> Self {
         libm::floor(self)
+    }
+    #[inline]
+    fn exp(self) -> Self {
+        libm::exp(self)
     }
     #[inline]
     fn to_f64(self) -> f64 {
@@ -145,6 +151,10 @@ impl Real for f32 {
     #[inline]
     fn floor(self) -> Self {
         libm::floorf(self)
+    }
+    #[inline]
+    fn exp(self) -> Self {
+        libm::expf(self)
     }
     #[inline]
     fn to_f64(self) -> f64 {

@@ -1,0 +1,501 @@
+//! The conditional sampler's network (paper §4), written once for the trainer
+//! (`f64`) and the runtime (`f32`, the precision a shader reproduces).
+//!
+//! Point `i` of instance `k` of the set for condition `c` is
+//!
+//! ```text
+//! x_i(c, k) = M( sigmoid( g(i, features(c, k, i)) ) )
+//! ```
+//!
+//! * `features` ([`input_features`], [`INPUTS`] numbers): five polynomial features of
+//!   the condition normalized to `[0,1]^2` ([`condition_features`]), the instance's
+//!   pseudo-random offset `z_k` ([`instance_offset`]), and the rank-1 lattice point
+//!   `l_i = (i/N, frac(i g / N))` shifted by `z_k` on the torus, through triangle
+//!   waves that are continuous across the torus' seams ([`lattice_features`]). The
+//!   shifted lattice makes every instance a different set by construction; the
+//!   network warps it toward the target.
+//! * `g` ([`Network::forward`]): a multilayer perceptron. Its first hidden layer adds
+//!   a learned per-index vector `E[i]` (the paper's per-index embedding `e_i`,
+//!   composed with the first layer's weights: an `H`-wide bias per index costs no
+//!   multiply at run time). Hidden activations are [`Activation::Relu`] or
+//!   [`Activation::Silu`]; the output layer has two linear units.
+//! * `sigmoid` maps the two outputs onto the open unit square; `M` is the domain's
+//!   equal-area map (for BRDF samplers the hemisphere map of
+//!   [`crate::sphere::square_to_hemisphere`]).
+//!
+//! Parameters are one flat array in this order ([`Shape::param_len`]):
+//!
+//! ```text
+//! E        n x h1          per-index bias of the first hidden layer, row i = index i
+//! W1, b1   h1 x INPUTS, h1 first hidden layer, row-major by output unit
+//! Wl, bl   hl x h(l-1), hl further hidden layers l = 2..=L
+//! Wo, bo   2 x hL, 2       output layer
+//! ```
+//!
+//! Everything here is `O(1)` in the number of points, allocation-free and total:
+//! indices wrap modulo `n`, and a shape that does not fit [`MAX_WIDTH`] /
+//! [`MAX_HIDDEN_LAYERS`] is rejected by [`Shape::new`].
+
+use crate::real::Real;
+
+/// Number of input features of the network: 5 of the condition, 2 of the instance
+/// offset, 4 of the shifted lattice point.
+pub const INPUTS: usize = CONDITION_FEATURES + 2 + 4;
+
+/// Number of condition features ([`condition_features`]).
+pub const CONDITION_FEATURES: usize = 5;
+
+/// Largest hidden width a [`Shape`] may have.
+pub const MAX_WIDTH: usize = 128;
+
+/// Largest number of hidden layers a [`Shape`] may have.
+pub const MAX_HIDDEN_LAYERS: usize = 3;
+
+/// Number of network outputs (a point of the unit square, before the sigmoid).
+pub const OUTPUTS: usize = 2;
+
+/// The hidden layers' nonlinearity.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum Activation {
+    /// `max(0, x)`: no transcendental per unit, the cheapest at run time.
+    Relu = 0,
+    /// `x sigmoid(x)` (SiLU / swish): smooth, one `exp` per unit.
+    Silu = 1,
+}
+
+impl Activation {
+    /// The activation with this code, if any.
+    pub fn from_code(code: u32) -> Option<Self> {
+        match code {
+            0 => Some(Self::Relu),
+            1 => Some(Self::Silu),
+            _ => None,
+        }
+    }
+
+    /// `act(x)`.
+    #[inline]
+    pub fn apply<T: Real>(self, x: T) -> T {
+        match self {
+            Self::Relu => x.max(T::ZERO),
+            Self::Silu => x * sigmoid(x),
+        }
+    }
+
+    /// `d act / dx` at `x` (for `Relu`, 0 at `x <= 0`).
+    #[inline]
+    pub fn derivative<T: Real>(self, x: T) -> T {
+        match self {
+            Self::Relu => {
+                if x > T::ZERO {
+                    T::ONE
+                } else {
+                    T::ZERO
+                }
+            }
+            Self::Silu => {
+                let s = sigmoid(x);
+                s * (T::ONE + x * (T::ONE - s))
+            }
+        }
+    }
+}
+
+/// The logistic function `1 / (1 + exp(-x))`, in `(0,1)` for finite `x` (saturating
+/// to exactly 0 or 1 only beyond the type's range).
+#[inline]
+pub fn sigmoid<T: Real>(x: T) -> T {
+    T::ONE / (T::ONE + (-x).exp())
+}
+
+/// The architecture of a network: points per set, hidden widths, activation, and the
+/// rank-1 lattice generator of its input.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shape {
+    n: u32,
+    hidden: [u32; MAX_HIDDEN_LAYERS],
+    layers: u32,
+    activation: Activation,
+    lattice_generator: u32,
+}
+
+impl Shape {
+    /// A shape with `n >= 1` points per set, `hidden.len()` in
+    /// `1..=MAX_HIDDEN_LAYERS` hidden layers of widths in `1..=MAX_WIDTH`, and the
+    /// lattice generator `g` (any value; `g` coprime to `n` makes the lattice's second
+    /// coordinate a permutation). `None` if a count is out of range.
+    pub fn new(
+        n: u32,
+        hidden: &[u32],
+        activation: Activation,
+        lattice_generator: u32,
+    ) -> Option<Self> {
+        if n == 0 || hidden.is_empty() || hidden.len() > MAX_HIDDEN_LAYERS {
+            return None;
+        }
+        let mut widths = [0u32; MAX_HIDDEN_LAYERS];
+        for (w, &h) in widths.iter_mut().zip(hidden) {
+            if h == 0 || h as usize > MAX_WIDTH {
+                return None;
+            }
+            *w = h;
+        }
+        Some(Self {
+            n,
+            hidden: widths,
+            layers: hidden.len() as u32,
+            activation,
+            lattice_generator,
+        })
+    }
+
+    /// Points per set `n` (the number of per-index rows of `E`).
+    pub fn n(&self) -> u32 {
+        self.n
+    }
+
+    /// The hidden widths, first layer first.
+    pub fn hidden(&self) -> &[u32] {
+        &self.hidden[..self.layers as usize]
+    }
+
+    /// The hidden layers' nonlinearity.
+    pub fn activation(&self) -> Activation {
+        self.activation
+    }
+
+    /// The rank-1 lattice generator `g` of [`lattice_point`].
+    pub fn lattice_generator(&self) -> u32 {
+        self.lattice_generator
+    }
+
+    /// Number of parameters: `n h1 + sum over layers (out in + out)` with the input
+    /// layer of width [`INPUTS`] and the output layer of width [`OUTPUTS`].
+    pub fn param_len(&self) -> usize {
+        let hidden = self.hidden();
+        let mut len = self.n as usize * hidden[0] as usize;
+        let mut fan_in = INPUTS;
+        for &h in hidden {
+            len += h as usize * (fan_in + 1);
+            fan_in = h as usize;
+        }
+        len + OUTPUTS * (fan_in + 1)
+    }
+
+    /// Multiply-adds of one forward pass (the run-time cost of a network sample,
+    /// besides the activations and the map).
+    pub fn multiply_adds(&self) -> usize {
+        self.param_len() - self.n as usize * self.hidden[0] as usize
+    }
+
+    /// Offset of the per-index row `E[i mod n]` in the parameter array.
+    #[inline]
+    pub fn embedding_offset(&self, i: u32) -> usize {
+        (i % self.n) as usize * self.hidden[0] as usize
+    }
+
+    /// Offset of the first hidden layer's weights (its biases follow the weights).
+    pub fn first_layer_offset(&self) -> usize {
+        self.n as usize * self.hidden[0] as usize
+    }
+}
+
+/// The values a forward pass went through, which a backward pass needs: the
+/// inputs, every hidden layer's pre-activations, and the two outputs before the
+/// sigmoid. Fixed-size storage: no allocation.
+#[derive(Clone, Copy, Debug)]
+pub struct Trace<T> {
+    /// The input features.
+    pub input: [T; INPUTS],
+    /// Pre-activations `z_l` of hidden layer `l` (the first `width_l` entries).
+    pub pre: [[T; MAX_WIDTH]; MAX_HIDDEN_LAYERS],
+    /// The outputs before the sigmoid.
+    pub output: [T; OUTPUTS],
+}
+
+impl<T: Real> Trace<T> {
+    /// The point of the unit square: `sigmoid` of each output.
+    #[inline]
+    pub fn square_point(&self) -> [T; 2] {
+        [sigmoid(self.output[0]), sigmoid(self.output[1])]
+    }
+}
+
+/// A network: a [`Shape`] and a way to read parameter `j` as `T` (an `f64` slice in
+/// the trainer, f16 bits decoded to `f32` in the runtime).
+#[derive(Clone, Copy, Debug)]
+pub struct Network<W> {
+    /// The architecture.
+    pub shape: Shape,
+    /// Parameter `j` of the flat layout in the module documentation.
+    pub params: W,
+}
+
+impl<W> Network<W> {
+    /// Evaluates the network for index `i` (taken modulo `n`) on `input`
+    /// ([`input_features`]). `params(j)` must be defined for `j < param_len()`;
+    /// `O(multiply_adds)`, no allocation.
+    #[inline]
+    pub fn forward<T: Real>(&self, i: u32, input: [T; INPUTS]) -> Trace<T>
+    where
+        W: Fn(usize) -> T,
+    {
+        let shape = &self.shape;
+        let w = &self.params;
+        let act = shape.activation;
+        let mut trace = Trace {
+            input,
+            pre: [[T::ZERO; MAX_WIDTH]; MAX_HIDDEN_LAYERS],
+            output: [T::ZERO; OUTPUTS],
+        };
+        let mut a = [T::ZERO; MAX_WIDTH];
+        a[..INPUTS].copy_from_slice(&input);
+        let mut fan_in = INPUTS;
+        let mut off = shape.first_layer_offset();
+        for (l, &h) in shape.hidden().iter().enumerate() {
+            let h = h as usize;
+            let bias = off + h * fan_in;
+            let mut next = [T::ZERO; MAX_WIDTH];
+            for (o, slot) in next.iter_mut().enumerate().take(h) {
+                let row = off + o * fan_in;
+                let mut acc = w(bias + o);
+                if l == 0 {
+                    acc = acc + w(shape.embedding_offset(i) + o);
+                }
+                for (k, &x) in a.iter().enumerate().take(fan_in) {
+                    acc = acc + w(row + k) * x;
+                }
+                trace.pre[l][o] = acc;
+                *slot = act.apply(acc);
+            }
+            a = next;
+            off = bias + h;
+            fan_in = h;
+        }
+        let bias = off + OUTPUTS * fan_in;
+        for o in 0..OUTPUTS {
+            let row = off + o * fan_in;
+            let mut acc = w(bias + o);
+            for (k, &x) in a.iter().enumerate().take(fan_in) {
+                acc = acc + w(row + k) * x;
+            }
+            trace.output[o] = acc;
+        }
+        trace
+    }
+}
+
+/// The five features of a condition `c` normalized to `[0,1]^2` (each coordinate
+/// clamped there first; NaN counts as 0): `(u, v, u v, u^2, v^2)` mapped to `[-1,1]`
+/// by `2x - 1`. Polynomial so that neither side needs a transcendental per sample.
+#[inline]
+pub fn condition_features<T: Real>(c: [T; 2]) -> [T; CONDITION_FEATURES] {
+    let unit = |x: T| {
+        if x.is_nan() {
+            T::ZERO
+        } else {
+            x.max(T::ZERO).min(T::ONE)
+        }
+    };
+    let (u, v) = (unit(c[0]), unit(c[1]));
+    let two = T::of(2.0);
+    [u, v, u * v, u * u, v * v].map(|x| two * x - T::ONE)
+}
+
+/// `lowbias32` (C. Wellons' integer hash): a bijection of `u32` with good avalanche,
+/// cheap in a shader.
+#[inline]
+pub fn hash_u32(mut x: u32) -> u32 {
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^= x >> 16;
+    x
+}
+
+/// The pseudo-random offset `z_k` in `[0,1)^2` of instance `k`: the top 24 bits of
+/// `hash_u32(2k)` and `hash_u32(2k + 1)` (wrapping) times `2^-24`, exact in `f32`
+/// and `f64`. Every `u32` is an instance.
+#[inline]
+pub fn instance_offset<T: Real>(k: u32) -> [T; 2] {
+    let unit = |h: u32| T::of((h >> 8) as f64 * (1.0 / 16_777_216.0));
+    let k2 = k.wrapping_mul(2);
+    [unit(hash_u32(k2)), unit(hash_u32(k2.wrapping_add(1)))]
+}
+
+/// Point `i mod n` of the rank-1 lattice with generator `g`:
+/// `(i / n, ((i g) mod n) / n)`, in `[0,1)^2`.
+#[inline]
+pub fn lattice_point<T: Real>(i: u32, n: u32, g: u32) -> [T; 2] {
+    let n = n.max(1);
+    let i = i % n;
+    let j = ((i as u64 * g as u64) % n as u64) as u32;
+    let nf = T::of(n as f64);
+    [T::of(i as f64) / nf, T::of(j as f64) / nf]
+}
+
+/// The lattice point shifted by `z` on the torus: `frac(l + z)`, in `[0,1)^2`.
+#[inline]
+pub fn shifted_lattice_point<T: Real>(i: u32, n: u32, g: u32, z: [T; 2]) -> [T; 2] {
+    let l = lattice_point::<T>(i, n, g);
+    let frac = |x: T| x - x.floor();
+    [frac(l[0] + z[0]), frac(l[1] + z[1])]
+}
+
+/// Triangle-wave features of a torus point `u`: per coordinate `tri(x)` and
+/// `tri(x + 1/4)` with `tri(x) = 4 |frac(x) - 1/2| - 1`, in `[-1,1]`. Continuous
+/// across the seams, and the pair identifies the position on the circle (the
+/// piecewise-linear analogue of `(cos, sin)`, without a transcendental).
+#[inline]
+pub fn lattice_features<T: Real>(u: [T; 2]) -> [T; 4] {
+    let half = T::of(0.5);
+    let quarter = T::of(0.25);
+    let four = T::of(4.0);
+    let tri = |x: T| four * (x - x.floor() - half).abs() - T::ONE;
+    [
+        tri(u[0]),
+        tri(u[0] + quarter),
+        tri(u[1]),
+        tri(u[1] + quarter),
+    ]
+}
+
+/// The network input of index `i`, instance `k`, normalized condition `c` (in
+/// `[0,1]^2`): `[condition_features(c), 2 z_k - 1, lattice_features(shifted
+/// lattice point)]`.
+#[inline]
+pub fn input_features<T: Real>(shape: &Shape, c: [T; 2], k: u32, i: u32) -> [T; INPUTS] {
+    let z = instance_offset::<T>(k);
+    let u = shifted_lattice_point(i, shape.n, shape.lattice_generator, z);
+    let cf = condition_features(c);
+    let lf = lattice_features(u);
+    let two = T::of(2.0);
+    [
+        cf[0],
+        cf[1],
+        cf[2],
+        cf[3],
+        cf[4],
+        two * z[0] - T::ONE,
+        two * z[1] - T::ONE,
+        lf[0],
+        lf[1],
+        lf[2],
+        lf[3],
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn shape(act: Activation) -> Shape {
+        Shape::new(4, &[3, 2], act, 3).unwrap()
+    }
+
+    #[test]
+    fn param_len_counts_every_matrix_and_bias() {
+        let s = shape(Activation::Relu);
+        // E 4x3, W1 3x11 + 3, W2 2x3 + 2, Wo 2x2 + 2.
+        assert_eq!(s.param_len(), 12 + 36 + 8 + 6);
+        assert_eq!(s.multiply_adds(), 36 + 8 + 6);
+        assert!(Shape::new(0, &[3], Activation::Relu, 1).is_none());
+        assert!(Shape::new(4, &[], Activation::Relu, 1).is_none());
+        assert!(Shape::new(4, &[129], Activation::Relu, 1).is_none());
+        assert!(Shape::new(4, &[1, 1, 1, 1], Activation::Relu, 1).is_none());
+    }
+
+    /// The forward pass against the same network written out as explicit matrix
+    /// products.
+    #[test]
+    fn forward_equals_explicit_matrix_products() {
+        for act in [Activation::Relu, Activation::Silu] {
+            let s = shape(act);
+            let p: [f64; 62] = core::array::from_fn(|j| ((j * 37 % 23) as f64 - 11.0) / 9.0);
+            let net = Network {
+                shape: s,
+                params: |j: usize| p[j],
+            };
+            let x: [f64; INPUTS] = core::array::from_fn(|k| (k as f64 - 5.0) / 7.0);
+            let i = 6; // wraps to row 2 of E
+            let t = net.forward(i, x);
+            let (e, w1, b1) = (&p[6..9], &p[12..45], &p[45..48]);
+            let h1: [f64; 3] = core::array::from_fn(|o| {
+                b1[o] + e[o] + (0..INPUTS).map(|k| w1[o * INPUTS + k] * x[k]).sum::<f64>()
+            });
+            let (w2, b2) = (&p[48..54], &p[54..56]);
+            let a1 = h1.map(|z| act.apply(z));
+            let h2: [f64; 2] = core::array::from_fn(|o| {
+                b2[o] + (0..3).map(|k| w2[o * 3 + k] * a1[k]).sum::<f64>()
+            });
+            let a2 = h2.map(|z| act.apply(z));
+            let (wo, bo) = (&p[56..60], &p[60..62]);
+            let out: [f64; 2] = core::array::from_fn(|o| {
+                bo[o] + (0..2).map(|k| wo[o * 2 + k] * a2[k]).sum::<f64>()
+            });
+            let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-14);
+            assert!(close(&t.pre[0][..3], &h1));
+            assert!(close(&t.pre[1][..2], &h2));
+            assert!(close(&t.output, &out));
+        }
+    }
+
+    #[test]
+    fn activation_derivatives_match_finite_differences() {
+        for act in [Activation::Relu, Activation::Silu] {
+            for x in [-3.0, -0.7, 0.4, 2.5] {
+                let h = 1e-6;
+                let fd = (act.apply(x + h) - act.apply(x - h)) / (2.0 * h);
+                assert!((act.derivative(x) - fd).abs() < 1e-8, "{act:?} {x}");
+            }
+        }
+    }
+
+    #[test]
+    fn instance_offsets_are_exact_in_both_precisions_and_distinct() {
+        for k in [0u32, 1, 2, 77, u32::MAX] {
+            let a = instance_offset::<f32>(k);
+            let b = instance_offset::<f64>(k);
+            assert_eq!(a[0] as f64, b[0]);
+            assert_eq!(a[1] as f64, b[1]);
+            assert!(b.iter().all(|&z| (0.0..1.0).contains(&z)));
+        }
+        assert_ne!(instance_offset::<f64>(0), instance_offset::<f64>(1));
+        // Values of an independent Python implementation of lowbias32.
+        assert_eq!(hash_u32(1), 0x6889_90c0);
+        assert_eq!(hash_u32(0x1234_5678), 0xf5e7_1c96);
+    }
+
+    #[test]
+    fn lattice_is_a_permutation_and_shift_wraps() {
+        let (n, g) = (8u32, 3u32);
+        let mut seen = [false; 8];
+        for i in 0..n {
+            let p = lattice_point::<f64>(i, n, g);
+            assert_eq!(p[0], i as f64 / 8.0);
+            seen[(p[1] * 8.0) as usize] = true;
+        }
+        assert!(seen.iter().all(|&s| s));
+        let u = shifted_lattice_point::<f64>(7, n, g, [0.5, 0.9]);
+        assert!((u[0] - 0.375).abs() < 1e-15 && (u[1] - (5.0 / 8.0 + 0.9 - 1.0)).abs() < 1e-15);
+        assert_eq!(lattice_point::<f64>(9, n, g), lattice_point::<f64>(1, n, g));
+    }
+
+    #[test]
+    fn lattice_features_are_continuous_on_the_torus() {
+        let a = lattice_features::<f64>([1.0 - 1e-12, 0.3]);
+        let b = lattice_features::<f64>([0.0, 0.3]);
+        assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-9));
+        assert_eq!(lattice_features::<f64>([0.5, 0.25]), [-1.0, 0.0, 0.0, -1.0]);
+    }
+
+    #[test]
+    fn condition_features_clamp_and_reject_nan() {
+        let f = condition_features::<f64>([f64::NAN, 2.0]);
+        assert_eq!(f, [-1.0, 1.0, -1.0, -1.0, 1.0]);
+        let g = condition_features::<f32>([0.5, 0.25]);
+        assert_eq!(g, [0.0, -0.5, -0.75, -0.5, -0.875]);
+    }
+}
