@@ -11,6 +11,8 @@
 //! * [`warp`]: the warps baselines sample with (concentric disk, cosine hemisphere,
 //!   GGX visible normals), each beside its density and its inverse;
 //! * [`domain`]: where a set's points live and the map from square to direction;
+//! * [`conditional`]: the conditional sampler's info record, condition grid and
+//!   bilinear interpolation (blob kind 3);
 //! * [`network`]: the conditional sampler's network (features, forward pass), one
 //!   formula for the trainer and the runtime;
 //! * [`quantize`]: the u16 unorm and f16 codecs blobs store values with;
@@ -32,6 +34,7 @@
 
 pub mod blob;
 pub mod brdf;
+pub mod conditional;
 pub mod domain;
 pub mod network;
 pub mod quantize;

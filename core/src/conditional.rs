@@ -1,0 +1,310 @@
+//! The conditional sampler's blob contents (kind 3, paper §4): the info record, the
+//! condition grid, and the interpolation arithmetic that the build tool's tables
+//! and every reader (the runtime, shaders) must share.
+//!
+//! A conditional blob serves, for a condition `c` (for BRDF samplers
+//! `c = (roughness, theta_o in degrees)`), an instance `k` and an index `i < n`, a
+//! direction and the estimator weight. Two ways:
+//!
+//! * **network mode**: [`crate::network`] evaluated on the f16 parameters;
+//! * **table mode**: the network's square points on a regular grid of conditions,
+//!   for instances `0..instances`, interpolated bilinearly in the square between the
+//!   four grid nodes around `c` ([`GridCell`]), then mapped to the domain.
+//!
+//! The weight is the target's normalization (for BRDFs the directional albedo
+//! `A(c)`) interpolated bilinearly on its own grid.
+//!
+//! Conditions are clamped into `[cond_min, cond_max]` per axis (NaN reads as
+//! `cond_min`), then normalized to `[0,1]^2` ([`ConditionalInfo::normalize`]); the
+//! network's condition input is that normalized point.
+
+use crate::network::{Activation, Shape, MAX_HIDDEN_LAYERS};
+use bytemuck::{Pod, Zeroable};
+
+/// What a conditional blob's condition means.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum ConditionalTarget {
+    /// The glTF 2.0 BRDF (`crate::brdf`): condition `(roughness, theta_o in
+    /// degrees)`, view in the xz-plane on the `+x` side, directions on the upper
+    /// hemisphere, weight = directional albedo.
+    GltfBrdf = 1,
+}
+
+impl ConditionalTarget {
+    /// The target with this code, if any.
+    pub fn from_code(code: u32) -> Option<Self> {
+        match code {
+            1 => Some(Self::GltfBrdf),
+            _ => None,
+        }
+    }
+}
+
+/// Contents of the conditional info section (80 bytes, `#[repr(C)]`,
+/// little-endian). Byte offsets in `core/FORMAT.md`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct ConditionalInfo {
+    /// Points per set `n >= 1`.
+    pub n: u32,
+    /// Instances stored in the point table `S >= 1` (network mode serves any).
+    pub instances: u32,
+    /// A [`crate::domain::Domain`] code (2 = hemisphere for BRDF samplers).
+    pub domain: u32,
+    /// A [`ConditionalTarget`] code.
+    pub target: u32,
+    /// Point-table grid nodes per condition axis, each `>= 2`.
+    pub grid: [u32; 2],
+    /// Weight-table grid nodes per condition axis, each `>= 2`.
+    pub weight_grid: [u32; 2],
+    /// Lower end of each condition axis (blob units), finite.
+    pub cond_min: [f32; 2],
+    /// Upper end of each condition axis, finite and `> cond_min`.
+    pub cond_max: [f32; 2],
+    /// Hidden widths of the network, first layer first; unused trailing entries 0.
+    pub hidden: [u32; MAX_HIDDEN_LAYERS],
+    /// An [`Activation`] code.
+    pub activation: u32,
+    /// The rank-1 lattice generator of the network's input.
+    pub lattice_generator: u32,
+    /// Reserved, zero.
+    pub reserved: [u32; 3],
+}
+
+/// Size of [`ConditionalInfo`] in bytes.
+pub const CONDITIONAL_INFO_LEN: usize = core::mem::size_of::<ConditionalInfo>();
+
+const _: () = assert!(CONDITIONAL_INFO_LEN == 80);
+
+/// Where a normalized condition falls on an axis of `nodes >= 2` grid nodes: the
+/// lower node `j0` (the upper one is `j0 + 1`) and the fraction `t` in `[0,1]`
+/// between them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AxisCell {
+    /// The lower node, in `0..nodes - 1`.
+    pub j0: u32,
+    /// Position between node `j0` (0) and `j0 + 1` (1).
+    pub t: f32,
+}
+
+impl AxisCell {
+    /// The cell of `u` in `[0,1]` on an axis with `nodes` nodes at
+    /// `j / (nodes - 1)`: `s = u (nodes - 1)`, `j0 = min(floor(s), nodes - 2)`,
+    /// `t = s - j0`. Total: `u` outside `[0,1]` or NaN is clamped (NaN to 0), and
+    /// `nodes < 2` gives `j0 = 0, t = 0`.
+    #[inline]
+    pub fn locate(u: f32, nodes: u32) -> Self {
+        if nodes < 2 {
+            return Self { j0: 0, t: 0.0 };
+        }
+        let u = if u.is_nan() { 0.0 } else { u.clamp(0.0, 1.0) };
+        let s = u * (nodes - 1) as f32;
+        // `s` is in [0, nodes - 1]; the cast truncates (= floor for s >= 0).
+        let j0 = (s as u32).min(nodes - 2);
+        Self {
+            j0,
+            t: s - j0 as f32,
+        }
+    }
+}
+
+/// The four grid nodes around a condition and their bilinear weights.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridCell {
+    /// Cell along each axis.
+    pub axes: [AxisCell; 2],
+    /// Nodes per axis.
+    pub nodes: [u32; 2],
+}
+
+impl GridCell {
+    /// The cell of the normalized condition `u` on a grid of `nodes[0] x nodes[1]`.
+    #[inline]
+    pub fn locate(u: [f32; 2], nodes: [u32; 2]) -> Self {
+        Self {
+            axes: [
+                AxisCell::locate(u[0], nodes[0]),
+                AxisCell::locate(u[1], nodes[1]),
+            ],
+            nodes,
+        }
+    }
+
+    /// Linear index `j1 * nodes[0] + j0` of corner `(dx, dy)` (each 0 or 1): axis 0
+    /// varies fastest.
+    #[inline]
+    pub fn node(&self, dx: u32, dy: u32) -> usize {
+        let j0 = (self.axes[0].j0 + dx) as usize;
+        let j1 = (self.axes[1].j0 + dy) as usize;
+        j1 * self.nodes[0] as usize + j0
+    }
+
+    /// Bilinear interpolation of the corner values `v00, v10, v01, v11` (`vXY`: X
+    /// along axis 0) in this exact order of operations, which readers reproduce
+    /// bit for bit: `a = v00 + (v10 - v00) t0`, `b = v01 + (v11 - v01) t0`,
+    /// `a + (b - a) t1`.
+    #[inline]
+    pub fn lerp(&self, v00: f32, v10: f32, v01: f32, v11: f32) -> f32 {
+        let (t0, t1) = (self.axes[0].t, self.axes[1].t);
+        let a = v00 + (v10 - v00) * t0;
+        let b = v01 + (v11 - v01) * t0;
+        a + (b - a) * t1
+    }
+}
+
+impl ConditionalInfo {
+    /// The normalized condition in `[0,1]^2`: each axis clamped into
+    /// `[cond_min, cond_max]` (NaN to `cond_min`), then
+    /// `(c - cond_min) / (cond_max - cond_min)`.
+    #[inline]
+    pub fn normalize(&self, c: [f32; 2]) -> [f32; 2] {
+        core::array::from_fn(|a| {
+            let (lo, hi) = (self.cond_min[a], self.cond_max[a]);
+            let x = if c[a].is_nan() {
+                lo
+            } else {
+                c[a].clamp(lo, hi)
+            };
+            let u = (x - lo) / (hi - lo);
+            if u.is_finite() {
+                u.clamp(0.0, 1.0)
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// The condition (blob units) of point-table node `(j0, j1)`:
+    /// `cond_min + j / (grid - 1) (cond_max - cond_min)` per axis, in `f64` (the
+    /// tool evaluates the network there).
+    pub fn grid_condition(&self, j: [u32; 2]) -> [f64; 2] {
+        node_condition(self, self.grid, j)
+    }
+
+    /// The condition of weight-table node `(j0, j1)`, as [`Self::grid_condition`].
+    pub fn weight_grid_condition(&self, j: [u32; 2]) -> [f64; 2] {
+        node_condition(self, self.weight_grid, j)
+    }
+
+    /// The network architecture the info describes, if its counts are valid.
+    pub fn shape(&self) -> Option<Shape> {
+        let layers = self.hidden.iter().take_while(|&&h| h != 0).count();
+        if self.hidden[layers..].iter().any(|&h| h != 0) {
+            return None;
+        }
+        let act = Activation::from_code(self.activation)?;
+        Shape::new(self.n, &self.hidden[..layers], act, self.lattice_generator)
+    }
+
+    /// Number of `u32` entries of the point table:
+    /// `grid[0] grid[1] instances n`, or `None` on overflow.
+    pub fn point_table_len(&self) -> Option<u64> {
+        (self.grid[0] as u64)
+            .checked_mul(self.grid[1] as u64)?
+            .checked_mul(self.instances as u64)?
+            .checked_mul(self.n as u64)
+    }
+
+    /// Number of `f32` entries of the weight table: `weight_grid[0] weight_grid[1]`.
+    pub fn weight_table_len(&self) -> u64 {
+        self.weight_grid[0] as u64 * self.weight_grid[1] as u64
+    }
+
+    /// Index of `(node, instance, index)` in the point table: layout
+    /// `[node][instance][index]`.
+    #[inline]
+    pub fn point_table_index(&self, node: usize, instance: u32, i: u32) -> usize {
+        (node * self.instances as usize + instance as usize) * self.n as usize + i as usize
+    }
+}
+
+fn node_condition(info: &ConditionalInfo, nodes: [u32; 2], j: [u32; 2]) -> [f64; 2] {
+    core::array::from_fn(|a| {
+        let (lo, hi) = (info.cond_min[a] as f64, info.cond_max[a] as f64);
+        let steps = (nodes[a].max(2) - 1) as f64;
+        lo + (j[a] as f64 / steps) * (hi - lo)
+    })
+}
+
+/// Packs a square point's u16 unorm codes as one table entry: `x | y << 16`.
+#[inline]
+pub fn pack_point(qx: u16, qy: u16) -> u32 {
+    qx as u32 | (qy as u32) << 16
+}
+
+/// Unpacks a table entry into its u16 unorm codes `(w & 0xffff, w >> 16)`.
+#[inline]
+pub fn unpack_point(w: u32) -> [u16; 2] {
+    [(w & 0xffff) as u16, (w >> 16) as u16]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn info() -> ConditionalInfo {
+        ConditionalInfo {
+            n: 4,
+            instances: 2,
+            domain: 2,
+            target: 1,
+            grid: [3, 5],
+            weight_grid: [4, 4],
+            cond_min: [0.1, 0.0],
+            cond_max: [1.0, 89.0],
+            hidden: [8, 8, 0],
+            activation: 0,
+            lattice_generator: 3,
+            reserved: [0; 3],
+        }
+    }
+
+    #[test]
+    fn axis_cells_cover_the_range_and_clamp() {
+        assert_eq!(AxisCell::locate(0.0, 3), AxisCell { j0: 0, t: 0.0 });
+        assert_eq!(AxisCell::locate(1.0, 3), AxisCell { j0: 1, t: 1.0 });
+        assert_eq!(AxisCell::locate(0.75, 3), AxisCell { j0: 1, t: 0.5 });
+        assert_eq!(AxisCell::locate(f32::NAN, 3), AxisCell { j0: 0, t: 0.0 });
+        assert_eq!(AxisCell::locate(7.0, 3), AxisCell { j0: 1, t: 1.0 });
+        assert_eq!(AxisCell::locate(0.5, 0), AxisCell { j0: 0, t: 0.0 });
+    }
+
+    #[test]
+    fn lerp_reproduces_corners_and_bilinear_functions() {
+        let cell = GridCell::locate([0.25, 0.6], [3, 5]);
+        let f = |x: f32, y: f32| 2.0 + 3.0 * x - y + 0.5 * x * y;
+        let (x0, x1) = (0.0, 0.5);
+        let (y0, y1) = (0.5, 0.75);
+        let v = cell.lerp(f(x0, y0), f(x1, y0), f(x0, y1), f(x1, y1));
+        assert!((v - f(0.25, 0.6)).abs() < 1e-6);
+        assert_eq!(cell.node(0, 0), 2 * 3);
+        assert_eq!(cell.node(1, 1), 3 * 3 + 1);
+    }
+
+    #[test]
+    fn normalize_clamps_and_maps_nan_to_the_lower_end() {
+        let inf = info();
+        assert_eq!(inf.normalize([0.1, 0.0]), [0.0, 0.0]);
+        assert_eq!(inf.normalize([5.0, -3.0]), [1.0, 0.0]);
+        assert_eq!(inf.normalize([f32::NAN, f32::INFINITY]), [0.0, 1.0]);
+        let u = inf.normalize([0.55, 44.5]);
+        assert!((u[0] - 0.5).abs() < 1e-6 && (u[1] - 0.5).abs() < 1e-6);
+        let c = inf.grid_condition([2, 4]);
+        assert!((c[0] - 1.0).abs() < 1e-7 && (c[1] - 89.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn shape_and_table_sizes_follow_the_counts() {
+        let inf = info();
+        let s = inf.shape().unwrap();
+        assert_eq!(s.hidden(), &[8, 8]);
+        assert_eq!(inf.point_table_len(), Some(3 * 5 * 2 * 4));
+        assert_eq!(inf.weight_table_len(), 16);
+        assert_eq!(inf.point_table_index(3, 1, 2), (3 * 2 + 1) * 4 + 2);
+        let mut gap = inf;
+        gap.hidden = [8, 0, 8];
+        assert!(gap.shape().is_none());
+        assert_eq!(unpack_point(pack_point(7, 65535)), [7, 65535]);
+    }
+}
