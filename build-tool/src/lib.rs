@@ -6,6 +6,7 @@
 
 pub mod baselines;
 pub mod cli;
+pub mod conditional;
 pub mod density;
 pub mod discrepancy;
 pub mod eval;

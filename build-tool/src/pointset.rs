@@ -111,6 +111,9 @@ impl PointSets {
                     dirs.map(|d| d.square_points()),
                 )
             }
+            BlobKind::Conditional => {
+                bail!("the blob holds a conditional sampler, not point sets (use `sample`)")
+            }
         };
         let square = square.map_err(|e| anyhow::anyhow!("{e}"))?;
         let decode = |[x, y]: [u16; 2]| DVec2::new(unorm16_decode_f64(x), unorm16_decode_f64(y));

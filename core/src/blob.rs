@@ -85,6 +85,10 @@ pub enum BlobKind {
     PointSet2D = 1,
     /// Direction sets stored as square points of an equal-area map (same sections).
     DirectionSet = 2,
+    /// A conditional sampler (paper §4): [`SectionTag::ConditionalInfo`],
+    /// [`SectionTag::NetworkParams`], [`SectionTag::PointTable`],
+    /// [`SectionTag::WeightTable`]; see [`crate::conditional`].
+    Conditional = 3,
 }
 
 impl BlobKind {
@@ -93,6 +97,7 @@ impl BlobKind {
         match code {
             1 => Some(Self::PointSet2D),
             2 => Some(Self::DirectionSet),
+            3 => Some(Self::Conditional),
             _ => None,
         }
     }
@@ -106,6 +111,16 @@ pub enum SectionTag {
     PointSetInfo = 1,
     /// `set_count * len * 2` u16 unorm coordinates, set-major, then index, then axis.
     Points = 2,
+    /// One [`crate::conditional::ConditionalInfo`] (80 bytes).
+    ConditionalInfo = 3,
+    /// The network's parameters as f16 bits, in the order of [`crate::network`]
+    /// (`elem_size` 2).
+    NetworkParams = 4,
+    /// The point table, `u32` entries `x | y << 16` of u16 unorm codes, laid out
+    /// `[grid node][instance][index]` (`elem_size` 4).
+    PointTable = 5,
+    /// The weight table, `f32` per weight-grid node, axis 0 fastest (`elem_size` 4).
+    WeightTable = 6,
 }
 
 /// Contents of the [`SectionTag::PointSetInfo`] section.

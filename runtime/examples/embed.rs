@@ -41,6 +41,8 @@ fn main() -> Result<(), BlobError> {
             }
             sum /= dirs.len() as f32;
         }
+        // Conditional samplers take a condition per sample; this blob is not one.
+        BlobKind::Conditional => {}
     }
     println!("set {set}: estimate {sum}");
     Ok(())

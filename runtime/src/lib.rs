@@ -95,6 +95,8 @@ impl<'a> Blob<'a> {
             BlobKind::PointSet2D | BlobKind::DirectionSet => {
                 blob.points_view()?;
             }
+            // Validated by the conditional sampler view (issue 13, in progress).
+            BlobKind::Conditional => return Err(BlobError::UnknownKind(code)),
         }
         Ok(blob)
     }
@@ -163,6 +165,7 @@ impl<'a> Blob<'a> {
         let domain_ok = match self.kind {
             BlobKind::PointSet2D => domain == Domain::Square,
             BlobKind::DirectionSet => domain != Domain::Square,
+            BlobKind::Conditional => false,
         };
         if !domain_ok {
             return Err(BlobError::DomainMismatch {

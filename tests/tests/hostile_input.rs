@@ -31,6 +31,7 @@ fn parse_and_touch(bytes: &[u8]) -> Result<(), BlobError> {
                 assert!((v.length() - 1.0).abs() < 1e-5);
             }
         }
+        BlobKind::Conditional => unreachable!("Blob::parse does not accept conditional blobs yet"),
     }
     Ok(())
 }

@@ -2,7 +2,7 @@
 //! CSV shows exactly what a renderer gets.
 
 use crate::pointset::AlignedBytes;
-use anyhow::{anyhow, Result};
+use anyhow::{anyhow, bail, Result};
 use clap::Args;
 use nuld_runtime::{Blob, BlobKind};
 use std::io::Write;
@@ -40,6 +40,11 @@ pub fn write_csv(bytes: &[u8], out: &mut impl Write) -> Result<()> {
                     writeln!(out, "{s},{i},{},{},{}", d.x, d.y, d.z)?;
                 }
             }
+        }
+        BlobKind::Conditional => {
+            bail!(
+                "the blob holds a conditional sampler: print its samples with `build-tool sample`"
+            )
         }
     }
     Ok(())

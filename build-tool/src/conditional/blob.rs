@@ -1,0 +1,90 @@
+//! [`ConditionalParts`]: the four sections of a conditional blob (kind 3), owned,
+//! and their encoding through [`nuld_core::blob::write`].
+
+use crate::pointset::AlignedBytes;
+use anyhow::{bail, Context, Result};
+use nuld_core::blob::{encoded_len, write, BlobKind, Metadata, SectionSpec, SectionTag};
+use nuld_core::conditional::{ConditionalInfo, CONDITIONAL_INFO_LEN};
+use std::path::Path;
+
+/// Everything a conditional blob holds besides its metadata (layouts in
+/// `core/FORMAT.md` and [`nuld_core::conditional`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ConditionalParts {
+    /// Counts, grids, condition ranges and the network's architecture.
+    pub info: ConditionalInfo,
+    /// The network's parameters as f16 bits ([`nuld_core::network`] order).
+    pub params: Vec<u16>,
+    /// The point table: `x | y << 16` u16 unorm codes, `[node][instance][index]`.
+    pub table: Vec<u32>,
+    /// The weight table, one `f32` per weight-grid node, axis 0 fastest.
+    pub weights: Vec<f32>,
+}
+
+impl ConditionalParts {
+    /// Encodes the parts as a blob. Fails if a length disagrees with the counts of
+    /// `info` (the runtime would reject the blob).
+    pub fn to_blob(&self, meta: &Metadata<'_>) -> Result<AlignedBytes> {
+        let info = &self.info;
+        let shape = info
+            .shape()
+            .context("conditional info describes no valid network")?;
+        if self.params.len() != shape.param_len() {
+            bail!(
+                "{} network parameters, the shape calls for {}",
+                self.params.len(),
+                shape.param_len()
+            );
+        }
+        if Some(self.table.len() as u64) != info.point_table_len() {
+            bail!(
+                "point table has {} entries, the counts call for {:?}",
+                self.table.len(),
+                info.point_table_len()
+            );
+        }
+        if self.weights.len() as u64 != info.weight_table_len() {
+            bail!(
+                "weight table has {} entries, the grid calls for {}",
+                self.weights.len(),
+                info.weight_table_len()
+            );
+        }
+        let meta_bytes = postcard::to_allocvec(meta).context("cannot encode metadata")?;
+        let sections = [
+            SectionSpec {
+                tag: SectionTag::ConditionalInfo,
+                elem_size: CONDITIONAL_INFO_LEN as u32,
+                bytes: bytemuck::bytes_of(info),
+            },
+            SectionSpec {
+                tag: SectionTag::NetworkParams,
+                elem_size: 2,
+                bytes: bytemuck::cast_slice(&self.params),
+            },
+            SectionSpec {
+                tag: SectionTag::PointTable,
+                elem_size: 4,
+                bytes: bytemuck::cast_slice(&self.table),
+            },
+            SectionSpec {
+                tag: SectionTag::WeightTable,
+                elem_size: 4,
+                bytes: bytemuck::cast_slice(&self.weights),
+            },
+        ];
+        let mut out = AlignedBytes::zeroed(encoded_len(&meta_bytes, &sections));
+        write(
+            out.as_mut_slice(),
+            BlobKind::Conditional,
+            &meta_bytes,
+            &sections,
+        )?;
+        Ok(out)
+    }
+
+    /// Writes the blob to `path` atomically (nothing half-written on failure).
+    pub fn write_blob(&self, path: &Path, meta: &Metadata<'_>) -> Result<()> {
+        crate::output::write_atomic(path, self.to_blob(meta)?.as_slice())
+    }
+}
