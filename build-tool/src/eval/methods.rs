@@ -15,7 +15,7 @@ use crate::optimize::directions::{
 };
 use crate::optimize::{optimize, AreaOption, OptimizeConfig};
 use crate::seeding::derive_seed;
-use crate::sphere::DirectionDensity;
+use crate::sphere::{square_cell_masses, DirectionDensity};
 use anyhow::Result;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
@@ -233,16 +233,7 @@ pub const PROJECTION_RESOLUTION: usize = 256;
 /// non-uniform directions (paper §5: "generated over a projected density").
 pub fn projected_density(density: &dyn DirectionDensity) -> Result<TabulatedDensity> {
     let m = PROJECTION_RESOLUTION;
-    let domain = density.domain();
-    let values = (0..m * m)
-        .map(|i| {
-            let p = DVec2::new(
-                ((i % m) as f64 + 0.5) / m as f64,
-                ((i / m) as f64 + 0.5) / m as f64,
-            );
-            density.pdf(domain.to_direction(p))
-        })
-        .collect();
+    let values = square_cell_masses(density, m, 1);
     Ok(TabulatedDensity::from_grid(m, m, values)?)
 }
 

@@ -15,8 +15,12 @@
 //! [`rows`], and [`report`] writes `figN.csv`, `figN.json`, `figN-<target>-<metric>.png` and
 //! `figN-summary.md` ([`summary`]: ours against the best other method).
 //! Everything is deterministic given the seeds ([`methods::realization_seed`]).
+//!
+//! [`conditional`] is the quality report of a conditional BRDF sampler (paper §4)
+//! on held-out conditions (`build-tool eval conditional`).
 
 pub mod cache;
+pub mod conditional;
 pub mod figures;
 pub mod integrands;
 pub mod methods;

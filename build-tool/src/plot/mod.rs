@@ -1,9 +1,11 @@
-//! Pictures: point sets over their target density, and log-log curves.
+//! Pictures: point sets over their target density, log-log curves, heat maps.
 
 mod curves;
+mod heatmap;
 mod points;
 
 pub use curves::{render_loglog, Series};
+pub use heatmap::{render_heatmap, Heatmap};
 pub use points::{render_direction_set, render_point_set};
 
 use std::sync::Once;

@@ -11,6 +11,8 @@
 //!   per-condition sample weight) and tables of it;
 //! * [`geometry`]: closed-form cap measures (uniform sphere and hemisphere, cosine);
 //! * [`cap_table`]: [`CapMeasureTable`], fast cap sums over a weighted point rule;
+//! * [`tabulated_warp`]: [`TabulatedWarp`], a target's exact tabulated inverse CDF
+//!   on its equal-area square (the exact-warp baseline);
 //! * [`metrics`]: cap L2 discrepancy (Stolarsky closed form, energy distance,
 //!   Monte Carlo in the paper's theta-uniform convention) and a lower bound of the
 //!   cap star discrepancy.
@@ -27,6 +29,7 @@ pub mod envmap;
 pub mod geometry;
 pub mod metrics;
 pub mod spec;
+pub mod tabulated_warp;
 pub mod target;
 
 pub use brdf_target::BrdfTarget;
@@ -44,4 +47,5 @@ pub use metrics::{
     root_with_stderr, CapRadius, CapStarEstimate, CapStarOptions, EnergyReference, MeasuredCaps,
 };
 pub use spec::parse_direction_spec;
+pub use tabulated_warp::{square_cell_masses, TabulatedWarp};
 pub use target::{DirectionDensity, DirectionSpecError};

@@ -1,0 +1,552 @@
+//! The conditional quality report: per-condition scores and ratios, the summary
+//! over conditions, and its files (`conditional.json`, `conditional.csv`,
+//! `conditional-summary.md`, ratio heat maps and sets drawn over their target).
+
+use super::{ConditionalSettings, Diversity};
+use crate::plot::{render_direction_set, render_heatmap, Heatmap};
+use crate::sphere::{BrdfTarget, DirectionDensity};
+use anyhow::Result;
+use glam::DVec3;
+use nuld_core::blob::Domain;
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Name of the exact-inverse-CDF reference (Owen-Sobol warped by the tabulated
+/// inverse CDF of the target).
+pub const EXACT: &str = "owen-sobol-exact";
+/// Name of the renderer's-mixture reference (Owen-Sobol warped by VNDF + cosine).
+pub const MIXTURE: &str = "owen-sobol-mixture";
+/// Name of the per-condition direct optimization.
+pub const DIRECT: &str = "direct";
+
+/// A method's scores at one condition: means over its sets.
+#[derive(Clone, Debug, Serialize)]
+pub struct MethodScore {
+    /// Method name.
+    pub method: String,
+    /// Sets scored.
+    pub sets: usize,
+    /// Mean cap L2 discrepancy (theta-uniform, paper Eq. 9).
+    pub cap_l2: f64,
+    /// Its standard error: `sqrt(se_instances^2 + se_caps^2)`.
+    pub cap_l2_se: f64,
+    /// Spread over sets, `sd / sqrt(sets)` (0 for one set).
+    pub cap_l2_se_instances: f64,
+    /// Mean Monte Carlo standard error of one set's estimate (the caps are shared by
+    /// every set, so this part does not average out).
+    pub cap_l2_se_caps: f64,
+    /// Mean of the largest local discrepancy found (a lower bound of the cap star
+    /// discrepancy).
+    pub cap_star: f64,
+}
+
+impl MethodScore {
+    /// Aggregates per-set `(cap L2, its MC se, largest local discrepancy)`.
+    ///
+    /// # Panics
+    /// If `scores` is empty.
+    pub fn from_scores(method: &str, scores: &[(f64, f64, f64)]) -> Self {
+        assert!(!scores.is_empty(), "no sets scored");
+        let k = scores.len() as f64;
+        let cap_l2 = scores.iter().map(|s| s.0).sum::<f64>() / k;
+        let var = if scores.len() > 1 {
+            scores.iter().map(|s| (s.0 - cap_l2).powi(2)).sum::<f64>() / (k - 1.0)
+        } else {
+            0.0
+        };
+        let se_instances = (var / k).sqrt();
+        let se_caps = scores.iter().map(|s| s.1).sum::<f64>() / k;
+        Self {
+            method: method.into(),
+            sets: scores.len(),
+            cap_l2,
+            cap_l2_se: se_instances.hypot(se_caps),
+            cap_l2_se_instances: se_instances,
+            cap_l2_se_caps: se_caps,
+            cap_star: scores.iter().map(|s| s.2).sum::<f64>() / k,
+        }
+    }
+}
+
+/// A sampler's ratios at one condition (its mean over the reference's mean).
+#[derive(Clone, Debug, Serialize)]
+pub struct SamplerRatios {
+    /// Sampler name.
+    pub sampler: String,
+    /// Cap L2 over the exact-inverse-CDF reference's.
+    pub to_exact: f64,
+    /// Cap L2 over the mixture reference's.
+    pub to_mixture: f64,
+    /// Cap L2 over the direct optimization's (where it ran).
+    pub to_direct: Option<f64>,
+    /// Largest local discrepancy over the exact reference's.
+    pub star_to_exact: f64,
+}
+
+/// A method's diversity at one condition.
+#[derive(Clone, Debug, Serialize)]
+pub struct NamedDiversity {
+    /// Method name.
+    pub method: String,
+    /// The figures.
+    #[serde(flatten)]
+    pub diversity: Diversity,
+}
+
+/// Instance 0 of a method at one condition, for pictures.
+#[derive(Clone, Debug, Serialize)]
+pub struct ExampleSet {
+    /// Method name.
+    pub method: String,
+    /// Unit directions `[x, y, z]`.
+    pub directions: Vec<[f64; 3]>,
+}
+
+/// Everything measured at one condition.
+#[derive(Clone, Debug, Serialize)]
+pub struct ConditionResult {
+    /// Roughness.
+    pub roughness: f64,
+    /// View angle (degrees).
+    pub theta_o_deg: f64,
+    /// Directional albedo `A` (the estimator weight).
+    pub albedo: f64,
+    /// The samplers' scores.
+    pub samplers: Vec<MethodScore>,
+    /// Exact-inverse-CDF reference.
+    pub exact: MethodScore,
+    /// Mixture reference.
+    pub mixture: MethodScore,
+    /// Direct optimization, where it ran.
+    pub direct: Option<MethodScore>,
+    /// The samplers' ratios.
+    pub ratios: Vec<SamplerRatios>,
+    /// Diversity of every sampler, then of the exact reference (independent
+    /// scrambles: the calibration).
+    pub diversity: Vec<NamedDiversity>,
+    /// Instance 0 of every sampler and of the exact reference.
+    pub examples: Vec<ExampleSet>,
+}
+
+impl ConditionResult {
+    /// Assembles a condition's result and computes its ratios.
+    pub fn new(
+        [roughness, theta_o_deg]: [f64; 2],
+        albedo: f64,
+        samplers: Vec<MethodScore>,
+        exact: MethodScore,
+        mixture: MethodScore,
+        direct: Option<MethodScore>,
+        diversity: Vec<(String, Diversity)>,
+        examples: Vec<(String, Vec<DVec3>)>,
+    ) -> Self {
+        let ratios = samplers
+            .iter()
+            .map(|s| SamplerRatios {
+                sampler: s.method.clone(),
+                to_exact: s.cap_l2 / exact.cap_l2,
+                to_mixture: s.cap_l2 / mixture.cap_l2,
+                to_direct: direct.as_ref().map(|d| s.cap_l2 / d.cap_l2),
+                star_to_exact: s.cap_star / exact.cap_star,
+            })
+            .collect();
+        Self {
+            roughness,
+            theta_o_deg,
+            albedo,
+            samplers,
+            exact,
+            mixture,
+            direct,
+            ratios,
+            diversity: diversity
+                .into_iter()
+                .map(|(method, diversity)| NamedDiversity { method, diversity })
+                .collect(),
+            examples: examples
+                .into_iter()
+                .map(|(method, d)| ExampleSet {
+                    method,
+                    directions: d.iter().map(|v| v.to_array()).collect(),
+                })
+                .collect(),
+        }
+    }
+
+    /// The diversity of `method` here, if measured.
+    pub fn diversity_of(&self, method: &str) -> Option<&Diversity> {
+        self.diversity
+            .iter()
+            .find(|d| d.method == method)
+            .map(|d| &d.diversity)
+    }
+}
+
+/// One sampler (or the exact reference, as calibration) over all conditions.
+#[derive(Clone, Debug, Serialize)]
+pub struct SamplerSummary {
+    /// Sampler name.
+    pub sampler: String,
+    /// Mean over conditions of the cap-L2 ratio to the exact reference.
+    pub mean_ratio_exact: f64,
+    /// Largest such ratio ...
+    pub worst_ratio_exact: f64,
+    /// ... and where (`[roughness, theta_o_deg]`).
+    pub worst_condition: [f64; 2],
+    /// Conditions where the ratio to the exact reference exceeds 1.
+    pub conditions_above_one: usize,
+    /// Mean cap-L2 ratio to the mixture reference.
+    pub mean_ratio_mixture: f64,
+    /// Mean cap-L2 ratio to direct optimization over the conditions where it ran.
+    pub mean_ratio_direct: Option<f64>,
+    /// Mean ratio of the largest local discrepancy to the exact reference's.
+    pub mean_star_ratio_exact: f64,
+    /// Mean union ratio ([`Diversity::union_ratio`]; 1/sqrt(K) independent, 1 identical).
+    pub mean_union_ratio: f64,
+    /// Largest union ratio.
+    pub worst_union_ratio: f64,
+    /// Mean nearest-neighbour ratio ([`Diversity::nn_ratio`]; 0.65 independent, 0 identical).
+    pub mean_nn_ratio: f64,
+    /// Smallest nearest-neighbour ratio.
+    pub worst_nn_ratio: f64,
+}
+
+/// The whole report (`conditional.json`). Deterministic: no timings.
+#[derive(Clone, Debug, Serialize)]
+pub struct ConditionalReport {
+    /// What it shows.
+    pub title: String,
+    /// Points per set.
+    pub n: usize,
+    /// The samplers under test.
+    pub samplers: Vec<String>,
+    /// Settings of the run.
+    pub settings: ConditionalSettings,
+    /// Per sampler over all conditions; then the exact reference's own diversity
+    /// (`exact` row: ratios 1 by definition).
+    pub summary: Vec<SamplerSummary>,
+    /// Mean over conditions of mixture / exact (cap L2).
+    pub mixture_over_exact: f64,
+    /// Mean over direct conditions of direct / exact (cap L2).
+    pub direct_over_exact: Option<f64>,
+    /// Per condition.
+    pub conditions: Vec<ConditionResult>,
+}
+
+fn mean(v: impl Iterator<Item = f64>) -> Option<f64> {
+    let (s, k) = v.fold((0.0, 0usize), |(s, k), x| (s + x, k + 1));
+    (k > 0).then(|| s / k as f64)
+}
+
+impl ConditionalReport {
+    /// Assembles the report and its summary.
+    pub fn new(
+        settings: &ConditionalSettings,
+        samplers: Vec<String>,
+        n: usize,
+        conditions: Vec<ConditionResult>,
+        _seconds: f64,
+    ) -> Self {
+        let mut summary: Vec<SamplerSummary> = samplers
+            .iter()
+            .enumerate()
+            .map(|(j, name)| summarize(name, &conditions, |c| Some(&c.ratios[j])))
+            .collect();
+        summary.push(summarize(EXACT, &conditions, |_| None));
+        Self {
+            title: format!(
+                "conditional sampler on held-out conditions, N = {n}: cap L2 and largest \
+                 local discrepancy vs Owen-Sobol + exact inverse CDF, Owen-Sobol + \
+                 VNDF/cosine mixture, and per-condition optimization; instance diversity"
+            ),
+            n,
+            samplers,
+            settings: settings.clone(),
+            summary,
+            mixture_over_exact: mean(conditions.iter().map(|c| c.mixture.cap_l2 / c.exact.cap_l2))
+                .unwrap_or(f64::NAN),
+            direct_over_exact: mean(
+                conditions
+                    .iter()
+                    .filter_map(|c| c.direct.as_ref().map(|d| d.cap_l2 / c.exact.cap_l2)),
+            ),
+            conditions,
+        }
+    }
+
+    /// The summary as a Markdown table (what `eval conditional` prints).
+    pub fn summary_markdown(&self) -> String {
+        let mut s = format!(
+            "N = {}, {} conditions, {} instances (diversity: {}); cap L2 ratios (mean / worst) \
+             to Owen-Sobol + exact inverse CDF, mean to the VNDF/cosine mixture and to direct \
+             optimization; diversity: union of instances / one instance (independent sets \
+             ~{:.3}, identical 1), nearest-neighbour angle across / within (independent \
+             ~0.65, identical 0).\n\n\
+             | sampler | / exact (mean) | / exact (worst, at) | above 1 | / mixture | / direct | D* / exact | union ratio (mean, worst) | NN ratio (mean, worst) |\n\
+             |---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+            self.n,
+            self.conditions.len(),
+            self.settings.instances,
+            self.settings.union_instances,
+            1.0 / (self.settings.union_instances as f64).sqrt(),
+        );
+        for l in &self.summary {
+            let _ = writeln!(
+                s,
+                "| {} | {:.3} | {:.3} ({}, {}) | {} | {:.3} | {} | {:.3} | {:.3}, {:.3} | {:.3}, {:.3} |",
+                l.sampler,
+                l.mean_ratio_exact,
+                l.worst_ratio_exact,
+                l.worst_condition[0],
+                l.worst_condition[1],
+                l.conditions_above_one,
+                l.mean_ratio_mixture,
+                l.mean_ratio_direct
+                    .map_or("-".to_string(), |v| format!("{v:.3}")),
+                l.mean_star_ratio_exact,
+                l.mean_union_ratio,
+                l.worst_union_ratio,
+                l.mean_nn_ratio,
+                l.worst_nn_ratio,
+            );
+        }
+        let _ = writeln!(
+            s,
+            "\nReferences: mixture / exact {:.3}, direct / exact {}.",
+            self.mixture_over_exact,
+            self.direct_over_exact
+                .map_or("-".to_string(), |v| format!("{v:.3}"))
+        );
+        s
+    }
+
+    /// The CSV: one line per (condition, method); ratio and diversity columns empty
+    /// where they do not apply.
+    pub fn csv(&self) -> String {
+        let mut out = String::from(
+            "roughness,theta_o_deg,method,sets,cap_l2,cap_l2_se,cap_star,ratio_to_exact,\
+             ratio_to_mixture,ratio_to_direct,union_ratio,nn_ratio\n",
+        );
+        let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:e}"));
+        for c in &self.conditions {
+            let refs = [Some(&c.exact), Some(&c.mixture), c.direct.as_ref()];
+            let all = c.samplers.iter().chain(refs.into_iter().flatten());
+            for m in all {
+                let r = c.ratios.iter().find(|r| r.sampler == m.method);
+                let d = c.diversity_of(&m.method);
+                let _ = writeln!(
+                    out,
+                    "{},{},{},{},{:e},{:e},{:e},{},{},{},{},{}",
+                    c.roughness,
+                    c.theta_o_deg,
+                    m.method,
+                    m.sets,
+                    m.cap_l2,
+                    m.cap_l2_se,
+                    m.cap_star,
+                    opt(r.map(|r| r.to_exact)),
+                    opt(r.map(|r| r.to_mixture)),
+                    opt(r.and_then(|r| r.to_direct)),
+                    opt(d.map(|d| d.union_ratio)),
+                    opt(d.map(|d| d.nn_ratio)),
+                );
+            }
+        }
+        out
+    }
+
+    /// Writes `conditional.json`, `conditional.csv`, `conditional-summary.md`, a
+    /// heat map of each sampler's ratio to the exact reference
+    /// (`conditional-<sampler>-ratio.png`) and of its union ratio
+    /// (`conditional-<sampler>-union.png`), and instance 0 of every sampler and of
+    /// the exact reference over the target at up to three conditions
+    /// (`conditional-sets-r<R>-t<T>.png`, one row per method); returns the paths.
+    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
+        crate::output::ensure_dir(dir)?;
+        let mut written = Vec::new();
+        let mut put = |name: &str, bytes: &[u8]| -> Result<()> {
+            let p = dir.join(name);
+            crate::output::write_atomic(&p, bytes)?;
+            written.push(p);
+            Ok(())
+        };
+        let mut json = serde_json::to_string_pretty(self)?;
+        json.push('\n');
+        put("conditional.json", json.as_bytes())?;
+        put("conditional.csv", self.csv().as_bytes())?;
+        put("conditional-summary.md", self.summary_markdown().as_bytes())?;
+        let mut rs: Vec<f64> = self.conditions.iter().map(|c| c.roughness).collect();
+        let mut ts: Vec<f64> = self.conditions.iter().map(|c| c.theta_o_deg).collect();
+        for v in [&mut rs, &mut ts] {
+            v.sort_by(f64::total_cmp);
+            v.dedup();
+        }
+        for (j, name) in self.samplers.iter().enumerate() {
+            for (what, center, value) in [
+                (
+                    "ratio",
+                    1.0,
+                    &(|c: &ConditionResult| Some(c.ratios[j].to_exact))
+                        as &dyn Fn(&ConditionResult) -> Option<f64>,
+                ),
+                ("union", 0.3, &|c: &ConditionResult| {
+                    c.diversity_of(name).map(|d| d.union_ratio)
+                }),
+            ] {
+                let cells: Vec<Option<f64>> = rs
+                    .iter()
+                    .flat_map(|&r| ts.iter().map(move |&t| (r, t)))
+                    .map(|(r, t)| {
+                        self.conditions
+                            .iter()
+                            .find(|c| c.roughness == r && c.theta_o_deg == t)
+                            .and_then(value)
+                    })
+                    .collect();
+                let file = format!("conditional-{}-{what}.png", sanitize(name));
+                let title = match what {
+                    "ratio" => format!(
+                        "{name}: cap L2 / Owen-Sobol + exact inverse CDF, N = {}",
+                        self.n
+                    ),
+                    _ => format!(
+                        "{name}: cap L2 of {} instances' union / one instance's",
+                        self.settings.union_instances
+                    ),
+                };
+                render_heatmap(
+                    &dir.join(&file),
+                    &Heatmap {
+                        title: &title,
+                        x_label: "theta_o (degrees)",
+                        y_label: "roughness",
+                        xs: &ts,
+                        ys: &rs,
+                        values: &cells,
+                        center,
+                    },
+                    (720, 600),
+                )?;
+                written.push(dir.join(file));
+            }
+        }
+        written.extend(self.write_set_pictures(dir)?);
+        Ok(written)
+    }
+
+    /// Instance 0 of every method over the target at up to three conditions (the
+    /// first, middle and last where direct optimization ran, else of all).
+    fn write_set_pictures(&self, dir: &Path) -> Result<Vec<PathBuf>> {
+        let pool: Vec<&ConditionResult> = if self.settings.direct.is_empty() {
+            self.conditions.iter().collect()
+        } else {
+            self.settings
+                .direct
+                .iter()
+                .map(|&i| &self.conditions[i])
+                .collect()
+        };
+        let mut picks = vec![0, pool.len() / 2, pool.len() - 1];
+        picks.dedup();
+        let mut written = Vec::new();
+        for c in picks.into_iter().map(|i| pool[i]) {
+            let target = BrdfTarget::new(c.roughness, c.theta_o_deg, Domain::Hemisphere)?;
+            for e in &c.examples {
+                let square: Vec<glam::DVec2> = e
+                    .directions
+                    .iter()
+                    .map(|d| Domain::Hemisphere.to_square(DVec3::from_array(*d)))
+                    .collect();
+                let file = format!(
+                    "conditional-sets-{}-r{}-t{}.png",
+                    sanitize(&e.method),
+                    c.roughness,
+                    c.theta_o_deg
+                );
+                render_direction_set(
+                    &dir.join(&file),
+                    &format!(
+                        "{} instance 0, roughness {}, theta_o {} deg",
+                        e.method, c.roughness, c.theta_o_deg
+                    ),
+                    &|d| target.pdf(d),
+                    &|p| Domain::Hemisphere.to_direction(p),
+                    &square,
+                    360,
+                )?;
+                written.push(dir.join(file));
+            }
+        }
+        Ok(written)
+    }
+}
+
+/// `name` with every character outside `[A-Za-z0-9.-]` replaced by `_`.
+fn sanitize(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '.' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// The summary of one sampler (`ratio(c)` its ratios at condition `c`), or of the
+/// exact reference when `ratio` gives `None` (ratios 1, its own diversity).
+fn summarize<'a>(
+    name: &str,
+    conditions: &'a [ConditionResult],
+    ratio: impl Fn(&'a ConditionResult) -> Option<&'a SamplerRatios>,
+) -> SamplerSummary {
+    let to_exact: Vec<f64> = conditions
+        .iter()
+        .map(|c| ratio(c).map_or(1.0, |r| r.to_exact))
+        .collect();
+    let (worst_at, worst) =
+        to_exact
+            .iter()
+            .copied()
+            .enumerate()
+            .fold(
+                (0, f64::NEG_INFINITY),
+                |b, (i, v)| if v > b.1 { (i, v) } else { b },
+            );
+    let div: Vec<&Diversity> = conditions
+        .iter()
+        .filter_map(|c| c.diversity_of(name))
+        .collect();
+    SamplerSummary {
+        sampler: name.into(),
+        mean_ratio_exact: mean(to_exact.iter().copied()).unwrap_or(f64::NAN),
+        worst_ratio_exact: worst,
+        worst_condition: [
+            conditions[worst_at].roughness,
+            conditions[worst_at].theta_o_deg,
+        ],
+        conditions_above_one: to_exact.iter().filter(|&&v| v > 1.0).count(),
+        mean_ratio_mixture: mean(
+            conditions
+                .iter()
+                .map(|c| ratio(c).map_or(c.exact.cap_l2 / c.mixture.cap_l2, |r| r.to_mixture)),
+        )
+        .unwrap_or(f64::NAN),
+        mean_ratio_direct: mean(conditions.iter().filter_map(|c| match ratio(c) {
+            Some(r) => r.to_direct,
+            None => c.direct.as_ref().map(|d| c.exact.cap_l2 / d.cap_l2),
+        })),
+        mean_star_ratio_exact: mean(
+            conditions
+                .iter()
+                .map(|c| ratio(c).map_or(1.0, |r| r.star_to_exact)),
+        )
+        .unwrap_or(f64::NAN),
+        mean_union_ratio: mean(div.iter().map(|d| d.union_ratio)).unwrap_or(f64::NAN),
+        worst_union_ratio: div.iter().map(|d| d.union_ratio).fold(f64::NAN, f64::max),
+        mean_nn_ratio: mean(div.iter().map(|d| d.nn_ratio)).unwrap_or(f64::NAN),
+        worst_nn_ratio: div.iter().map(|d| d.nn_ratio).fold(f64::NAN, f64::min),
+    }
+}
