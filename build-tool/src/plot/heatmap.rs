@@ -1,7 +1,7 @@
 //! Heat maps of a value over a grid of two parameters, each cell coloured on a
 //! diverging scale about a reference value and labelled with its value.
 
-use super::register_fonts;
+use super::write_png;
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
 use std::path::Path;
@@ -28,6 +28,16 @@ pub struct Heatmap<'a> {
 
 fn err(e: impl std::fmt::Display) -> anyhow::Error {
     anyhow!("plot: {e}")
+}
+
+/// The parameter value at integer tick `v` (cell centres), empty elsewhere.
+fn tick_label(values: &[f64], v: f64) -> String {
+    let i = v.round() as usize;
+    if v.fract() == 0.0 && v >= 0.0 && i < values.len() {
+        format!("{}", values[i])
+    } else {
+        String::new()
+    }
 }
 
 /// Colour of `v` on the diverging scale about `center` (log scale, saturating at
@@ -57,12 +67,8 @@ pub fn render_heatmap(path: &Path, map: &Heatmap<'_>, (width, height): (u32, u32
             map.values.len()
         ));
     }
-    register_fonts();
-    let mut buf = vec![255u8; (width * height * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buf, (width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(err)?;
-        let mut chart = ChartBuilder::on(&root)
+    write_png(path, (width, height), |root| {
+        let mut chart = ChartBuilder::on(root)
             .caption(map.title, ("sans-serif", 16))
             .margin(14)
             .x_label_area_size(40)
@@ -78,18 +84,8 @@ pub fn render_heatmap(path: &Path, map: &Heatmap<'_>, (width, height): (u32, u32
             .y_desc(map.y_label)
             .x_labels(nx)
             .y_labels(ny)
-            .x_label_formatter(&move |v| {
-                let i = v.round() as usize;
-                (v.fract() == 0.0 && *v >= 0.0 && i < xs.len())
-                    .then(|| format!("{}", xs[i]))
-                    .unwrap_or_default()
-            })
-            .y_label_formatter(&move |v| {
-                let i = v.round() as usize;
-                (v.fract() == 0.0 && *v >= 0.0 && i < ys.len())
-                    .then(|| format!("{}", ys[i]))
-                    .unwrap_or_default()
-            })
+            .x_label_formatter(&move |v| tick_label(&xs, *v))
+            .y_label_formatter(&move |v| tick_label(&ys, *v))
             .draw()
             .map_err(err)?;
         for i in 0..ny {
@@ -114,13 +110,8 @@ pub fn render_heatmap(path: &Path, map: &Heatmap<'_>, (width, height): (u32, u32
                     .map_err(err)?;
             }
         }
-        root.present().map_err(err)?;
-    }
-    let img =
-        image::RgbImage::from_raw(width, height, buf).ok_or_else(|| anyhow!("plot buffer size"))?;
-    let mut png = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
-    crate::output::write_atomic(path, &png)
+        Ok(())
+    })
 }
 
 #[cfg(test)]

@@ -8,7 +8,14 @@ pub use curves::{render_loglog, Series};
 pub use heatmap::{render_heatmap, Heatmap};
 pub use points::{render_direction_set, render_point_set};
 
+use anyhow::{anyhow, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::Path;
 use std::sync::Once;
+
+/// A drawing area over an RGB buffer.
+pub(crate) type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
 
 /// DejaVu Sans (Bitstream Vera license, `assets/DejaVuSans-LICENSE.txt`), embedded so
 /// that plots need no system fonts.
@@ -22,4 +29,24 @@ pub(crate) fn register_fonts() {
         let _ =
             plotters::style::register_font("sans-serif", plotters::style::FontStyle::Normal, FONT);
     });
+}
+
+/// Renders into a fresh `w x h` buffer and writes it as PNG to `path` atomically.
+pub(crate) fn write_png(
+    path: &Path,
+    (w, h): (u32, u32),
+    draw: impl FnOnce(&Area<'_>) -> Result<()>,
+) -> Result<()> {
+    register_fonts();
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
+        draw(&root)?;
+        root.present().map_err(|e| anyhow!("plot: {e}"))?;
+    }
+    let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| anyhow!("plot buffer size"))?;
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
+    crate::output::write_atomic(path, &png)
 }

@@ -2,14 +2,11 @@
 //! unit square, and direction sets both in their equal-area square and as
 //! orthographic views of the sphere.
 
-use super::register_fonts;
+use super::{write_png, Area};
 use anyhow::{anyhow, Result};
 use glam::{DVec2, DVec3};
-use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
-
-type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
 
 fn err(e: impl std::fmt::Display) -> anyhow::Error {
     anyhow!("plot: {e}")
@@ -85,26 +82,6 @@ fn draw_panel(
             .map_err(err)?;
     }
     Ok(())
-}
-
-/// Renders into a fresh `w x h` buffer and writes it as PNG to `path` atomically.
-fn write_png(
-    path: &Path,
-    (w, h): (u32, u32),
-    draw: impl FnOnce(&Area<'_>) -> Result<()>,
-) -> Result<()> {
-    register_fonts();
-    let mut buf = vec![255u8; (w * h * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(err)?;
-        draw(&root)?;
-        root.present().map_err(err)?;
-    }
-    let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| anyhow!("plot buffer size"))?;
-    let mut png = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
-    crate::output::write_atomic(path, &png)
 }
 
 /// Draws `points` (in `[0,1]^2`) over `density` and writes a PNG of

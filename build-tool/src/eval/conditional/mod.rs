@@ -31,7 +31,7 @@ pub mod report;
 pub mod sets;
 
 pub use diversity::{diversity, Diversity};
-pub use report::{ConditionResult, ConditionalReport, MethodScore};
+pub use report::{ConditionResult, ConditionalReport, MethodScore, References};
 pub use sets::{blob_sets, ConditionalSets, MixtureOwenSobol, SampleFnSets};
 
 use crate::baselines::seeded_owen_sobol;
@@ -352,9 +352,11 @@ pub fn evaluate(
             [roughness, theta],
             target.albedo(),
             methods,
-            exact,
-            mixture,
-            direct,
+            References {
+                exact,
+                mixture,
+                direct,
+            },
             diversities,
             examples,
         ));

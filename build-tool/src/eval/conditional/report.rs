@@ -103,6 +103,16 @@ pub struct ExampleSet {
     pub directions: Vec<[f64; 3]>,
 }
 
+/// The references' scores at one condition.
+pub struct References {
+    /// Exact-inverse-CDF reference.
+    pub exact: MethodScore,
+    /// Mixture reference.
+    pub mixture: MethodScore,
+    /// Direct optimization, where it ran.
+    pub direct: Option<MethodScore>,
+}
+
 /// Everything measured at one condition.
 #[derive(Clone, Debug, Serialize)]
 pub struct ConditionResult {
@@ -135,9 +145,11 @@ impl ConditionResult {
         [roughness, theta_o_deg]: [f64; 2],
         albedo: f64,
         samplers: Vec<MethodScore>,
-        exact: MethodScore,
-        mixture: MethodScore,
-        direct: Option<MethodScore>,
+        References {
+            exact,
+            mixture,
+            direct,
+        }: References,
         diversity: Vec<(String, Diversity)>,
         examples: Vec<(String, Vec<DVec3>)>,
     ) -> Self {
