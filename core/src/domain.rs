@@ -120,7 +120,10 @@ mod tests {
         for d in [Domain::Sphere, Domain::Hemisphere] {
             let q = d.to_square(d.to_direction(p));
             assert!((p - q).length() < 1e-12, "{d:?}: {q:?}");
-            assert_eq!(DVec3::from(d.to_direction_real([p.x, p.y])), d.to_direction(p));
+            assert_eq!(
+                DVec3::from(d.to_direction_real([p.x, p.y])),
+                d.to_direction(p)
+            );
         }
     }
 }

@@ -134,10 +134,18 @@ mod tests {
     fn fast_f16_decoder_equals_half_on_every_finite_code() {
         let mut finite = 0;
         for h in 0..=u16::MAX {
-            assert_eq!(f16_is_finite(h), half::f16::from_bits(h).is_finite(), "{h:#06x}");
+            assert_eq!(
+                f16_is_finite(h),
+                half::f16::from_bits(h).is_finite(),
+                "{h:#06x}"
+            );
             if f16_is_finite(h) {
                 finite += 1;
-                assert_eq!(f16_decode_finite(h).to_bits(), f16_decode(h).to_bits(), "{h:#06x}");
+                assert_eq!(
+                    f16_decode_finite(h).to_bits(),
+                    f16_decode(h).to_bits(),
+                    "{h:#06x}"
+                );
             }
         }
         assert_eq!(finite, 63488);
