@@ -308,7 +308,7 @@ impl<'a> ConditionalSampler<'a> {
     /// ```
     #[inline]
     pub fn sample(&self, cond: Vec2, instance: u32, i: u32) -> Sample {
-        self.to_sample(self.square_point(cond, instance, i), cond)
+        self.mapped(self.square_point(cond, instance, i), cond)
     }
 
     /// Network mode: as [`Self::sample`] with [`Self::network_square_point`]; every
@@ -316,7 +316,7 @@ impl<'a> ConditionalSampler<'a> {
     /// `O(multiply_adds)`, never panics.
     #[inline]
     pub fn sample_network(&self, cond: Vec2, instance: u32, i: u32) -> Sample {
-        self.to_sample(self.network_square_point(cond, instance, i), cond)
+        self.mapped(self.network_square_point(cond, instance, i), cond)
     }
 
     /// Table mode for a BRDF sampler ([`ConditionalTarget::GltfBrdf`]) at any view:
@@ -360,7 +360,7 @@ impl<'a> ConditionalSampler<'a> {
     }
 
     #[inline]
-    fn to_sample(&self, p: Vec2, cond: Vec2) -> Sample {
+    fn mapped(&self, p: Vec2, cond: Vec2) -> Sample {
         Sample {
             direction: Vec3::from_array(self.domain.to_direction_real(p.to_array())),
             weight: self.weight(cond),
@@ -643,7 +643,7 @@ mod tests {
         let cs = Blob::parse(bytes.get()).unwrap().conditional().unwrap();
         for k in 0..300u32 {
             let theta = (noise(7, k) % 8000) as f64 / 100.0;
-            let phi = (noise(8, k) % 62832) as f64 / 10_000.0 - 3.1416;
+            let phi = ((noise(8, k) % 10_000) as f64 / 5_000.0 - 1.0) * core::f64::consts::PI;
             let len = 0.5 + (noise(9, k) % 100) as f64 / 20.0;
             let (t, f) = (theta.to_radians(), phi);
             let wo = [t.sin() * f.cos(), t.sin() * f.sin(), t.cos()].map(|x| (x * len) as f32);
@@ -685,7 +685,8 @@ mod tests {
     #[test]
     fn each_validation_failure_has_its_error() {
         assert_eq!(with(|_| {}), Ok(()));
-        let cases: [(fn(&mut Parts), BlobError); 22] = [
+        type Change = fn(&mut Parts);
+        let cases: [(Change, BlobError); 22] = [
             (|p| p.info.n = 0, BlobError::ConditionalNoPoints),
             (|p| p.info.instances = 0, BlobError::ConditionalNoInstances),
             (|p| p.info.domain = 0, BlobError::ConditionalDomain(0)),
