@@ -16,5 +16,6 @@ pub mod output;
 pub mod plot;
 pub mod pointset;
 pub mod progress;
+pub mod runtime_speed;
 pub mod seeding;
 pub mod sphere;

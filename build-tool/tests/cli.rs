@@ -448,3 +448,148 @@ fn an_unrecognized_image_names_its_extension_plainly() {
     assert!(!out.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A small conditional blob (n 6, hidden [5], 3 instances, 3 x 4 grid) with
+/// deterministic contents, written with the tool's writer.
+fn conditional_blob(path: &Path) {
+    use nuld_build_tool::conditional::blob::ConditionalParts;
+    use nuld_core::conditional::ConditionalInfo;
+    use nuld_core::quantize::f16_encode;
+    let info = ConditionalInfo {
+        n: 6,
+        instances: 3,
+        domain: 2,
+        target: 1,
+        grid: [3, 4],
+        weight_grid: [2, 3],
+        cond_min: [0.1, 0.0],
+        cond_max: [1.0, 89.0],
+        hidden: [5, 0, 0],
+        activation: 1,
+        lattice_generator: 5,
+        reserved: [0; 3],
+    };
+    let params = (0..info.shape().unwrap().param_len())
+        .map(|j| f16_encode(((j * 37 % 101) as f32 - 50.0) / 60.0))
+        .collect();
+    let table = (0..info.point_table_len().unwrap() as u32)
+        .map(|e| e.wrapping_mul(0x9e37_79b9))
+        .collect();
+    let weights = vec![1.0, 0.9, 1.1, 0.95, 1.3, 1.05];
+    let parts = ConditionalParts {
+        info,
+        params,
+        table,
+        weights,
+    };
+    let meta = nuld_core::blob::Metadata {
+        generator: "cli-test",
+        target: "brdf",
+        seed: 0,
+    };
+    parts.write_blob(path, &meta).unwrap();
+}
+
+#[test]
+fn sample_prints_what_the_runtime_serves_and_rejects_bad_input() {
+    use nuld_runtime::glam::Vec2;
+    let dir = scratch("sample");
+    let file = dir.join("brdf.nuld");
+    conditional_blob(&file);
+    let bytes = AlignedBytes::read(&file).unwrap();
+    let cs = Blob::parse(bytes.as_slice())
+        .unwrap()
+        .conditional()
+        .unwrap();
+    for (mode, instance) in [("table", "4"), ("network", "123456")] {
+        let out = build_tool()
+            .arg("sample")
+            .arg(&file)
+            .args([
+                "--cond",
+                "0.35,47.5",
+                "--instance",
+                instance,
+                "--mode",
+                mode,
+            ])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let csv = String::from_utf8(out.stdout).unwrap();
+        let mut lines = csv.lines();
+        assert_eq!(lines.next(), Some("index,x,y,z,weight"));
+        let rows: Vec<Vec<f32>> = lines
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect();
+        assert_eq!(rows.len(), 6);
+        let c = Vec2::new(0.35, 47.5);
+        let k: u32 = instance.parse().unwrap();
+        for (i, row) in rows.iter().enumerate() {
+            let s = match mode {
+                "table" => cs.sample(c, k, i as u32),
+                _ => cs.sample_network(c, k, i as u32),
+            };
+            let want = [
+                i as f32,
+                s.direction.x,
+                s.direction.y,
+                s.direction.z,
+                s.weight,
+            ];
+            assert_eq!(row.as_slice(), want.as_slice(), "{mode} {i}");
+        }
+    }
+    // The default mode is table mode, the default instance 0.
+    let out = build_tool()
+        .arg("sample")
+        .arg(&file)
+        .args(["--cond", "2,-10"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let first = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .nth(1)
+        .unwrap()
+        .to_string();
+    let s = cs.sample(Vec2::new(1.0, 0.0), 0, 0);
+    let d = s.direction;
+    assert_eq!(first, format!("0,{},{},{},{}", d.x, d.y, d.z, s.weight));
+
+    let sobol = dir.join("sobol.nuld");
+    let st = build_tool()
+        .args(["sobol", "--n", "8", "--out"])
+        .arg(&sobol)
+        .status()
+        .unwrap();
+    assert!(st.success());
+    for (target, cond) in [
+        (&sobol, "0.5,30"),
+        (&file, "0.5"),
+        (&file, "abc,30"),
+        (&file, "0.5,inf"),
+        (&file, "0.5,30,2"),
+    ] {
+        let out = build_tool()
+            .arg("sample")
+            .arg(target)
+            .args(["--cond", cond])
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{cond}");
+        assert!(out.stdout.is_empty(), "{cond}");
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert!(!err.trim().is_empty(), "{cond}");
+        if cond == "0.5,30" {
+            assert_eq!(err.trim().lines().count(), 1, "{err}");
+            assert!(err.contains("not Conditional"), "{err}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -151,8 +151,8 @@ pub struct Metadata<'a> {
 
 /// Everything that can be wrong with a blob: one variant per failed check, carrying
 /// the numbers that failed it. [`Layout::read`] produces the variants up to
-/// [`BlobError::SectionsOverlap`]; the kind, metadata and point-set variants come
-/// from the runtime's `Blob::parse`, the last two from [`write`].
+/// [`BlobError::SectionsOverlap`]; the kind, metadata, point-set and conditional
+/// variants come from the runtime's `Blob::parse`, the last two from [`write`].
 ///
 /// `Display` writes one line; the type implements [`core::error::Error`], so `?`
 /// converts it into `Box<dyn std::error::Error>` or `anyhow::Error`.
@@ -300,6 +300,102 @@ pub enum BlobError {
         /// Bytes present.
         got: u64,
     },
+    /// The [`SectionTag::ConditionalInfo`] section is not one
+    /// [`crate::conditional::ConditionalInfo`] long.
+    ConditionalInfoSize {
+        /// Its length in bytes.
+        got: u64,
+        /// [`crate::conditional::CONDITIONAL_INFO_LEN`].
+        expected: u64,
+    },
+    /// The conditional info's `n` (points per set) is zero.
+    ConditionalNoPoints,
+    /// The conditional info's `instances` is zero.
+    ConditionalNoInstances,
+    /// The conditional info's domain code is not [`Domain::Sphere`] or
+    /// [`Domain::Hemisphere`].
+    ConditionalDomain(u32),
+    /// The conditional info's target is not a
+    /// [`crate::conditional::ConditionalTarget`] code.
+    UnknownConditionalTarget(u32),
+    /// A point-table grid axis has fewer than 2 nodes.
+    ConditionalGrid {
+        /// The axis (0 or 1).
+        axis: u32,
+        /// Its node count.
+        nodes: u32,
+    },
+    /// A weight-table grid axis has fewer than 2 nodes.
+    ConditionalWeightGrid {
+        /// The axis (0 or 1).
+        axis: u32,
+        /// Its node count.
+        nodes: u32,
+    },
+    /// A condition axis' range is not finite with `cond_min < cond_max` (the bounds
+    /// are carried as `f32` bits so the error stays `Eq`).
+    ConditionalRange {
+        /// The axis (0 or 1).
+        axis: u32,
+        /// `f32::to_bits` of `cond_min`.
+        min_bits: u32,
+        /// `f32::to_bits` of `cond_max`.
+        max_bits: u32,
+    },
+    /// The conditional info's activation is not a
+    /// [`crate::network::Activation`] code.
+    UnknownActivation(u32),
+    /// The hidden widths describe no [`crate::network::Shape`]: no first layer, a
+    /// width above [`crate::network::MAX_WIDTH`], or a non-zero width after a zero.
+    NetworkWidths([u32; 3]),
+    /// A reserved field of the conditional info is not zero.
+    ConditionalReserved([u32; 3]),
+    /// The [`SectionTag::NetworkParams`] elements are not 2 bytes (f16).
+    ParamElementSize(u32),
+    /// The [`SectionTag::NetworkParams`] section does not hold exactly
+    /// `Shape::param_len` entries.
+    ParamsLength {
+        /// Entries the shape calls for.
+        expected: u64,
+        /// Entries present.
+        got: u64,
+    },
+    /// A network parameter is an f16 infinity or NaN.
+    NonFiniteParam {
+        /// Its index in the parameter array.
+        index: u64,
+        /// Its f16 bits.
+        bits: u16,
+    },
+    /// The [`SectionTag::PointTable`] elements are not 4 bytes (2 x u16).
+    PointTableElementSize(u32),
+    /// `grid[0] grid[1] instances n` overflows `u64`.
+    PointTableCountOverflow,
+    /// The [`SectionTag::PointTable`] section does not hold exactly
+    /// `grid[0] grid[1] instances n` entries.
+    PointTableLength {
+        /// Entries the counts call for.
+        expected: u64,
+        /// Entries present.
+        got: u64,
+    },
+    /// The [`SectionTag::WeightTable`] elements are not 4 bytes (f32).
+    WeightElementSize(u32),
+    /// The [`SectionTag::WeightTable`] section does not hold exactly
+    /// `weight_grid[0] weight_grid[1]` entries.
+    WeightTableLength {
+        /// Entries the grid calls for.
+        expected: u64,
+        /// Entries present.
+        got: u64,
+    },
+    /// A weight is negative, infinite or NaN.
+    BadWeight {
+        /// Its index in the weight table.
+        index: u64,
+        /// Its `f32` bits.
+        bits: u32,
+    },
     /// The blob holds something other than what was asked for.
     WrongKind {
         /// The kind asked for.
@@ -408,6 +504,82 @@ impl core::fmt::Display for BlobError {
             Self::PointsLength { expected, got } => write!(
                 f,
                 "blob points section is {got} bytes, the counts call for {expected}"
+            ),
+            Self::ConditionalInfoSize { got, expected } => write!(
+                f,
+                "blob conditional info section is {got} bytes, not {expected}"
+            ),
+            Self::ConditionalNoPoints => write!(f, "blob conditional sampler has 0 points per set"),
+            Self::ConditionalNoInstances => write!(f, "blob conditional sampler has 0 instances"),
+            Self::ConditionalDomain(d) => write!(
+                f,
+                "blob conditional domain code {d} is neither the sphere (1) nor the hemisphere (2)"
+            ),
+            Self::UnknownConditionalTarget(t) => {
+                write!(f, "unknown blob conditional target code {t}")
+            }
+            Self::ConditionalGrid { axis, nodes } => write!(
+                f,
+                "blob point-table grid axis {axis} has {nodes} nodes, needs at least 2"
+            ),
+            Self::ConditionalWeightGrid { axis, nodes } => write!(
+                f,
+                "blob weight-table grid axis {axis} has {nodes} nodes, needs at least 2"
+            ),
+            Self::ConditionalRange {
+                axis,
+                min_bits,
+                max_bits,
+            } => write!(
+                f,
+                "blob condition axis {axis} range [{}, {}] is not finite with min < max",
+                f32::from_bits(min_bits),
+                f32::from_bits(max_bits)
+            ),
+            Self::UnknownActivation(a) => write!(f, "unknown blob network activation code {a}"),
+            Self::NetworkWidths(h) => write!(
+                f,
+                "blob network hidden widths {h:?} are not 1 to 3 layers of 1 to {} units",
+                crate::network::MAX_WIDTH
+            ),
+            Self::ConditionalReserved(r) => {
+                write!(f, "blob conditional info reserved fields {r:?} are not zero")
+            }
+            Self::ParamElementSize(s) => write!(
+                f,
+                "blob network parameters have {s}-byte elements, not 2 (f16)"
+            ),
+            Self::ParamsLength { expected, got } => write!(
+                f,
+                "blob network has {got} parameters, its shape calls for {expected}"
+            ),
+            Self::NonFiniteParam { index, bits } => write!(
+                f,
+                "blob network parameter {index} is not finite (f16 bits {bits:#06x})"
+            ),
+            Self::PointTableElementSize(s) => write!(
+                f,
+                "blob point table has {s}-byte elements, not 4 (2 x u16)"
+            ),
+            Self::PointTableCountOverflow => {
+                write!(f, "blob point-table size grid x instances x n overflows u64")
+            }
+            Self::PointTableLength { expected, got } => write!(
+                f,
+                "blob point table has {got} entries, the counts call for {expected}"
+            ),
+            Self::WeightElementSize(s) => write!(
+                f,
+                "blob weight table has {s}-byte elements, not 4 (f32)"
+            ),
+            Self::WeightTableLength { expected, got } => write!(
+                f,
+                "blob weight table has {got} entries, the grid calls for {expected}"
+            ),
+            Self::BadWeight { index, bits } => write!(
+                f,
+                "blob weight {index} is {}, not finite and >= 0",
+                f32::from_bits(bits)
             ),
             Self::WrongKind { expected, found } => {
                 write!(f, "blob holds {found:?}, not {expected:?}")

@@ -5,8 +5,10 @@
 //! domain names the equal-area map ([`crate::sphere`]) that turns them into unit
 //! vectors. Blobs record the domain by its code ([`Domain::from_code`]).
 
+use crate::real::Real;
 use crate::sphere::{
-    hemisphere_to_square, sphere_to_square, square_to_hemisphere, square_to_sphere,
+    hemisphere_to_square, sphere_to_square, square_to_hemisphere, square_to_hemisphere_real,
+    square_to_sphere, square_to_sphere_real,
 };
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
@@ -68,6 +70,22 @@ impl Domain {
         }
     }
 
+    /// [`Domain::to_direction`] in any [`Real`] precision on plain arrays
+    /// ([`square_to_hemisphere_real`] or [`square_to_sphere_real`]): what the
+    /// runtime's conditional sampler evaluates in `f32`. `O(1)`, never panics.
+    ///
+    /// ```
+    /// # use nuld_core::domain::Domain;
+    /// assert_eq!(Domain::Hemisphere.to_direction_real([0.5f32, 0.5]), [0.0, 0.0, 1.0]);
+    /// ```
+    #[inline]
+    pub fn to_direction_real<T: Real>(self, p: [T; 2]) -> [T; 3] {
+        match self {
+            Self::Hemisphere => square_to_hemisphere_real(p),
+            Self::Sphere | Self::Square => square_to_sphere_real(p),
+        }
+    }
+
     /// Inverse of [`Domain::to_direction`]: the square point of the unit direction
     /// `d` ([`hemisphere_to_square`], which mirrors `z < 0` to `|z|`, or
     /// [`sphere_to_square`]). `O(1)`, never panics.
@@ -102,6 +120,10 @@ mod tests {
         for d in [Domain::Sphere, Domain::Hemisphere] {
             let q = d.to_square(d.to_direction(p));
             assert!((p - q).length() < 1e-12, "{d:?}: {q:?}");
+            assert_eq!(
+                DVec3::from(d.to_direction_real([p.x, p.y])),
+                d.to_direction(p)
+            );
         }
     }
 }

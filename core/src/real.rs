@@ -50,6 +50,9 @@ pub trait Real:
     fn floor(self) -> Self;
     /// `e^self`.
     fn exp(self) -> Self;
+    /// `self` with the sign bit of `sign` (IEEE 754 `copySign`; `-0.0` and negative
+    /// NaNs count as negative).
+    fn copysign(self, sign: Self) -> Self;
     /// The value as `f64` (exact).
     fn to_f64(self) -> f64;
 }
@@ -101,6 +104,10 @@ impl Real for f64 {
     #[inline]
     fn exp(self) -> Self {
         libm::exp(self)
+    }
+    #[inline]
+    fn copysign(self, sign: Self) -> Self {
+        libm::copysign(self, sign)
     }
     #[inline]
     fn to_f64(self) -> f64 {
@@ -155,6 +162,10 @@ impl Real for f32 {
     #[inline]
     fn exp(self) -> Self {
         libm::expf(self)
+    }
+    #[inline]
+    fn copysign(self, sign: Self) -> Self {
+        libm::copysignf(self, sign)
     }
     #[inline]
     fn to_f64(self) -> f64 {

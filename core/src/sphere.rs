@@ -7,8 +7,12 @@
 //! * [`square_to_sphere`]: `pdf_sphere = pdf_square / (4 pi)`;
 //! * [`square_to_hemisphere`]: `pdf_hemisphere = pdf_square / (2 pi)`.
 //!
-//! Everything is computed in `f64`; the runtime converts the result to `f32` once.
+//! The `DVec` maps compute in `f64`; [`square_to_sphere_real`] and
+//! [`square_to_hemisphere_real`] are the same formulas in any [`Real`] precision
+//! (the `f64` maps call them), which the runtime's conditional sampler evaluates in
+//! `f32`, as a shader does.
 
+use crate::real::Real;
 use crate::warp::{concentric_polar, concentric_polar_inverse, safe_sqrt};
 use core::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 use glam::{DVec2, DVec3};
@@ -25,19 +29,40 @@ use glam::{DVec2, DVec3};
 /// assert_eq!(square_to_sphere(DVec2::new(0.5, 0.5)), DVec3::Z);
 /// ```
 pub fn square_to_sphere(p: DVec2) -> DVec3 {
-    let u = 2.0 * p.x - 1.0;
-    let v = 2.0 * p.y - 1.0;
+    DVec3::from(square_to_sphere_real([p.x, p.y]))
+}
+
+/// [`square_to_sphere`] in any [`Real`] precision, on plain arrays: the one formula
+/// the `f64` map and the runtime's `f32` map (and shaders, in the same order of
+/// operations) evaluate. With `u = 2 p.x - 1`, `v = 2 p.y - 1`,
+/// `d = 1 - (|u| + |v|)`, `r = 1 - |d|`, `phi = ((|v| - |u|) / r + 1) pi/4` (`pi/4`
+/// when `r = 0`):
+/// `(copysign(cos phi, u) s, copysign(sin phi, v) s, copysign(1 - r^2, d))` with
+/// `s = r sqrt(max(2 - r^2, 0))`. Total; NaN in, NaN out.
+///
+/// ```
+/// # use nuld_core::sphere::square_to_sphere_real;
+/// assert_eq!(square_to_sphere_real([0.5f32, 0.5]), [0.0, 0.0, 1.0]);
+/// ```
+pub fn square_to_sphere_real<T: Real>(p: [T; 2]) -> [T; 3] {
+    let two = T::of(2.0);
+    let u = two * p[0] - T::ONE;
+    let v = two * p[1] - T::ONE;
     let up = u.abs();
     let vp = v.abs();
-    let signed_distance = 1.0 - (up + vp);
+    let signed_distance = T::ONE - (up + vp);
     let d = signed_distance.abs();
-    let r = 1.0 - d;
-    let phi = if r == 0.0 { 1.0 } else { (vp - up) / r + 1.0 } * FRAC_PI_4;
-    let z = libm::copysign(1.0 - r * r, signed_distance);
-    let cos_phi = libm::copysign(libm::cos(phi), u);
-    let sin_phi = libm::copysign(libm::sin(phi), v);
-    let s = r * safe_sqrt(2.0 - r * r);
-    DVec3::new(cos_phi * s, sin_phi * s, z)
+    let r = T::ONE - d;
+    let phi = if r == T::ZERO {
+        T::ONE
+    } else {
+        (vp - up) / r + T::ONE
+    } * T::of(FRAC_PI_4);
+    let z = (T::ONE - r * r).copysign(signed_distance);
+    let cos_phi = phi.cos().copysign(u);
+    let sin_phi = phi.sin().copysign(v);
+    let s = r * (two - r * r).max(T::ZERO).sqrt();
+    [cos_phi * s, sin_phi * s, z]
 }
 
 /// Inverse of [`square_to_sphere`]: a unit vector to its point in `[0,1]^2`.
@@ -117,12 +142,30 @@ pub fn wrap_octahedral(mut p: DVec2) -> DVec2 {
 /// assert!((e - DVec3::X).length() < 1e-12);
 /// ```
 pub fn square_to_hemisphere(p: DVec2) -> DVec3 {
+    DVec3::from(square_to_hemisphere_real([p.x, p.y]))
+}
+
+/// [`square_to_hemisphere`] in any [`Real`] precision, on plain arrays: the one
+/// formula the `f64` map and the runtime's `f32` map (and shaders, in the same order
+/// of operations) evaluate. With the concentric map's signed polar form
+/// `a = 2 p.x - 1`, `b = 2 p.y - 1`; `(r, theta) = (a, pi/4 (b / a))` if `|a| > |b|`,
+/// else `(b, pi/2 - pi/4 (a / b))`: `(s cos theta, s sin theta, 1 - r^2)` with
+/// `s = r sqrt(max(2 - r^2, 0))`, and `+z` at the centre `a = b = 0`. Total; NaN in,
+/// NaN out.
+///
+/// ```
+/// # use nuld_core::sphere::square_to_hemisphere_real;
+/// assert_eq!(square_to_hemisphere_real([0.5f32, 0.5]), [0.0, 0.0, 1.0]);
+/// let e = square_to_hemisphere_real([1.0f32, 0.5]);
+/// assert!((e[0] - 1.0).abs() < 1e-6 && e[1].abs() < 1e-6 && e[2].abs() < 1e-6);
+/// ```
+pub fn square_to_hemisphere_real<T: Real>(p: [T; 2]) -> [T; 3] {
     let Some((r, theta)) = concentric_polar(p) else {
-        return DVec3::Z;
+        return [T::ZERO, T::ZERO, T::ONE];
     };
     let r2 = r * r;
-    let s = r * safe_sqrt(2.0 - r2);
-    DVec3::new(s * libm::cos(theta), s * libm::sin(theta), 1.0 - r2)
+    let s = r * (T::of(2.0) - r2).max(T::ZERO).sqrt();
+    [s * theta.cos(), s * theta.sin(), T::ONE - r2]
 }
 
 /// Inverse of [`square_to_hemisphere`]. Directions below the horizon are mirrored
@@ -241,6 +284,24 @@ mod tests {
             let got = square_to_hemisphere(DVec2::from(p));
             assert!((got - DVec3::from(d)).length() < 1e-12, "{p:?} -> {got:?}");
         }
+    }
+
+    /// The `f32` instantiation (the runtime's) stays within a few `f32` ulps of the
+    /// `f64` map, on both maps, over the whole square.
+    #[test]
+    fn f32_maps_follow_the_f64_maps() {
+        let mut worst: f64 = 0.0;
+        for p in grid(257) {
+            let q = [p.x as f32, p.y as f32];
+            let p = DVec2::new(q[0] as f64, q[1] as f64);
+            for (a, b) in [
+                (square_to_hemisphere_real(q), square_to_hemisphere(p)),
+                (square_to_sphere_real(q), square_to_sphere(p)),
+            ] {
+                worst = worst.max((DVec3::from(a.map(f64::from)) - b).length());
+            }
+        }
+        assert!(worst < 2e-6, "{worst}");
     }
 
     #[test]

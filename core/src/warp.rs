@@ -18,6 +18,7 @@
 //! does off its domain.
 
 use crate::brdf::{ggx_d, smith_g1};
+use crate::real::Real;
 use core::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
 use glam::{DVec2, DVec3};
 
@@ -36,18 +37,21 @@ pub const DISK_PDF: f64 = 1.0 / PI;
 /// Low Distortion Map Between Disk and Square", as pbrt-v4's `SampleUniformDiskConcentric`):
 /// the disk point is `r (cos theta, sin theta)`, `r` in `[-1, 1]`,
 /// `theta` in `[-pi/4, 3pi/4]`; `None` at the square's centre. Shared by
-/// [`square_to_disk`] and [`crate::sphere::square_to_hemisphere`], which lifts it.
+/// [`square_to_disk`] and [`crate::sphere::square_to_hemisphere_real`], which lifts
+/// it; generic so that the runtime evaluates the same formula in `f32`.
 #[inline]
-pub(crate) fn concentric_polar(u: DVec2) -> Option<(f64, f64)> {
-    let a = 2.0 * u.x - 1.0;
-    let b = 2.0 * u.y - 1.0;
-    if a == 0.0 && b == 0.0 {
+pub(crate) fn concentric_polar<T: Real>(u: [T; 2]) -> Option<(T, T)> {
+    let two = T::of(2.0);
+    let a = two * u[0] - T::ONE;
+    let b = two * u[1] - T::ONE;
+    if a == T::ZERO && b == T::ZERO {
         return None;
     }
+    let quarter_pi = T::of(FRAC_PI_4);
     Some(if a.abs() > b.abs() {
-        (a, FRAC_PI_4 * (b / a))
+        (a, quarter_pi * (b / a))
     } else {
-        (b, FRAC_PI_2 - FRAC_PI_4 * (a / b))
+        (b, T::of(FRAC_PI_2) - quarter_pi * (a / b))
     })
 }
 
@@ -86,7 +90,7 @@ pub(crate) fn concentric_polar_inverse(r: f64, mut phi: f64) -> DVec2 {
 /// assert!((c - DVec2::splat(core::f64::consts::FRAC_1_SQRT_2)).length() < 1e-15);
 /// ```
 pub fn square_to_disk(u: DVec2) -> DVec2 {
-    match concentric_polar(u) {
+    match concentric_polar([u.x, u.y]) {
         None => DVec2::ZERO,
         Some((r, theta)) => r * DVec2::new(libm::cos(theta), libm::sin(theta)),
     }

@@ -23,6 +23,30 @@
 //! # Ok::<(), nuld_runtime::BlobError>(())
 //! ```
 //!
+//! A conditional sampler ([`BlobKind::Conditional`], paper §4) serves, for a
+//! condition known only at run time, the directions of a low-discrepancy set and the
+//! estimator weight:
+//!
+//! ```
+//! use nuld_runtime::{Blob, glam::{Vec2, Vec3}};
+//! # let bytes = nuld_runtime::doc_example_conditional_blob();
+//! # let bytes: &[u8] = &bytes.0;
+//! let cs = Blob::parse(bytes)?.conditional()?;
+//! let (roughness, instance) = (0.4, 17); // instance: e.g. a hash of the pixel
+//! let wo = Vec3::new(0.3, 0.4, 0.866).normalize(); // view, local frame (z = normal)
+//! let mut estimate = 0.0;
+//! for i in 0..cs.len() {
+//!     let s = cs.sample_brdf(wo, roughness, instance, i); // table mode
+//!     assert!((s.direction.length() - 1.0).abs() < 1e-5 && s.direction.z >= 0.0);
+//!     let radiance = 1.0; // L(s.direction) in a renderer
+//!     estimate += s.weight * radiance / cs.len() as f32;
+//! }
+//! // Network mode: the same model evaluated per sample, any u32 instance.
+//! let s = cs.sample_network(Vec2::new(roughness, 30.0), instance, 0);
+//! assert!(estimate > 0.0 && s.weight > 0.0);
+//! # Ok::<(), nuld_runtime::BlobError>(())
+//! ```
+//!
 //! Where the bytes come from:
 //! * compiled in: [`include_blob!`] (no allocation; `runtime/examples/embed.rs`);
 //! * read at run time: `AlignedBuf` with the `alloc` feature, and
@@ -44,6 +68,7 @@ extern crate std;
 mod aligned;
 #[cfg(feature = "alloc")]
 mod aligned_buf;
+mod conditional;
 mod points;
 
 /// The `glam` this crate returns its vectors in; use it instead of a `glam`
@@ -53,7 +78,9 @@ pub use glam;
 pub use aligned::Aligned;
 #[cfg(feature = "alloc")]
 pub use aligned_buf::AlignedBuf;
+pub use conditional::{ConditionalSampler, Sample};
 pub use nuld_core::blob::{BlobError, BlobKind, Domain, Metadata};
+pub use nuld_core::conditional::{ConditionalInfo, ConditionalTarget};
 pub use points::{DirectionSet, PointSet2D};
 
 use nuld_core::blob::{Layout, PointSetInfo, SectionTag};
@@ -95,8 +122,9 @@ impl<'a> Blob<'a> {
             BlobKind::PointSet2D | BlobKind::DirectionSet => {
                 blob.points_view()?;
             }
-            // Validated by the conditional sampler view (issue 13, in progress).
-            BlobKind::Conditional => return Err(BlobError::UnknownKind(code)),
+            BlobKind::Conditional => {
+                ConditionalSampler::validate(&blob.layout)?;
+            }
         }
         Ok(blob)
     }
@@ -131,6 +159,15 @@ impl<'a> Blob<'a> {
             PointSet2D::new(coords, info.len, info.set_count),
             domain,
         ))
+    }
+
+    /// The conditional sampler of a [`BlobKind::Conditional`] blob (table and
+    /// network mode, see [`ConditionalSampler`]).
+    ///
+    /// Errors with [`BlobError::WrongKind`] for any other kind.
+    pub fn conditional(&self) -> Result<ConditionalSampler<'a>, BlobError> {
+        self.expect(BlobKind::Conditional)?;
+        ConditionalSampler::view(&self.layout)
     }
 
     fn expect(&self, expected: BlobKind) -> Result<(), BlobError> {
@@ -224,5 +261,67 @@ pub fn doc_example_blob() -> Aligned<[u8; 160]> {
     // array, which `write` checks (a mismatch would leave zeros and fail to parse).
     let mut out = Aligned([0u8; 160]);
     let _ = write(&mut out.0, BlobKind::PointSet2D, &meta, &sections);
+    out
+}
+
+/// A small valid conditional blob for the crate's documentation examples: `n = 2`,
+/// 2 instances, 2 x 2 grids over roughness `[0.1, 1]` x `theta_o` `[0°, 89°]`, a
+/// one-unit network.
+#[doc(hidden)]
+pub fn doc_example_conditional_blob() -> Aligned<[u8; 400]> {
+    use nuld_core::blob::{write, SectionSpec};
+    use nuld_core::conditional::{pack_point, CONDITIONAL_INFO_LEN};
+    let info = ConditionalInfo {
+        n: 2,
+        instances: 2,
+        domain: Domain::Hemisphere as u32,
+        target: ConditionalTarget::GltfBrdf as u32,
+        grid: [2, 2],
+        weight_grid: [2, 2],
+        cond_min: [0.1, 0.0],
+        cond_max: [1.0, 89.0],
+        hidden: [1, 0, 0],
+        activation: 0,
+        lattice_generator: 1,
+        reserved: [0; 3],
+    };
+    // 2 x 1 embedding, 1 x 11 + 1 first layer, 2 x 1 + 2 output: 18 parameters.
+    let params: [u16; 18] =
+        core::array::from_fn(|j| nuld_core::quantize::f16_encode((j as f32 - 8.0) / 8.0));
+    // [node][instance][index]: 4 nodes x 2 instances x 2 indices.
+    let table: [u32; 16] = core::array::from_fn(|e| {
+        let e = e as u32;
+        pack_point((e * 3_001 + 9_000) as u16, (60_000 - e * 2_503) as u16)
+    });
+    let weights: [f32; 4] = [1.0, 0.95, 1.2, 0.98];
+    let meta = [
+        3, b'd', b'o', b'c', 7, b'g', b'l', b't', b'f', b'-', b'd', b'o', 0,
+    ];
+    let sections = [
+        SectionSpec {
+            tag: SectionTag::ConditionalInfo,
+            elem_size: CONDITIONAL_INFO_LEN as u32,
+            bytes: bytemuck::bytes_of(&info),
+        },
+        SectionSpec {
+            tag: SectionTag::NetworkParams,
+            elem_size: 2,
+            bytes: bytemuck::cast_slice(&params),
+        },
+        SectionSpec {
+            tag: SectionTag::PointTable,
+            elem_size: 4,
+            bytes: bytemuck::cast_slice(&table),
+        },
+        SectionSpec {
+            tag: SectionTag::WeightTable,
+            elem_size: 4,
+            bytes: bytemuck::cast_slice(&weights),
+        },
+    ];
+    // 48 + 4 x 32 + 13 -> 192; info 80 -> 272; params 36 -> 320; table 64 -> 384;
+    // weights 16 -> 400 bytes: exactly the array, which `write` checks.
+    let mut out = Aligned([0u8; 400]);
+    let _ = write(&mut out.0, BlobKind::Conditional, &meta, &sections);
     out
 }

@@ -30,3 +30,18 @@ pub fn sobol_blob(domain: Domain, n: usize, sets: usize, seed: u64) -> (PointSet
     let bytes = ps.to_blob(&META).expect("encodable point sets");
     (ps, bytes)
 }
+
+/// A conditional sampler (kind 3) with random contents, as a stand-in for a trained
+/// one ([`nuld_build_tool::runtime_speed::random_parts`]; the benchmark times the
+/// same blobs).
+pub fn conditional_parts(
+    n: u32,
+    hidden: &[u32],
+    activation: nuld_core::network::Activation,
+    instances: u32,
+    grid: [u32; 2],
+    seed: u64,
+) -> nuld_build_tool::conditional::blob::ConditionalParts {
+    nuld_build_tool::runtime_speed::random_parts(n, hidden, activation, instances, grid, seed)
+        .expect("a valid fixture shape")
+}

@@ -4,11 +4,15 @@
 
 use nuld_build_tool::pointset::AlignedBytes;
 use nuld_core::blob::{
-    checksum, encoded_len, write, BlobError, Domain, SectionSpec, SectionTag, CHECKSUM_OFFSET,
-    MAX_SECTIONS,
+    checksum, encoded_len, write, BlobError, Domain, Layout, SectionSpec, SectionTag,
+    CHECKSUM_OFFSET, MAX_SECTIONS,
 };
+use nuld_core::conditional::CONDITIONAL_INFO_LEN;
+use nuld_core::network::Activation;
+use nuld_core::quantize::f16_decode;
+use nuld_runtime::glam::{Vec2, Vec3};
 use nuld_runtime::{Blob, BlobKind};
-use nuld_tests::sobol_blob;
+use nuld_tests::{conditional_parts, sobol_blob, META};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -31,9 +35,50 @@ fn parse_and_touch(bytes: &[u8]) -> Result<(), BlobError> {
                 assert!((v.length() - 1.0).abs() < 1e-5);
             }
         }
-        BlobKind::Conditional => unreachable!("Blob::parse does not accept conditional blobs yet"),
+        BlobKind::Conditional => {
+            let cs = blob.conditional()?;
+            let info = *cs.info();
+            // Every stored table entry (all grid nodes, instances, indices, plus one
+            // wrap each), and every index of the network at two instances.
+            let [g0, g1] = info.grid;
+            for j1 in 0..g1 {
+                for j0 in 0..g0 {
+                    let c = info.grid_condition([j0, j1]).map(|x| x as f32);
+                    let c = Vec2::from(c);
+                    for k in 0..=cs.instances() {
+                        for i in 0..=cs.len() {
+                            check_sample(cs.sample(c, k, i));
+                        }
+                    }
+                }
+            }
+            let c = Vec2::new(0.55, 33.0);
+            let wo = Vec3::new(-0.3, 0.5, 0.7);
+            for i in 0..=cs.len() {
+                for k in [0, u32::MAX] {
+                    check_sample(cs.sample_network(c, k, i));
+                    check_sample(cs.sample_brdf(wo, c.x, k, i));
+                    check_sample(cs.sample_brdf_network(wo, c.x, k, i));
+                }
+            }
+        }
     }
     Ok(())
+}
+
+/// A sample a parsed blob serves: a unit direction and a finite weight `>= 0`.
+fn check_sample(s: nuld_runtime::Sample) {
+    let d = s.direction;
+    assert!((d.length() - 1.0).abs() < 1e-5, "{d}");
+    assert!(s.weight.is_finite() && s.weight >= 0.0, "{}", s.weight);
+}
+
+/// A small conditional blob with random contents (n 4, hidden [3, 2], 2 instances,
+/// a 3 x 2 grid).
+fn conditional_blob() -> AlignedBytes {
+    conditional_parts(4, &[3, 2], Activation::Silu, 2, [3, 2], 5)
+        .to_blob(&META)
+        .unwrap()
 }
 
 fn valid_blobs() -> Vec<AlignedBytes> {
@@ -42,6 +87,7 @@ fn valid_blobs() -> Vec<AlignedBytes> {
         sobol_blob(Domain::Sphere, 16, 1, 2).1,
         sobol_blob(Domain::Hemisphere, 3, 3, 3).1,
         sobol_blob(Domain::Square, 200, 1, 4).1,
+        conditional_blob(),
     ]
 }
 
@@ -427,4 +473,176 @@ fn blob_errors_convert_into_boxed_std_errors_with_question_mark() {
     assert_eq!(e.to_string(), "not a nuld blob (bad magic)");
     let blob = sobol_blob(Domain::Square, 5, 1, 1).1;
     assert_eq!(len(blob.as_slice()).unwrap(), 5);
+}
+
+/// The info record's fields, read by offset.
+struct ConditionalFields {
+    n: u32,
+    instances: u32,
+    domain: u32,
+    target: u32,
+    grid: [u32; 2],
+    weight_grid: [u32; 2],
+    cond_min: [f32; 2],
+    cond_max: [f32; 2],
+    hidden: [u32; 3],
+    activation: u32,
+    reserved: [u32; 3],
+}
+
+/// What a parsed conditional blob promises (core/FORMAT.md, "Validation"), checked
+/// here from the raw sections by field offset with plain arithmetic, independently of the
+/// runtime's validation.
+fn conditional_semantics_hold(bytes: &[u8]) -> bool {
+    let Ok(layout) = Layout::read(bytes) else {
+        return false;
+    };
+    let section = |tag| layout.section(tag).ok();
+    let (Some((_, info)), Some((pe, params)), Some((te, table)), Some((we, weights))) = (
+        section(SectionTag::ConditionalInfo),
+        section(SectionTag::NetworkParams),
+        section(SectionTag::PointTable),
+        section(SectionTag::WeightTable),
+    ) else {
+        return false;
+    };
+    if info.len() != CONDITIONAL_INFO_LEN {
+        return false;
+    }
+    // The info record's fields at their core/FORMAT.md offsets.
+    let word = |at: usize| u32::from_le_bytes(info[at..at + 4].try_into().unwrap());
+    let real = |at: usize| f32::from_bits(word(at));
+    let info = ConditionalFields {
+        n: word(0),
+        instances: word(4),
+        domain: word(8),
+        target: word(12),
+        grid: [word(16), word(20)],
+        weight_grid: [word(24), word(28)],
+        cond_min: [real(32), real(36)],
+        cond_max: [real(40), real(44)],
+        hidden: [word(48), word(52), word(56)],
+        activation: word(60),
+        reserved: [word(68), word(72), word(76)],
+    };
+    let h = info.hidden;
+    let layers = h.iter().take_while(|&&w| w > 0).count();
+    let widths_ok =
+        layers >= 1 && h[layers..].iter().all(|&w| w == 0) && h.iter().all(|&w| w <= 128);
+    let ranges_ok = (0..2).all(|a| {
+        let (lo, hi) = (info.cond_min[a], info.cond_max[a]);
+        lo.is_finite() && hi.is_finite() && lo < hi
+    });
+    if !(info.n >= 1
+        && info.instances >= 1
+        && (info.domain == 1 || info.domain == 2)
+        && info.target == 1
+        && info.grid.iter().chain(&info.weight_grid).all(|&g| g >= 2)
+        && ranges_ok
+        && info.activation <= 1
+        && widths_ok
+        && info.reserved == [0; 3])
+    {
+        return false;
+    }
+    // n h1 + sum over layers (out (in + 1)) + 2 (last + 1), inputs 11.
+    let mut expected_params = info.n as u128 * h[0] as u128;
+    let mut fan_in = 11u128;
+    for &w in &h[..layers] {
+        expected_params += w as u128 * (fan_in + 1);
+        fan_in = w as u128;
+    }
+    expected_params += 2 * (fan_in + 1);
+    let table_len =
+        info.grid[0] as u128 * info.grid[1] as u128 * info.instances as u128 * info.n as u128;
+    let weight_len = info.weight_grid[0] as u128 * info.weight_grid[1] as u128;
+    pe.elem_size == 2
+        && te.elem_size == 4
+        && we.elem_size == 4
+        && params.len() as u128 == 2 * expected_params
+        && table.len() as u128 == 4 * table_len
+        && weights.len() as u128 == 4 * weight_len
+        && params
+            .chunks_exact(2)
+            .all(|b| f16_decode(u16::from_le_bytes([b[0], b[1]])).is_finite())
+        && weights.chunks_exact(4).all(|b| {
+            let w = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+            w.is_finite() && w >= 0.0
+        })
+}
+
+/// 100k mutations of a conditional blob: byte changes and truncations (the
+/// checksum or the length check must refuse them), and byte changes with the
+/// checksum recomputed, anywhere in the blob, so that the semantic checks are what
+/// stands. Nothing panics; whatever parses satisfies the validated semantics
+/// (checked independently) and serves only unit directions and finite weights.
+#[test]
+fn conditional_blob_mutations_are_rejected_or_harmless() {
+    let blob = conditional_blob();
+    let valid = blob.as_slice();
+    assert!(conditional_semantics_hold(valid));
+    parse_and_touch(valid).unwrap();
+    let mut rng = Pcg64Mcg::seed_from_u64(13);
+    let n = valid.len();
+    let (mut accepted, mut rejected_semantic) = (0, 0);
+    for case in 0..100_000 {
+        let mut copy = blob.clone();
+        let bytes = copy.as_mut_slice();
+        match case % 4 {
+            0 => {
+                let at = rng.random_range(0..n);
+                bytes[at] = bytes[at].wrapping_add(rng.random_range(1..=255));
+                assert!(parse_and_touch(bytes).is_err(), "case {case}");
+            }
+            1 => {
+                let cut = rng.random_range(0..n);
+                assert!(parse_and_touch(&bytes[..cut]).is_err(), "case {case}");
+            }
+            _ => {
+                for _ in 0..rng.random_range(1..4) {
+                    let at = loop {
+                        let at = rng.random_range(0..n);
+                        if !(CHECKSUM_OFFSET..CHECKSUM_OFFSET + 8).contains(&at) {
+                            break at;
+                        }
+                    };
+                    // Half the time a whole little-endian u32 (counts, codes, bits).
+                    if rng.random_bool(0.5) && at + 4 <= n {
+                        let v: u32 = match rng.random_range(0..4) {
+                            0 => rng.random_range(0..4),
+                            1 => u32::MAX - rng.random_range(0..4),
+                            2 => 0x7f80_0000 | rng.random_range(0..2) << 31,
+                            _ => rng.random(),
+                        };
+                        put_u32(bytes, at & !3, v);
+                    } else {
+                        bytes[at] = rng.random();
+                    }
+                }
+                let sum = checksum(bytes);
+                bytes[CHECKSUM_OFFSET..CHECKSUM_OFFSET + 8].copy_from_slice(&sum.to_le_bytes());
+                let semantics = conditional_semantics_hold(bytes);
+                match parse_and_touch(bytes) {
+                    Ok(()) => {
+                        accepted += 1;
+                        // Accepted as conditional: its semantics must hold.
+                        if Blob::parse(bytes).unwrap().kind() == BlobKind::Conditional {
+                            assert!(semantics, "case {case}: broken blob accepted");
+                        }
+                    }
+                    Err(_) => {
+                        if !semantics {
+                            rejected_semantic += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // Both outcomes happen: data bytes (codes, finite parameters) may change
+    // harmlessly, and many mutations break a count, code, range or value.
+    assert!(
+        accepted > 1000 && rejected_semantic > 1000,
+        "{accepted} {rejected_semantic}"
+    );
 }

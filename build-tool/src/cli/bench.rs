@@ -53,6 +53,9 @@ pub enum BenchPart {
     Directions,
     /// Only the baseline generators (milliseconds per set; not part of `all`).
     Baselines,
+    /// Only the runtime's conditional sampler against the incumbent warp
+    /// (nanoseconds per sample, one thread; not part of `all`).
+    Runtime,
 }
 
 fn direction_seconds_per_epoch(
@@ -150,7 +153,24 @@ pub fn run(a: BenchArgs) -> Result<()> {
         BenchPart::Square => run_square(&a),
         BenchPart::Directions => run_directions(&a),
         BenchPart::Baselines => run_baselines(&a),
+        BenchPart::Runtime => run_runtime(),
     }
+}
+
+/// Samples timed per method (a tenth of it in network mode).
+const RUNTIME_SAMPLES: u32 = 2_000_000;
+
+/// Nanoseconds per sample of the conditional sampler's modes and of the incumbent,
+/// one thread, with each method's ratio to the incumbent (direction only).
+fn run_runtime() -> Result<()> {
+    let t = crate::runtime_speed::measure(RUNTIME_SAMPLES)?;
+    println!("runtime ns per sample, one thread, n = 64 (best of 3)");
+    println!("{:<44} {:>10} {:>12}", "method", "ns/sample", "/ incumbent");
+    let base = t.rows.first().map_or(f64::NAN, |r| r.1);
+    for (name, ns) in &t.rows {
+        println!("{name:<44} {ns:>10.1} {:>11.2}x", ns / base);
+    }
+    Ok(())
 }
 
 /// Sets timed per (baseline, size); the fastest is reported (the least disturbed

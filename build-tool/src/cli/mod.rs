@@ -5,6 +5,7 @@ pub mod eval;
 pub mod export;
 pub mod metrics;
 pub mod optimize;
+pub mod sample;
 pub mod sobol;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -26,6 +27,8 @@ pub enum Command {
     Sobol(sobol::SobolArgs),
     /// Print a blob's points as CSV: `set,index,x,y` (2D) or `set,index,x,y,z`.
     Export(export::ExportArgs),
+    /// Print a conditional blob's samples at one condition as CSV: `index,x,y,z,weight`.
+    Sample(sample::SampleArgs),
     /// Optimize point sets for a target density: DIR/set.nuld, report.json, set.png.
     Optimize(optimize::OptimizeArgs),
     /// Exact discrepancies of a blob's point sets against a target density.
@@ -79,6 +82,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Sobol(a) => sobol::run(a),
         Command::Export(a) => export::run(a),
+        Command::Sample(a) => sample::run(a),
         Command::Optimize(a) => optimize::run(a),
         Command::Metrics(a) => metrics::run(a),
         Command::Bench(a) => bench::run(a),

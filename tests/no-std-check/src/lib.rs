@@ -72,6 +72,44 @@ pub unsafe extern "C" fn nuld_check_direction(
     }
 }
 
+/// Writes sample `i` of instance `instance` of the conditional blob to
+/// `out[0..4]` (direction, weight) in the given mode: 0 table mode at
+/// `(c0, c1)`, 1 network mode at `(c0, c1)`, 2 `sample_brdf` with the view
+/// `(c1, 0, 1)` and roughness `c0`. Returns 0 on success, 1 otherwise.
+///
+/// # Safety
+/// `ptr` must be valid for `len` bytes and `out` for four `f32` writes.
+#[no_mangle]
+#[allow(clippy::too_many_arguments)] // a flat C signature
+pub unsafe extern "C" fn nuld_check_conditional(
+    ptr: *const u8,
+    len: usize,
+    mode: u32,
+    c0: f32,
+    c1: f32,
+    instance: u32,
+    i: u32,
+    out: *mut f32,
+) -> i32 {
+    use nuld_runtime::glam::{Vec2, Vec3};
+    let bytes = core::slice::from_raw_parts(ptr, len);
+    match Blob::parse(bytes).and_then(|b| b.conditional()) {
+        Ok(cs) => {
+            let s = match mode {
+                0 => cs.sample(Vec2::new(c0, c1), instance, i),
+                1 => cs.sample_network(Vec2::new(c0, c1), instance, i),
+                _ => cs.sample_brdf(Vec3::new(c1, 0.0, 1.0), c0, instance, i),
+            };
+            *out = s.direction.x;
+            *out.add(1) = s.direction.y;
+            *out.add(2) = s.direction.z;
+            *out.add(3) = s.weight;
+            0
+        }
+        Err(_) => 1,
+    }
+}
+
 /// Allocates, which a no-alloc build must refuse to link.
 #[cfg(feature = "leak-alloc")]
 #[no_mangle]

@@ -1,0 +1,204 @@
+//! The runtime's cost per sample (`build-tool bench --only runtime`): the
+//! conditional sampler's table and network modes against the incumbent a renderer
+//! would otherwise use, Owen-scrambled Sobol (`sobol_burley`) warped by the BRDF
+//! importance-sampling mixture (GGX visible normals with probability
+//! `p_s = A_spec / A`, else cosine; [`BrdfTarget`]'s warp).
+//!
+//! Speed does not depend on the network's or the table's values, so the samplers
+//! are timed on blobs with random contents ([`random_parts`]).
+
+use crate::conditional::blob::ConditionalParts;
+use crate::pointset::AlignedBytes;
+use crate::sphere::{BrdfTarget, DirectionDensity};
+use anyhow::{anyhow, Result};
+use glam::{DVec2, DVec3};
+use nuld_core::blob::{Domain, Metadata};
+use nuld_core::conditional::{ConditionalInfo, ConditionalTarget};
+use nuld_core::network::Activation;
+use nuld_runtime::glam::{Vec2, Vec3};
+use nuld_runtime::Blob;
+use rand::{Rng, SeedableRng};
+use std::hint::black_box;
+use std::time::Instant;
+
+/// A BRDF conditional sampler (hemisphere, roughness `[0.1, 1]` x `theta_o`
+/// `[0°, 89°]`) with random contents: `n` points, `instances` stored instances, a
+/// `grid` point table of random codes, a 7 x 9 weight table of weights in
+/// `[0.5, 1.6)`, and a network of the given hidden widths (1 to 3) with f16
+/// parameters uniform in `[-0.6, 0.6]`. Deterministic for a seed. Fails if the
+/// counts describe no valid network.
+pub fn random_parts(
+    n: u32,
+    hidden: &[u32],
+    activation: Activation,
+    instances: u32,
+    grid: [u32; 2],
+    seed: u64,
+) -> Result<ConditionalParts> {
+    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
+    let mut widths = [0u32; 3];
+    widths
+        .get_mut(..hidden.len())
+        .ok_or_else(|| anyhow!("{} hidden layers, at most 3", hidden.len()))?
+        .copy_from_slice(hidden);
+    let info = ConditionalInfo {
+        n,
+        instances,
+        domain: Domain::Hemisphere as u32,
+        target: ConditionalTarget::GltfBrdf as u32,
+        grid,
+        weight_grid: [7, 9],
+        cond_min: [0.1, 0.0],
+        cond_max: [1.0, 89.0],
+        hidden: widths,
+        activation: activation as u32,
+        // Odd: coprime to every power of two, so the lattice's second coordinate
+        // is a permutation for such n.
+        lattice_generator: (n / 3) | 1,
+        reserved: [0; 3],
+    };
+    let shape = info
+        .shape()
+        .ok_or_else(|| anyhow!("n {n}, hidden {hidden:?}: no valid network"))?;
+    let params = (0..shape.param_len())
+        .map(|_| nuld_core::quantize::f16_encode(rng.random_range(-0.6f32..=0.6)))
+        .collect();
+    let table_len = info
+        .point_table_len()
+        .ok_or_else(|| anyhow!("point table size overflows"))?;
+    let table = (0..table_len).map(|_| rng.random()).collect();
+    let weights = (0..info.weight_table_len())
+        .map(|_| rng.random_range(0.5f32..1.6))
+        .collect();
+    Ok(ConditionalParts {
+        info,
+        params,
+        table,
+        weights,
+    })
+}
+
+fn sampler(b: &AlignedBytes) -> Result<nuld_runtime::ConditionalSampler<'_>> {
+    Blob::parse(b.as_slice())
+        .and_then(|b| b.conditional())
+        .map_err(|e| anyhow!("{e}"))
+}
+
+/// Nanoseconds per sample of each method, one thread.
+#[derive(Clone, Debug)]
+pub struct RuntimeTimings {
+    /// `(method, ns per sample)`, the incumbent first.
+    pub rows: Vec<(String, f64)>,
+}
+
+/// Conditions cycled through by every method: a renderer's shading points each
+/// have their own.
+const CONDITIONS: usize = 64;
+
+/// Times of each method are the best of this many repeats (the least disturbed by
+/// other work on the machine).
+const REPEATS: usize = 3;
+
+/// Best-of-[`REPEATS`] nanoseconds per call of `f(sample number)` over `count`
+/// calls.
+fn ns_per_sample(count: u32, mut f: impl FnMut(u32)) -> f64 {
+    let mut best = f64::INFINITY;
+    for _ in 0..REPEATS {
+        let t = Instant::now();
+        for s in 0..count {
+            f(black_box(s));
+        }
+        best = best.min(t.elapsed().as_secs_f64() * 1e9 / count as f64);
+    }
+    best
+}
+
+/// Times, one thread, `samples` samples per method (a tenth of it for network
+/// mode): the incumbent (direction only, and with its estimator weight
+/// `f cos / p` as a renderer needs it), table mode (`sample` and `sample_brdf`),
+/// and network mode at n 64 with hidden [32, 32] ReLU and [64, 64] SiLU. Every
+/// method cycles through the same [`CONDITIONS`] conditions, instance `s / n` and
+/// index `s mod n` for sample `s`; the incumbent's per-condition setup (its
+/// [`BrdfTarget`], albedos included) is done before timing, which favours it.
+pub fn measure(samples: u32) -> Result<RuntimeTimings> {
+    let n = 64u32;
+    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(1);
+    let conds: Vec<Vec2> = (0..CONDITIONS)
+        .map(|_| Vec2::new(rng.random_range(0.1..1.0), rng.random_range(0.0..89.0)))
+        .collect();
+    let views: Vec<Vec3> = conds
+        .iter()
+        .map(|c| {
+            let (t, phi) = (
+                c.y.to_radians(),
+                rng.random_range(0.0..std::f32::consts::TAU),
+            );
+            Vec3::new(t.sin() * phi.cos(), t.sin() * phi.sin(), t.cos())
+        })
+        .collect();
+    let targets = conds
+        .iter()
+        .map(|c| BrdfTarget::new(c.x as f64, c.y as f64, Domain::Hemisphere))
+        .collect::<Result<Vec<_>, _>>()?;
+    let meta = Metadata {
+        generator: "bench",
+        target: "random",
+        seed: 0,
+    };
+    let blob = |hidden: &[u32], act| -> Result<AlignedBytes> {
+        random_parts(n, hidden, act, 16, [10, 9], 2)?.to_blob(&meta)
+    };
+    let (relu, silu) = (
+        blob(&[32, 32], Activation::Relu)?,
+        blob(&[64, 64], Activation::Silu)?,
+    );
+    let (relu, silu) = (sampler(&relu)?, sampler(&silu)?);
+    let at = |s: u32| (s as usize / n as usize) % CONDITIONS;
+    let mut rows = Vec::new();
+
+    let incumbent_u = |s: u32| {
+        let seed = nuld_core::network::hash_u32(s / n);
+        DVec2::new(
+            sobol_burley::sample(s % n, 0, seed) as f64,
+            sobol_burley::sample(s % n, 1, seed) as f64,
+        )
+    };
+    rows.push((
+        "incumbent: owen-sobol + mixture warp (f64)".into(),
+        ns_per_sample(samples, |s| {
+            black_box(targets[at(s)].sample(incumbent_u(s)));
+        }),
+    ));
+    rows.push((
+        "incumbent + weight f cos / p (f64)".into(),
+        ns_per_sample(samples, |s| {
+            let t = &targets[at(s)];
+            let d: DVec3 = t.sample(incumbent_u(s));
+            black_box((d, t.pdf(d) * t.albedo() / t.sample_pdf(d)));
+        }),
+    ));
+    rows.push((
+        "table: sample".into(),
+        ns_per_sample(samples, |s| {
+            black_box(relu.sample(conds[at(s)], s / n, s % n));
+        }),
+    ));
+    rows.push((
+        "table: sample_brdf".into(),
+        ns_per_sample(samples, |s| {
+            black_box(relu.sample_brdf(views[at(s)], conds[at(s)].x, s / n, s % n));
+        }),
+    ));
+    for (name, cs) in [
+        ("network [32,32] relu", &relu),
+        ("network [64,64] silu", &silu),
+    ] {
+        rows.push((
+            format!("{name}: sample_network"),
+            ns_per_sample(samples / 10, |s| {
+                black_box(cs.sample_network(conds[at(s)], s / n, s % n));
+            }),
+        ));
+    }
+    Ok(RuntimeTimings { rows })
+}
