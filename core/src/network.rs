@@ -36,6 +36,7 @@
 //! indices wrap modulo `n`, and a shape that does not fit [`MAX_WIDTH`] /
 //! [`MAX_HIDDEN_LAYERS`] is rejected by [`Shape::new`].
 
+use crate::quantize::f16_decode_finite;
 use crate::real::Real;
 
 /// Number of input features of the network: 5 of the condition, 2 of the instance
@@ -222,67 +223,205 @@ impl<T: Real> Trace<T> {
     }
 }
 
-/// A network: a [`Shape`] and a way to read parameter `j` as `T` (an `f64` slice in
-/// the trainer, f16 bits decoded to `f32` in the runtime).
+/// Read access to a network's flat parameter array as `T`: an `f64` slice in the
+/// trainer, f16 bits decoded to `f32` in the runtime ([`F16Params`]). Reads past
+/// the end give 0 (never a panic).
+pub trait Parameters<T> {
+    /// Parameter `j`.
+    fn get(&self, j: usize) -> T;
+    /// Parameters `start..start + out.len()` into `out`.
+    fn read(&self, start: usize, out: &mut [T]);
+}
+
+impl<T: Real> Parameters<T> for &[T] {
+    #[inline]
+    fn get(&self, j: usize) -> T {
+        <[T]>::get(self, j).copied().unwrap_or(T::ZERO)
+    }
+    #[inline]
+    fn read(&self, start: usize, out: &mut [T]) {
+        match start
+            .checked_add(out.len())
+            .and_then(|end| <[T]>::get(self, start..end))
+        {
+            Some(src) => out.copy_from_slice(src),
+            None => out.iter_mut().enumerate().for_each(|(k, o)| {
+                *o = Parameters::get(self, start.saturating_add(k));
+            }),
+        }
+    }
+}
+
+/// Parameters stored as IEEE binary16 bits, all finite (blobs are validated so),
+/// decoded exactly to `f32` by [`crate::quantize::f16_decode_finite`].
+#[derive(Clone, Copy, Debug)]
+pub struct F16Params<'a>(pub &'a [u16]);
+
+impl Parameters<f32> for F16Params<'_> {
+    #[inline]
+    fn get(&self, j: usize) -> f32 {
+        self.0.get(j).map_or(0.0, |&h| f16_decode_finite(h))
+    }
+    #[inline]
+    fn read(&self, start: usize, out: &mut [f32]) {
+        match start
+            .checked_add(out.len())
+            .and_then(|end| self.0.get(start..end))
+        {
+            // A plain loop over two slices: the compiler vectorizes the decode.
+            Some(src) => {
+                for (o, &h) in out.iter_mut().zip(src) {
+                    *o = f16_decode_finite(h);
+                }
+            }
+            None => out.iter_mut().enumerate().for_each(|(k, o)| {
+                *o = self.get(start.saturating_add(k));
+            }),
+        }
+    }
+}
+
+/// A network: a [`Shape`] and its [`Parameters`].
 #[derive(Clone, Copy, Debug)]
 pub struct Network<W> {
     /// The architecture.
     pub shape: Shape,
-    /// Parameter `j` of the flat layout in the module documentation.
+    /// The flat parameter array of the module documentation.
     pub params: W,
 }
 
 impl<W> Network<W> {
     /// Evaluates the network for index `i` (taken modulo `n`) on `input`
-    /// ([`input_features`]). `params(j)` must be defined for `j < param_len()`;
-    /// `O(multiply_adds)`, no allocation.
+    /// ([`input_features`]) and records what a backward pass needs. `params(j)` must
+    /// exist for `j < param_len()` (missing ones read as 0); `O(multiply_adds)`, no allocation.
     #[inline]
     pub fn forward<T: Real>(&self, i: u32, input: [T; INPUTS]) -> Trace<T>
     where
-        W: Fn(usize) -> T,
+        W: Parameters<T>,
+    {
+        let mut pre = [[T::ZERO; MAX_WIDTH]; MAX_HIDDEN_LAYERS];
+        let output = self.run(i, &input, |l, o, z| {
+            if let Some(slot) = pre.get_mut(l).and_then(|p| p.get_mut(o)) {
+                *slot = z;
+            }
+        });
+        Trace { input, pre, output }
+    }
+
+    /// The two outputs before the sigmoid, as [`Network::forward`] computes them
+    /// (the same operations in the same order, hence the same bits) without
+    /// recording a [`Trace`]: what samplers call.
+    #[inline]
+    pub fn evaluate<T: Real>(&self, i: u32, input: [T; INPUTS]) -> [T; OUTPUTS]
+    where
+        W: Parameters<T>,
+    {
+        self.run(i, &input, |_, _, _| {})
+    }
+
+    /// The point of the unit square: `sigmoid` of each output of
+    /// [`Network::evaluate`].
+    #[inline]
+    pub fn square_point<T: Real>(&self, i: u32, input: [T; INPUTS]) -> [T; 2]
+    where
+        W: Parameters<T>,
+    {
+        self.evaluate(i, input).map(sigmoid)
+    }
+
+    /// The forward pass, in this order of operations (which readers in other
+    /// languages reproduce): per unit `acc = b[o]`, then `acc += E[i][o]` in the
+    /// first hidden layer, then `acc += W[o][k] x[k]` for `k` ascending.
+    /// `record(layer, unit, pre_activation)` sees every hidden pre-activation.
+    #[inline(always)]
+    fn run<T: Real>(
+        &self,
+        i: u32,
+        input: &[T; INPUTS],
+        mut record: impl FnMut(usize, usize, T),
+    ) -> [T; OUTPUTS]
+    where
+        W: Parameters<T>,
     {
         let shape = &self.shape;
         let w = &self.params;
         let act = shape.activation;
-        let mut trace = Trace {
-            input,
-            pre: [[T::ZERO; MAX_WIDTH]; MAX_HIDDEN_LAYERS],
-            output: [T::ZERO; OUTPUTS],
-        };
+        // Two buffers used in turn as a layer's input and output.
         let mut a = [T::ZERO; MAX_WIDTH];
-        a[..INPUTS].copy_from_slice(&input);
+        let mut b = [T::ZERO; MAX_WIDTH];
+        a[..INPUTS].copy_from_slice(input);
         let mut fan_in = INPUTS;
         let mut off = shape.first_layer_offset();
+        let embedding = shape.embedding_offset(i);
         for (l, &h) in shape.hidden().iter().enumerate() {
             let h = h as usize;
             let bias = off + h * fan_in;
-            let mut next = [T::ZERO; MAX_WIDTH];
-            for (o, slot) in next.iter_mut().enumerate().take(h) {
-                let row = off + o * fan_in;
-                let mut acc = w(bias + o);
-                if l == 0 {
-                    acc = acc + w(shape.embedding_offset(i) + o);
-                }
-                for (k, &x) in a.iter().enumerate().take(fan_in) {
-                    acc = acc + w(row + k) * x;
-                }
-                trace.pre[l][o] = acc;
-                *slot = act.apply(acc);
-            }
-            a = next;
+            let first = (l == 0).then_some(embedding);
+            layer(w, off, bias, first, &a[..fan_in], &mut b[..h], |o, z| {
+                record(l, o, z);
+                act.apply(z)
+            });
+            core::mem::swap(&mut a, &mut b);
             off = bias + h;
             fan_in = h;
         }
+        let mut out = [T::ZERO; OUTPUTS];
         let bias = off + OUTPUTS * fan_in;
-        for o in 0..OUTPUTS {
-            let row = off + o * fan_in;
-            let mut acc = w(bias + o);
-            for (k, &x) in a.iter().enumerate().take(fan_in) {
-                acc = acc + w(row + k) * x;
-            }
-            trace.output[o] = acc;
+        layer(w, off, bias, None, &a[..fan_in], &mut out, |_, z| z);
+        out
+    }
+}
+
+/// Partial sums of [`dot`]: products `k ≡ c (mod DOT_LANES)` go to partial `c`,
+/// so the sum is a fixed tree that compilers turn into SIMD, and is the same on
+/// every platform.
+const DOT_LANES: usize = 8;
+
+/// `sum_k w[k] x[k]` over the shorter length, in this order of operations: partial
+/// sums `s[c] = sum over k ≡ c (mod 8), k ascending`, then
+/// `((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7))`.
+#[inline(always)]
+pub fn dot<T: Real>(w: &[T], x: &[T]) -> T {
+    let mut s = [T::ZERO; DOT_LANES];
+    let len = w.len().min(x.len());
+    let (w, x) = (&w[..len], &x[..len]);
+    let (wc, xc) = (w.chunks_exact(DOT_LANES), x.chunks_exact(DOT_LANES));
+    let (wr, xr) = (wc.remainder(), xc.remainder());
+    for (wk, xk) in wc.zip(xc) {
+        for (c, sc) in s.iter_mut().enumerate() {
+            *sc = *sc + wk[c] * xk[c];
         }
-        trace
+    }
+    for (sc, (&wk, &xk)) in s.iter_mut().zip(wr.iter().zip(xr)) {
+        *sc = *sc + wk * xk;
+    }
+    ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]))
+}
+
+/// One dense layer: `out[o] = finish(o, acc)` with
+/// `acc = (w(bias + o) [+ w(extra + o)]) + dot(row_o, x)`, `row_o` the `fan_in`
+/// parameters from `off + o fan_in` ([`dot`] fixes the order of the sum).
+#[inline(always)]
+fn layer<T: Real>(
+    w: &impl Parameters<T>,
+    off: usize,
+    bias: usize,
+    extra: Option<usize>,
+    x: &[T],
+    out: &mut [T],
+    mut finish: impl FnMut(usize, T) -> T,
+) {
+    let fan_in = x.len().min(MAX_WIDTH);
+    let x = &x[..fan_in];
+    let mut row = [T::ZERO; MAX_WIDTH];
+    let row = &mut row[..fan_in];
+    for (o, slot) in out.iter_mut().enumerate() {
+        let mut acc = w.get(bias + o);
+        if let Some(e) = extra {
+            acc = acc + w.get(e + o);
+        }
+        w.read(off + o * fan_in, row);
+        *slot = finish(o, acc + dot(row, x));
     }
 }
 
@@ -416,11 +555,16 @@ mod tests {
             let p: [f64; 62] = core::array::from_fn(|j| ((j * 37 % 23) as f64 - 11.0) / 9.0);
             let net = Network {
                 shape: s,
-                params: |j: usize| p[j],
+                params: &p[..],
             };
             let x: [f64; INPUTS] = core::array::from_fn(|k| (k as f64 - 5.0) / 7.0);
             let i = 6; // wraps to row 2 of E
             let t = net.forward(i, x);
+            assert_eq!(
+                net.evaluate(i, x),
+                t.output,
+                "evaluate and forward agree bit for bit"
+            );
             let (e, w1, b1) = (&p[6..9], &p[12..45], &p[45..48]);
             let h1: [f64; 3] = core::array::from_fn(|o| {
                 b1[o] + e[o] + (0..INPUTS).map(|k| w1[o * INPUTS + k] * x[k]).sum::<f64>()

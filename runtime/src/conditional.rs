@@ -11,8 +11,8 @@ use nuld_core::blob::{BlobError, Domain, Layout, SectionTag};
 use nuld_core::conditional::{
     unpack_point, ConditionalInfo, ConditionalTarget, GridCell, CONDITIONAL_INFO_LEN,
 };
-use nuld_core::network::{input_features, Activation, Network, Shape};
-use nuld_core::quantize::{f16_decode_finite, f16_is_finite, unorm16_decode};
+use nuld_core::network::{input_features, Activation, F16Params, Network, Shape};
+use nuld_core::quantize::{f16_is_finite, unorm16_decode};
 
 /// One sample: a unit direction and the estimator weight of every sample of its
 /// condition (for BRDF samplers the directional albedo `A`, so that
@@ -284,9 +284,9 @@ impl<'a> ConditionalSampler<'a> {
         let net = Network {
             shape: self.shape,
             // Every index below `param_len` exists and is finite (`validate`).
-            params: |j: usize| params.get(j).map_or(0.0, |&h| f16_decode_finite(h)),
+            params: F16Params(params),
         };
-        Vec2::from_array(net.forward(i, input).square_point())
+        Vec2::from_array(net.square_point(i, input))
     }
 
     /// Table mode: the direction of index `i` of instance `instance` at condition

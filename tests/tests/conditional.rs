@@ -67,7 +67,7 @@ fn network_mode_equals_the_tools_f64_evaluation_of_the_f16_weights() {
         let weights: Vec<f64> = parts.params.iter().map(|&h| f16_decode(h) as f64).collect();
         let tool = Network {
             shape,
-            params: |j: usize| weights[j],
+            params: &weights[..],
         };
         let mut rng = Pcg64Mcg::seed_from_u64(7);
         let (mut worst_square, mut worst_direction) = (0.0f64, 0.0f64);

@@ -116,18 +116,20 @@ impl ConditionalSets for MixtureOwenSobol {
 }
 
 /// The table-mode and network-mode samplers of a conditional `.nuld` blob, read
-/// through `nuld-runtime` (`Blob::parse(bytes)?.conditional()?`, then
-/// `sample(Vec2::new(roughness, theta_o_deg), instance, i).direction` and
-/// `sample_network(..)`), in that order.
-///
-/// The runtime's conditional reader is not in this build yet: until it is, this
-/// returns an error naming what is missing, and `build-tool eval conditional`
-/// runs only with `--calibrate`.
+/// through `nuld-runtime` exactly as a renderer reads them:
+/// `Blob::parse(bytes)?.conditional()?`, then
+/// `sample(Vec2::new(roughness, theta_o_deg), instance, i).direction` (named
+/// `table`) and `sample_network(..)` (named `network`), in that order.
 pub fn blob_sets(bytes: &[u8]) -> Result<Vec<Box<dyn ConditionalSets + '_>>> {
     let blob = nuld_runtime::Blob::parse(bytes).map_err(|e| anyhow::anyhow!("{e}"))?;
-    anyhow::bail!(
-        "blob of kind {:?}: this build-tool has no reader for conditional samplers yet \
-         (nuld-runtime ConditionalSampler); run with --calibrate to check the report itself",
-        blob.kind()
-    )
+    let cs = blob.conditional().map_err(|e| anyhow::anyhow!("{e}"))?;
+    let n = cs.len() as usize;
+    let cond = |r: f64, t: f64| nuld_runtime::glam::Vec2::new(r as f32, t as f32);
+    let table = SampleFnSets::new("table", n, move |r, t, k, i| {
+        cs.sample(cond(r, t), k, i).direction.as_dvec3()
+    });
+    let network = SampleFnSets::new("network", n, move |r, t, k, i| {
+        cs.sample_network(cond(r, t), k, i).direction.as_dvec3()
+    });
+    Ok(vec![Box::new(table), Box::new(network)])
 }
