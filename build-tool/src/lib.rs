@@ -11,6 +11,7 @@ pub mod density;
 pub mod discrepancy;
 pub mod eval;
 pub mod metrics;
+pub mod network;
 pub mod optimize;
 pub mod output;
 pub mod plot;
