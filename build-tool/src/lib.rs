@@ -19,3 +19,4 @@ pub mod pointset;
 pub mod progress;
 pub mod seeding;
 pub mod sphere;
+pub mod train;

@@ -4,7 +4,7 @@ mod curves;
 mod points;
 
 pub use curves::{render_loglog, Series};
-pub use points::{render_direction_set, render_point_set};
+pub use points::{render_direction_set, render_point_set, render_square_panels, SquarePanel};
 
 use std::sync::Once;
 
