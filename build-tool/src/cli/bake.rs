@@ -64,7 +64,11 @@ fn numbers(s: &str, what: &str) -> Result<Vec<u32>> {
 /// Runs `build-tool bake`.
 pub fn run(a: BakeArgs) -> Result<()> {
     ensure!(a.brdf, "bake needs a target: --brdf");
-    ensure!(a.n >= 1 && a.n <= 1 << 16, "--n must be in 1..=65536, got {}", a.n);
+    ensure!(
+        a.n >= 1 && a.n <= 1 << 16,
+        "--n must be in 1..=65536, got {}",
+        a.n
+    );
     ensure!(
         a.instances >= 1 && a.instances <= 1 << 16,
         "--instances must be in 1..=65536, got {}",
@@ -89,7 +93,10 @@ pub fn run(a: BakeArgs) -> Result<()> {
         train.hidden = numbers(h, "--hidden")?;
     }
     if let Some(w) = a.union_weight {
-        ensure!(w.is_finite() && w >= 0.0, "--union-weight must be finite and >= 0");
+        ensure!(
+            w.is_finite() && w >= 0.0,
+            "--union-weight must be finite and >= 0"
+        );
         train.union_weight = w;
     }
     if let Some(lr) = a.lr {

@@ -11,11 +11,11 @@
 use super::distill::distill;
 use super::quality::{evaluate, instance_directions, Quality, QualityConfig};
 use crate::plot::{render_loglog, render_square_panels, Series, SquarePanel};
-use glam::DVec2;
 use crate::progress::Progress;
 use crate::sphere::{BrdfTarget, DirectionDensity};
 use crate::train::{Checkpoint, TrainConfig, Trainer};
 use anyhow::{bail, Context, Result};
+use glam::DVec2;
 use nuld_core::blob::{Domain, Metadata};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -155,8 +155,12 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     timings.distill_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let quality = (config.quality_grid > 0)
-        .then(|| evaluate(&params, &QualityConfig::held_out(config.quality_grid, 0x9a11)));
+    let quality = (config.quality_grid > 0).then(|| {
+        evaluate(
+            &params,
+            &QualityConfig::held_out(config.quality_grid, 0x9a11),
+        )
+    });
     timings.quality_s = t.elapsed().as_secs_f64();
 
     let losses = &trainer.state.losses;
@@ -209,7 +213,10 @@ fn render_sets(path: &Path, params: &crate::network::Params) -> Result<()> {
         .collect::<Result<Vec<_>, _>>()?;
     let densities: Vec<Box<dyn Fn(DVec2) -> f64 + '_>> = targets
         .iter()
-        .map(|t| Box::new(move |p| t.pdf(Domain::Hemisphere.to_direction(p))) as Box<dyn Fn(DVec2) -> f64>)
+        .map(|t| {
+            Box::new(move |p| t.pdf(Domain::Hemisphere.to_direction(p)))
+                as Box<dyn Fn(DVec2) -> f64>
+        })
         .collect();
     let panels: Vec<SquarePanel<'_>> = conds
         .iter()
@@ -268,9 +275,19 @@ mod tests {
             assert!(dir.join(f).is_file(), "{f}");
         }
         // Resuming a finished run trains nothing and writes the same blob.
-        let again = bake(&BakeConfig { resume: true, ..config }, &dir).unwrap();
+        let again = bake(
+            &BakeConfig {
+                resume: true,
+                ..config
+            },
+            &dir,
+        )
+        .unwrap();
         assert_eq!(again.blob_bytes, report.blob_bytes);
-        assert_eq!(std::fs::read(dir.join("brdf.nuld")).unwrap(), bytes.to_vec());
+        assert_eq!(
+            std::fs::read(dir.join("brdf.nuld")).unwrap(),
+            bytes.to_vec()
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

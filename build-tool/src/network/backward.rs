@@ -71,7 +71,10 @@ pub fn backward(
         if l == 0 {
             a[..INPUTS].copy_from_slice(&trace.input);
         } else {
-            for (x, &z) in a.iter_mut().zip(&trace.pre[l - 1][..hidden[l - 1] as usize]) {
+            for (x, &z) in a
+                .iter_mut()
+                .zip(&trace.pre[l - 1][..hidden[l - 1] as usize])
+            {
                 *x = act.apply(z);
             }
         }
@@ -147,7 +150,13 @@ mod tests {
     fn backward_matches_central_differences() {
         // Index 6 wraps to row 1 of E.
         let conds: Vec<([f64; 2], u32, u32)> = (0..12u32)
-            .map(|j| ([(j as f64 * 0.37) % 1.0, (j as f64 * 0.61) % 1.0], 5 * j + 1, j % 7))
+            .map(|j| {
+                (
+                    [(j as f64 * 0.37) % 1.0, (j as f64 * 0.61) % 1.0],
+                    5 * j + 1,
+                    j % 7,
+                )
+            })
             .collect();
         for (act, hidden) in [
             (Activation::Silu, &[7u32, 5][..]),
@@ -173,7 +182,7 @@ mod tests {
             }
             let h = 1e-6;
             let mut worst: f64 = 0.0;
-            for j in 0..p.values.len() {
+            for (j, &g) in grad.iter().enumerate() {
                 let x = p.values[j];
                 p.values[j] = x + h;
                 let up = total_loss(&p, &conds);
@@ -181,7 +190,7 @@ mod tests {
                 let down = total_loss(&p, &conds);
                 p.values[j] = x;
                 let fd = (up - down) / (2.0 * h);
-                worst = worst.max((grad[j] - fd).abs() / (1.0 + fd.abs()));
+                worst = worst.max((g - fd).abs() / (1.0 + fd.abs()));
             }
             // The map's Jacobian is itself a central difference (step 1e-7).
             assert!(worst < 1e-5, "{act:?} {hidden:?}: {worst}");
@@ -189,7 +198,11 @@ mod tests {
             // (fewer with Relu, whose units are off for some of the three inputs).
             let weights = &grad[shape.first_layer_offset()..];
             let moved = weights.iter().filter(|&&g| g != 0.0).count();
-            assert!(moved > weights.len() / 5, "{act:?} {hidden:?}: {moved} of {}", weights.len());
+            assert!(
+                moved > weights.len() / 5,
+                "{act:?} {hidden:?}: {moved} of {}",
+                weights.len()
+            );
         }
     }
 }

@@ -73,13 +73,7 @@ impl<P: AdamParam> Adam<P> {
     ///
     /// # Panics
     /// If `scale` has a length other than `params.len()`.
-    pub fn step_scaled(
-        &mut self,
-        params: &mut [P],
-        grad: &[P],
-        lr: f64,
-        scale: Option<&[f64]>,
-    ) {
+    pub fn step_scaled(&mut self, params: &mut [P], grad: &[P], lr: f64, scale: Option<&[f64]>) {
         if let Some(s) = scale {
             assert_eq!(s.len(), params.len(), "one step scale per parameter");
         }

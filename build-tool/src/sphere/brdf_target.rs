@@ -84,7 +84,14 @@ impl BrdfTarget {
         theta_o_deg: f64,
         domain: Domain,
     ) -> Result<Self, DirectionSpecError> {
-        Self::with_rules(model, roughness, theta_o_deg, domain, TABLE_POINTS, PROFILE_POINTS)
+        Self::with_rules(
+            model,
+            roughness,
+            theta_o_deg,
+            domain,
+            TABLE_POINTS,
+            PROFILE_POINTS,
+        )
     }
 
     /// The glTF target with cap measures from a rule of about `table_points`

@@ -521,7 +521,10 @@ mod tests {
         }
         let mean = |s: &[f64]| s.iter().sum::<f64>() / s.len() as f64;
         // Squared square distance to the warp's points.
-        assert!(mean(&losses[50..60]) < 0.5 * mean(&losses[..10]), "{losses:?}");
+        assert!(
+            mean(&losses[50..60]) < 0.5 * mean(&losses[..10]),
+            "{losses:?}"
+        );
         // Cap loss.
         assert!(mean(&losses[110..]) < mean(&losses[60..70]), "{losses:?}");
     }

@@ -17,9 +17,9 @@ use crate::optimize::directions::{epoch_caps, local_factor};
 use crate::seeding::derive_seed;
 use crate::sphere::{BrdfTarget, DirectionDensity};
 use glam::{DVec2, DVec3};
+use nuld_core::brdf::{view_direction, BrdfModel, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
 use nuld_core::network::{instance_offset, shifted_lattice_point};
 use nuld_core::sphere::hemisphere_to_square;
-use nuld_core::brdf::{view_direction, BrdfModel, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
