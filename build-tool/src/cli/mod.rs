@@ -1,5 +1,6 @@
 //! The `build-tool` command line (README.md, "CLI").
 
+pub mod bake;
 pub mod bench;
 pub mod eval;
 pub mod export;
@@ -33,6 +34,8 @@ pub enum Command {
     Optimize(optimize::OptimizeArgs),
     /// Exact discrepancies of a blob's point sets against a target density.
     Metrics(metrics::MetricsArgs),
+    /// Train and distill a conditional sampler (--brdf): DIR/brdf.nuld, report.json, loss.png, sets.png.
+    Bake(bake::BakeArgs),
     /// Time the optimizer: fast vs dense gradient per epoch, and full default runs.
     Bench(bench::BenchArgs),
     /// Evaluate the paper's §5 figures (fig2, fig3, fig5, fig6, fig7, all): CSV, JSON, plots.
@@ -81,6 +84,7 @@ pub(crate) fn count(s: &str) -> Result<usize, String> {
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Sobol(a) => sobol::run(a),
+        Command::Bake(a) => bake::run(a),
         Command::Export(a) => export::run(a),
         Command::Sample(a) => sample::run(a),
         Command::Optimize(a) => optimize::run(a),

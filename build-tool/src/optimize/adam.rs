@@ -1,12 +1,45 @@
-//! Adam (Kingma & Ba 2015) on a vector of 2D points.
+//! Adam (Kingma & Ba 2015) on a vector of parameters: 2D points (the optimizers)
+//! or scalars (a network's flat weights).
 
 use glam::DVec2;
+use std::ops::{Add, Div, Mul, Sub};
 
-/// Adam state for `n` 2D parameters.
+/// A parameter Adam updates coordinate by coordinate: `f64` or [`DVec2`].
+pub trait AdamParam:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Mul<f64, Output = Self>
+    + Div<f64, Output = Self>
+    + Div<Output = Self>
+    + Add<f64, Output = Self>
+{
+    /// All coordinates zero.
+    const ZERO: Self;
+    /// Coordinate-wise square root.
+    fn sqrt(self) -> Self;
+}
+
+impl AdamParam for f64 {
+    const ZERO: Self = 0.0;
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+}
+
+impl AdamParam for DVec2 {
+    const ZERO: Self = DVec2::ZERO;
+    fn sqrt(self) -> Self {
+        self.powf(0.5)
+    }
+}
+
+/// Adam state for `n` parameters of type `P`.
 #[derive(Clone, Debug)]
-pub struct Adam {
-    m: Vec<DVec2>,
-    v: Vec<DVec2>,
+pub struct Adam<P = DVec2> {
+    m: Vec<P>,
+    v: Vec<P>,
     t: i32,
     /// First-moment decay, 0.9 by default.
     pub beta1: f64,
@@ -17,12 +50,12 @@ pub struct Adam {
     pub epsilon: f64,
 }
 
-impl Adam {
+impl<P: AdamParam> Adam<P> {
     /// Fresh state for `n` parameters.
     pub fn new(n: usize) -> Self {
         Self {
-            m: vec![DVec2::ZERO; n],
-            v: vec![DVec2::ZERO; n],
+            m: vec![P::ZERO; n],
+            v: vec![P::ZERO; n],
             t: 0,
             beta1: 0.9,
             beta2: 0.999,
@@ -31,7 +64,7 @@ impl Adam {
     }
 
     /// One step of size `lr` against `grad`: `x -= lr * m_hat / (sqrt(v_hat) + eps)`.
-    pub fn step(&mut self, params: &mut [DVec2], grad: &[DVec2], lr: f64) {
+    pub fn step(&mut self, params: &mut [P], grad: &[P], lr: f64) {
         self.step_scaled(params, grad, lr, None);
     }
 
@@ -40,13 +73,7 @@ impl Adam {
     ///
     /// # Panics
     /// If `scale` has a length other than `params.len()`.
-    pub fn step_scaled(
-        &mut self,
-        params: &mut [DVec2],
-        grad: &[DVec2],
-        lr: f64,
-        scale: Option<&[f64]>,
-    ) {
+    pub fn step_scaled(&mut self, params: &mut [P], grad: &[P], lr: f64, scale: Option<&[f64]>) {
         if let Some(s) = scale {
             assert_eq!(s.len(), params.len(), "one step scale per parameter");
         }
@@ -59,12 +86,31 @@ impl Adam {
             .zip(self.m.iter_mut().zip(self.v.iter_mut()))
             .enumerate()
         {
-            *m = self.beta1 * *m + (1.0 - self.beta1) * *g;
-            *v = self.beta2 * *v + (1.0 - self.beta2) * *g * *g;
+            *m = *m * self.beta1 + *g * (1.0 - self.beta1);
+            *v = *v * self.beta2 + *g * (1.0 - self.beta2) * *g;
             let m_hat = *m / c1;
             let v_hat = *v / c2;
             let lr_i = scale.map_or(lr, |s| lr * s[i]);
-            *x -= lr_i * m_hat / (v_hat.powf(0.5) + self.epsilon);
+            *x = *x - m_hat * lr_i / (v_hat.sqrt() + self.epsilon);
+        }
+    }
+
+    /// The state to checkpoint: first and second moments and the step count.
+    pub fn state(&self) -> (&[P], &[P], i32) {
+        (&self.m, &self.v, self.t)
+    }
+
+    /// Restores a state saved by [`Adam::state`] (default decay rates and epsilon).
+    ///
+    /// # Panics
+    /// If `m` and `v` differ in length.
+    pub fn from_state(m: Vec<P>, v: Vec<P>, t: i32) -> Self {
+        assert_eq!(m.len(), v.len(), "one second moment per first moment");
+        Self {
+            m,
+            v,
+            t,
+            ..Self::new(0)
         }
     }
 }

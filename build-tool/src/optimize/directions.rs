@@ -82,7 +82,7 @@ pub const MAX_LOCAL_FACTOR: f64 = 1e4;
 
 /// The local factor `f = sqrt(|domain| pdf(x))`, clamped into
 /// `[1, MAX_LOCAL_FACTOR]` ([`DirectionConfig::local_units`]).
-fn local_factor(area_of_domain: f64, pdf: f64) -> f64 {
+pub(crate) fn local_factor(area_of_domain: f64, pdf: f64) -> f64 {
     let f = (area_of_domain * pdf).sqrt();
     if f.is_finite() {
         f.clamp(1.0, MAX_LOCAL_FACTOR)
@@ -102,7 +102,7 @@ fn fold(domain: Domain, p: DVec2) -> DVec2 {
 
 /// Jacobian columns `(d dir / d p.x, d dir / d p.y)` of the map at `p`, by central
 /// differences through the fold (so the seam is crossed continuously).
-fn map_jacobian(domain: Domain, p: DVec2) -> (DVec3, DVec3) {
+pub(crate) fn map_jacobian(domain: Domain, p: DVec2) -> (DVec3, DVec3) {
     let h = 1e-7;
     let f = |q: DVec2| domain.to_direction(fold(domain, q));
     (
@@ -124,7 +124,7 @@ pub fn initial_square_points(density: &dyn DirectionDensity, n: usize, seed: u64
 /// The caps of epoch `epoch` for seed `seed`: `count` points of a freshly
 /// scrambled 3D Owen-Sobol set mapped by [`Cap::from_unit_cube`] (independent of
 /// the point count, so every size shares them).
-fn epoch_caps(seed: u64, epoch: usize, count: usize) -> Vec<Cap> {
+pub(crate) fn epoch_caps(seed: u64, epoch: usize, count: usize) -> Vec<Cap> {
     let scramble = derive_seed(seed, 2 * epoch as u64 + 1) as u32;
     (0..count)
         .map(|i| {

@@ -6,7 +6,7 @@ mod points;
 
 pub use curves::{render_loglog, Series};
 pub use heatmap::{render_heatmap, Heatmap};
-pub use points::{render_direction_set, render_point_set};
+pub use points::{render_direction_set, render_point_set, render_square_panels, SquarePanel};
 
 use anyhow::{anyhow, Result};
 use plotters::coord::Shift;

@@ -177,3 +177,38 @@ pub fn render_direction_set(
         Ok(())
     })
 }
+
+/// One panel of [`render_square_panels`]: a caption, a density over the unit square
+/// and points in it.
+pub struct SquarePanel<'a> {
+    /// Caption above the panel.
+    pub caption: String,
+    /// Density at a point of the square (e.g. a direction density through the
+    /// domain's equal-area map).
+    pub density: &'a dyn Fn(DVec2) -> f64,
+    /// Points in `[0,1]^2`.
+    pub points: Vec<DVec2>,
+}
+
+/// Draws `panels` side by side, each a unit square (y down, as
+/// [`render_point_set`]) over its density, and writes a PNG of
+/// `panels.len() size x (size + 60)` pixels to `path` atomically.
+pub fn render_square_panels(path: &Path, panels: &[SquarePanel<'_>], size: u32) -> Result<()> {
+    let columns = panels.len().max(1);
+    write_png(path, (columns as u32 * size, size + 60), |root| {
+        let areas = root.split_evenly((1, columns));
+        for (area, panel) in areas.iter().zip(panels) {
+            let flipped: Vec<(f64, f64)> = panel.points.iter().map(|p| (p.x, 1.0 - p.y)).collect();
+            draw_panel(
+                area,
+                &panel.caption,
+                (0.0, 1.0),
+                Some(("equal-area square x", "y (down)")),
+                &|x, y| Some((panel.density)(DVec2::new(x, 1.0 - y))),
+                &[],
+                &flipped,
+            )?;
+        }
+        Ok(())
+    })
+}

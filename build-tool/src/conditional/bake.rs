@@ -1,0 +1,293 @@
+//! `bake --brdf`: train the conditional BRDF sampler, distill it into a blob, and
+//! report on it (paper §4).
+//!
+//! Writes into the output directory `brdf.nuld` (the blob), `report.json`
+//! (settings, timings, the loss curve and [`quality`](super::quality) at
+//! held-out conditions), `loss.png` (the loss curve), `sets.png` (instance 0 at a
+//! few conditions over the target, in the equal-area square), and while training
+//! `checkpoint.bin` (every [`BakeConfig::checkpoint_every`], and at the end), from
+//! which `resume` continues bit for bit. Every file is written atomically.
+
+use super::distill::distill;
+use super::quality::{evaluate, instance_directions, Quality, QualityConfig};
+use crate::plot::{render_loglog, render_square_panels, Series, SquarePanel};
+use crate::progress::Progress;
+use crate::sphere::{BrdfTarget, DirectionDensity};
+use crate::train::{Checkpoint, TrainConfig, Trainer};
+use anyhow::{bail, Context, Result};
+use glam::DVec2;
+use nuld_core::blob::{Domain, Metadata};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// Settings of a bake.
+#[derive(Clone, Debug, Serialize)]
+pub struct BakeConfig {
+    /// The training run.
+    pub train: TrainConfig,
+    /// Instances stored in the point table `S`.
+    pub instances: u32,
+    /// Point-table grid nodes `(roughness, theta_o)`.
+    pub grid: [u32; 2],
+    /// Weight-table grid nodes.
+    pub weight_grid: [u32; 2],
+    /// Held-out conditions per axis of the quality check (0 skips it).
+    pub quality_grid: usize,
+    /// Time between checkpoints.
+    pub checkpoint_every: Duration,
+    /// Continue from the directory's checkpoint.
+    pub resume: bool,
+}
+
+impl Default for BakeConfig {
+    fn default() -> Self {
+        Self {
+            train: TrainConfig::default(),
+            instances: 16,
+            grid: [10, 12],
+            weight_grid: [32, 32],
+            quality_grid: 4,
+            checkpoint_every: Duration::from_secs(120),
+            resume: false,
+        }
+    }
+}
+
+/// Seconds spent per phase.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Timings {
+    /// Building the condition pool (cap measures).
+    pub pool_s: f64,
+    /// Training.
+    pub train_s: f64,
+    /// Distilling the tables.
+    pub distill_s: f64,
+    /// The quality check.
+    pub quality_s: f64,
+    /// Everything.
+    pub total_s: f64,
+}
+
+/// `report.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct BakeReport {
+    /// The settings.
+    pub config: BakeConfig,
+    /// Network parameters.
+    pub parameters: usize,
+    /// Multiply-adds per network sample.
+    pub multiply_adds: usize,
+    /// Blob size in bytes.
+    pub blob_bytes: usize,
+    /// Phase timings (this run; a resumed run times only what it did).
+    pub timings: Timings,
+    /// The loss of every step, averaged over blocks of `loss_block` steps.
+    pub loss_curve: Vec<f64>,
+    /// Steps per entry of `loss_curve`.
+    pub loss_block: usize,
+    /// Held-out quality (network mode, f16 parameters, against Owen-Sobol through
+    /// the mixture warp).
+    pub quality: Option<Quality>,
+}
+
+/// The checkpoint's path in `dir`.
+pub fn checkpoint_path(dir: &Path) -> PathBuf {
+    dir.join("checkpoint.bin")
+}
+
+/// Runs a bake into `out` (see the module docs); progress on stderr.
+pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
+    let started = Instant::now();
+    if config.train.shape().is_none() {
+        bail!(
+            "network shape out of range: 1 to 3 hidden layers of 1 to {} units",
+            nuld_core::network::MAX_WIDTH
+        );
+    }
+    crate::output::ensure_dir(out)?;
+    let ckpt_path = checkpoint_path(out);
+    let resume = if config.resume {
+        let c = Checkpoint::load(&ckpt_path)?;
+        if c.config != config.train {
+            bail!(
+                "{} was written with other training settings; rerun with the same options or without --resume",
+                ckpt_path.display()
+            );
+        }
+        Some(c)
+    } else {
+        None
+    };
+    let mut timings = Timings::default();
+    let t = Instant::now();
+    let mut trainer = Trainer::new(config.train.clone(), resume);
+    timings.pool_s = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let progress = Progress::stderr("bake", trainer.total_steps() as u64, "step");
+    progress.inc(trainer.state.step as u64);
+    let mut last_save = Instant::now();
+    while !trainer.done() {
+        let r = trainer.step();
+        progress.inc(1);
+        progress.set_message(format!(
+            "loss {:.3e}, sets/baseline {:.3}",
+            r.loss, r.set_ratio
+        ));
+        if last_save.elapsed() >= config.checkpoint_every {
+            trainer.state.save(&ckpt_path)?;
+            last_save = Instant::now();
+        }
+    }
+    trainer.state.save(&ckpt_path)?;
+    progress.finish();
+    timings.train_s = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let params = trainer.params();
+    let parts = distill(&params, config.instances, config.grid, config.weight_grid);
+    let blob = parts.to_blob(&Metadata {
+        generator: "bake",
+        target: "brdf",
+        seed: config.train.seed,
+    })?;
+    timings.distill_s = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let quality = (config.quality_grid > 0).then(|| {
+        evaluate(
+            &params,
+            &QualityConfig::held_out(config.quality_grid, 0x9a11),
+        )
+    });
+    timings.quality_s = t.elapsed().as_secs_f64();
+
+    let losses = &trainer.state.losses;
+    let loss_block = losses.len().div_ceil(200).max(1);
+    let loss_curve: Vec<f64> = losses
+        .chunks(loss_block)
+        .map(|c| c.iter().sum::<f64>() / c.len() as f64)
+        .collect();
+    let series = Series {
+        label: "training loss".into(),
+        points: loss_curve
+            .iter()
+            .enumerate()
+            .map(|(j, &l)| (((j + 1) * loss_block) as f64, l))
+            .collect(),
+    };
+    render_loglog(
+        &out.join("loss.png"),
+        "bake --brdf: training loss",
+        "step",
+        "loss",
+        &[series],
+        (800, 500),
+    )?;
+    render_sets(&out.join("sets.png"), &params)?;
+    crate::output::write_atomic(&out.join("brdf.nuld"), blob.as_slice())?;
+    timings.total_s = started.elapsed().as_secs_f64();
+    let report = BakeReport {
+        config: config.clone(),
+        parameters: params.shape.param_len(),
+        multiply_adds: params.shape.multiply_adds(),
+        blob_bytes: blob.as_slice().len(),
+        timings,
+        loss_curve,
+        loss_block,
+        quality,
+    };
+    let json = serde_json::to_vec_pretty(&report).context("cannot encode report")?;
+    crate::output::write_atomic(&out.join("report.json"), &json)?;
+    Ok(report)
+}
+
+/// Instance 0 at four conditions, each over its target in the equal-area square.
+fn render_sets(path: &Path, params: &crate::network::Params) -> Result<()> {
+    let shipped = params.rounded_to_f16();
+    let conds = [[0.15, 20.0], [0.15, 75.0], [0.5, 45.0], [0.9, 80.0]];
+    let targets = conds
+        .iter()
+        .map(|c| BrdfTarget::new(c[0], c[1], Domain::Hemisphere))
+        .collect::<Result<Vec<_>, _>>()?;
+    let densities: Vec<Box<dyn Fn(DVec2) -> f64 + '_>> = targets
+        .iter()
+        .map(|t| {
+            Box::new(move |p| t.pdf(Domain::Hemisphere.to_direction(p)))
+                as Box<dyn Fn(DVec2) -> f64>
+        })
+        .collect();
+    let panels: Vec<SquarePanel<'_>> = conds
+        .iter()
+        .zip(&densities)
+        .map(|(c, d)| SquarePanel {
+            caption: format!("roughness {}, theta_o {} deg", c[0], c[1]),
+            density: d.as_ref(),
+            points: instance_directions(&shipped, *c, 0)
+                .into_iter()
+                .map(|x| Domain::Hemisphere.to_square(x))
+                .collect(),
+        })
+        .collect();
+    render_square_panels(path, &panels, 450)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nuld_core::blob::{BlobKind, Layout, SectionTag};
+
+    #[test]
+    fn a_tiny_bake_writes_a_blob_whose_sections_match_its_counts() {
+        let dir = std::env::temp_dir().join(format!("nuld-bake-tiny-{}", std::process::id()));
+        let config = BakeConfig {
+            train: TrainConfig {
+                n: 8,
+                hidden: vec![6],
+                steps: 3,
+                pretrain_steps: 2,
+                conditions_per_step: 2,
+                instances_per_condition: 2,
+                pool_conditions: 3,
+                pool_caps: 32,
+                caps_per_step: 16,
+                ..TrainConfig::default()
+            },
+            instances: 3,
+            grid: [2, 3],
+            weight_grid: [4, 2],
+            quality_grid: 0,
+            ..BakeConfig::default()
+        };
+        let report = bake(&config, &dir).unwrap();
+        let blob = crate::pointset::AlignedBytes::read(&dir.join("brdf.nuld")).unwrap();
+        let bytes = blob.as_slice();
+        assert_eq!(bytes.len(), report.blob_bytes);
+        let layout = Layout::read(bytes).unwrap();
+        assert_eq!(layout.header().kind, BlobKind::Conditional as u32);
+        let len = |tag: SectionTag| layout.section(tag).unwrap().1.len();
+        let shape = config.train.shape().unwrap();
+        assert_eq!(len(SectionTag::NetworkParams), 2 * shape.param_len());
+        assert_eq!(len(SectionTag::PointTable), 4 * 2 * 3 * 3 * 8);
+        assert_eq!(len(SectionTag::WeightTable), 4 * 8);
+        for f in ["report.json", "loss.png", "sets.png", "checkpoint.bin"] {
+            assert!(dir.join(f).is_file(), "{f}");
+        }
+        // Resuming a finished run trains nothing and writes the same blob.
+        let again = bake(
+            &BakeConfig {
+                resume: true,
+                ..config
+            },
+            &dir,
+        )
+        .unwrap();
+        assert_eq!(again.blob_bytes, report.blob_bytes);
+        assert_eq!(
+            std::fs::read(dir.join("brdf.nuld")).unwrap(),
+            bytes.to_vec()
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

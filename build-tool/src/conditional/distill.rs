@@ -1,0 +1,130 @@
+//! Distillation (paper §4): from trained parameters, everything a conditional
+//! blob holds.
+//!
+//! * **network**: the parameters rounded to f16 ([`Params::to_f16_bits`]);
+//! * **point table**: for every grid node, instance `0..S` and index `0..N`, the
+//!   network's square point evaluated in `f64` on the *f16-rounded* parameters
+//!   (exactly what ships), as u16 unorm codes ([`unorm16_encode`], [`pack_point`]);
+//! * **weight table**: the glTF directional albedo `A` at every weight-grid node
+//!   ([`directional_albedo`]).
+
+use super::ConditionalParts;
+use crate::network::Params;
+use crate::sphere::brdf_albedo::directional_albedo;
+use crate::train::pool::{COND_MAX, COND_MIN};
+use nuld_core::blob::Domain;
+use nuld_core::brdf::BrdfModel;
+use nuld_core::conditional::{pack_point, ConditionalInfo, ConditionalTarget};
+use nuld_core::network::MAX_HIDDEN_LAYERS;
+use nuld_core::quantize::unorm16_encode;
+use rayon::prelude::*;
+
+/// The info record of a glTF BRDF sampler with `params`' architecture, `instances`
+/// stored instances, and the given point and weight grids (nodes per axis, each
+/// `>= 2`).
+pub fn brdf_info(
+    params: &Params,
+    instances: u32,
+    grid: [u32; 2],
+    weight_grid: [u32; 2],
+) -> ConditionalInfo {
+    let shape = params.shape;
+    let mut hidden = [0u32; MAX_HIDDEN_LAYERS];
+    hidden[..shape.hidden().len()].copy_from_slice(shape.hidden());
+    ConditionalInfo {
+        n: shape.n(),
+        instances,
+        domain: Domain::Hemisphere as u32,
+        target: ConditionalTarget::GltfBrdf as u32,
+        grid,
+        weight_grid,
+        cond_min: COND_MIN.map(|x| x as f32),
+        cond_max: COND_MAX.map(|x| x as f32),
+        hidden,
+        activation: shape.activation() as u32,
+        lattice_generator: shape.lattice_generator(),
+        reserved: [0; 3],
+    }
+}
+
+/// The blob's parts for `params` (see the module docs). Parallel over grid nodes;
+/// identical for any thread count.
+pub fn distill(
+    params: &Params,
+    instances: u32,
+    grid: [u32; 2],
+    weight_grid: [u32; 2],
+) -> ConditionalParts {
+    let info = brdf_info(params, instances, grid, weight_grid);
+    let shipped = params.rounded_to_f16();
+    let n = info.n;
+    let nodes = (grid[0] * grid[1]) as usize;
+    let table: Vec<u32> = (0..nodes)
+        .into_par_iter()
+        .flat_map_iter(|node| {
+            // Node j's normalized condition is j / (nodes - 1), what the reader
+            // computes there.
+            let unit = [
+                (node as u32 % grid[0]) as f64 / (grid[0] - 1) as f64,
+                (node as u32 / grid[0]) as f64 / (grid[1] - 1) as f64,
+            ];
+            let shipped = &shipped;
+            (0..instances).flat_map(move |k| {
+                (0..n).map(move |i| {
+                    let p = shipped.trace(unit, k, i).square_point();
+                    pack_point(unorm16_encode(p[0]), unorm16_encode(p[1]))
+                })
+            })
+        })
+        .collect();
+    let weight_nodes = (weight_grid[0] * weight_grid[1]) as usize;
+    let weights: Vec<f32> = (0..weight_nodes)
+        .into_par_iter()
+        .map(|node| {
+            let j = [node as u32 % weight_grid[0], node as u32 / weight_grid[0]];
+            let c = info.weight_grid_condition(j);
+            directional_albedo(BrdfModel::Gltf, c[0], c[1]).total() as f32
+        })
+        .collect();
+    ConditionalParts {
+        info,
+        params: params.to_f16_bits(),
+        table,
+        weights,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nuld_core::conditional::unpack_point;
+    use nuld_core::network::{Activation, Shape};
+    use nuld_core::quantize::{f16_decode, unorm16_decode_f64};
+
+    #[test]
+    fn table_holds_the_shipped_network_and_weights_the_albedo() {
+        let shape = Shape::new(5, &[6], Activation::Relu, 2).unwrap();
+        let params = Params::init(shape, 4);
+        let parts = distill(&params, 3, [3, 2], [4, 3]);
+        assert_eq!(parts.table.len(), 3 * 2 * 3 * 5);
+        assert_eq!(parts.weights.len(), 12);
+        // Entry (node (2, 1), instance 2, index 4) against the network evaluated by
+        // hand on the decoded f16 parameters at roughness 1, theta_o 89.
+        let decoded = Params {
+            shape,
+            values: parts.params.iter().map(|&b| f16_decode(b) as f64).collect(),
+        };
+        let want = decoded.trace([1.0, 1.0], 2, 4).square_point();
+        let got = unpack_point(parts.table[parts.info.point_table_index(5, 2, 4)]);
+        for a in 0..2 {
+            assert!((unorm16_decode_f64(got[a]) - want[a]).abs() <= 1.0 / 131072.0 + 1e-12);
+        }
+        // Weight node (3, 0): roughness 1, theta_o 0 (reference albedo 0.972228).
+        assert!((parts.weights[3] as f64 - 0.972228).abs() < 1e-6);
+        // Node (0, 2) of the weight grid: roughness 0.1, theta_o 89.
+        let c = parts.info.weight_grid_condition([0, 2]);
+        assert_eq!(c[1], 89.0);
+        let a = directional_albedo(BrdfModel::Gltf, c[0], c[1]).total();
+        assert_eq!(parts.weights[8], a as f32);
+    }
+}

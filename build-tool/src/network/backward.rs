@@ -1,0 +1,208 @@
+//! The backward pass of [`nuld_core::network::Network::forward`] and of the two
+//! maps after it (the sigmoid onto the square, the hemisphere's equal-area map).
+//!
+//! With `a_0` the input, `z_l = W_l a_(l-1) + b_l (+ E[i] for l = 1)`,
+//! `a_l = act(z_l)`, `o = W_o a_L + b_o`, `p = sigmoid(o)`, `x = M(p)`:
+//!
+//! ```text
+//! dL/do   = dL/dp * p (1 - p)
+//! dL/dW_o = dL/do a_L^T,   dL/db_o = dL/do,   dL/da_L = W_o^T dL/do
+//! dL/dz_l = dL/da_l * act'(z_l)
+//! dL/dW_l = dL/dz_l a_(l-1)^T,  dL/db_l = dL/dz_l (= dL/dE[i] for l = 1)
+//! dL/da_(l-1) = W_l^T dL/dz_l
+//! ```
+
+use crate::optimize::directions::map_jacobian;
+use glam::{DVec2, DVec3};
+use nuld_core::blob::Domain;
+use nuld_core::network::{sigmoid, Shape, Trace, INPUTS, MAX_WIDTH, OUTPUTS};
+
+/// `dL/dp` of the hemisphere's square point `p` from `dL/dx` of its direction
+/// `x = M(p)` (ambient gradient `g`): `(J_x . g, J_y . g)` with the map's Jacobian
+/// columns by central differences.
+pub fn hemisphere_square_gradient(p: DVec2, g: DVec3) -> DVec2 {
+    let (jx, jy) = map_jacobian(Domain::Hemisphere, p);
+    DVec2::new(jx.dot(g), jy.dot(g))
+}
+
+/// `dL/do` of the outputs before the sigmoid from `dL/dp` of the square point
+/// `p = sigmoid(o)`: `dL/dp p (1 - p)` per coordinate.
+pub fn output_gradient(trace: &Trace<f64>, d_square: DVec2) -> [f64; OUTPUTS] {
+    let d = [d_square.x, d_square.y];
+    core::array::from_fn(|o| {
+        let s = sigmoid(trace.output[o]);
+        d[o] * s * (1.0 - s)
+    })
+}
+
+/// Adds `dL/dparams` to `grad` (length `shape.param_len()`) for index `i` whose
+/// forward pass left `trace`, given `d_output = dL/do` (module formulas).
+/// `O(multiply_adds)`.
+///
+/// # Panics
+/// If `params` or `grad` is shorter than `shape.param_len()`.
+pub fn backward(
+    shape: &Shape,
+    params: &[f64],
+    trace: &Trace<f64>,
+    i: u32,
+    d_output: [f64; OUTPUTS],
+    grad: &mut [f64],
+) {
+    let act = shape.activation();
+    let hidden = shape.hidden();
+    let layers = hidden.len();
+    // Offsets of every layer's weights (biases follow them), output layer last.
+    let mut offsets = [0usize; 4];
+    let mut fan_ins = [0usize; 4];
+    let mut off = shape.first_layer_offset();
+    let mut fan_in = INPUTS;
+    for (l, &h) in hidden.iter().enumerate() {
+        offsets[l] = off;
+        fan_ins[l] = fan_in;
+        off += h as usize * (fan_in + 1);
+        fan_in = h as usize;
+    }
+    offsets[layers] = off;
+    fan_ins[layers] = fan_in;
+
+    let activation = |l: usize| -> [f64; MAX_WIDTH] {
+        let mut a = [0.0; MAX_WIDTH];
+        if l == 0 {
+            a[..INPUTS].copy_from_slice(&trace.input);
+        } else {
+            for (x, &z) in a
+                .iter_mut()
+                .zip(&trace.pre[l - 1][..hidden[l - 1] as usize])
+            {
+                *x = act.apply(z);
+            }
+        }
+        a
+    };
+
+    // Output layer.
+    let (off, fan_in) = (offsets[layers], fan_ins[layers]);
+    let a = activation(layers);
+    let mut delta_a = [0.0; MAX_WIDTH];
+    for (o, &d) in d_output.iter().enumerate() {
+        let row = off + o * fan_in;
+        for k in 0..fan_in {
+            grad[row + k] += d * a[k];
+            delta_a[k] += params[row + k] * d;
+        }
+        grad[off + OUTPUTS * fan_in + o] += d;
+    }
+    // Hidden layers, last first.
+    for l in (0..layers).rev() {
+        let (off, fan_in, h) = (offsets[l], fan_ins[l], hidden[l] as usize);
+        let a = activation(l);
+        let mut delta_z = [0.0; MAX_WIDTH];
+        for o in 0..h {
+            delta_z[o] = delta_a[o] * act.derivative(trace.pre[l][o]);
+        }
+        let mut next = [0.0; MAX_WIDTH];
+        for (o, &d) in delta_z.iter().enumerate().take(h) {
+            if d == 0.0 {
+                continue;
+            }
+            let row = off + o * fan_in;
+            for k in 0..fan_in {
+                grad[row + k] += d * a[k];
+                next[k] += params[row + k] * d;
+            }
+            grad[off + h * fan_in + o] += d;
+            if l == 0 {
+                grad[shape.embedding_offset(i) + o] += d;
+            }
+        }
+        delta_a = next;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::network::Params;
+    use nuld_core::network::Activation;
+    use nuld_core::sphere::square_to_hemisphere;
+
+    /// A smooth scalar of the direction: `L = <x, u> + 0.3 <x, v>^2`.
+    fn loss_of(x: DVec3) -> (f64, DVec3) {
+        let (u, v) = (DVec3::new(0.3, -0.7, 0.5), DVec3::new(-0.2, 0.4, 0.9));
+        let d = x.dot(v);
+        (x.dot(u) + 0.3 * d * d, u + 0.6 * d * v)
+    }
+
+    fn total_loss(p: &Params, conds: &[([f64; 2], u32, u32)]) -> f64 {
+        conds
+            .iter()
+            .map(|&(c, k, i)| {
+                let s = p.trace(c, k, i).square_point();
+                loss_of(square_to_hemisphere(DVec2::new(s[0], s[1]))).0
+            })
+            .sum()
+    }
+
+    /// The chain network -> sigmoid -> hemisphere map -> a smooth loss against
+    /// central differences of the loss in every parameter.
+    #[test]
+    fn backward_matches_central_differences() {
+        // Index 6 wraps to row 1 of E.
+        let conds: Vec<([f64; 2], u32, u32)> = (0..12u32)
+            .map(|j| {
+                (
+                    [(j as f64 * 0.37) % 1.0, (j as f64 * 0.61) % 1.0],
+                    5 * j + 1,
+                    j % 7,
+                )
+            })
+            .collect();
+        for (act, hidden) in [
+            (Activation::Silu, &[7u32, 5][..]),
+            (Activation::Relu, &[6u32, 5, 4][..]),
+            (Activation::Silu, &[9u32][..]),
+        ] {
+            let shape = Shape::new(5, hidden, act, 2).unwrap();
+            let mut p = Params::init(shape, 11);
+            // Non-zero E and biases, positive so that most Relu units are on.
+            for (j, x) in p.values.iter_mut().enumerate() {
+                if *x == 0.0 {
+                    *x = 0.15 + 0.1 * (((j * 7919) % 13) as f64 / 6.0 - 1.0);
+                }
+            }
+            let mut grad = vec![0.0; shape.param_len()];
+            for &(c, k, i) in &conds {
+                let t = p.trace(c, k, i);
+                let s = t.square_point();
+                let sq = DVec2::new(s[0], s[1]);
+                let g3 = loss_of(square_to_hemisphere(sq)).1;
+                let d_out = output_gradient(&t, hemisphere_square_gradient(sq, g3));
+                backward(&shape, &p.values, &t, i, d_out, &mut grad);
+            }
+            let h = 1e-6;
+            let mut worst: f64 = 0.0;
+            for (j, &g) in grad.iter().enumerate() {
+                let x = p.values[j];
+                p.values[j] = x + h;
+                let up = total_loss(&p, &conds);
+                p.values[j] = x - h;
+                let down = total_loss(&p, &conds);
+                p.values[j] = x;
+                let fd = (up - down) / (2.0 * h);
+                worst = worst.max((g - fd).abs() / (1.0 + fd.abs()));
+            }
+            // The map's Jacobian is itself a central difference (step 1e-7).
+            assert!(worst < 1e-5, "{act:?} {hidden:?}: {worst}");
+            // The check is not vacuous: many weights (past the per-index rows) moved
+            // (fewer with Relu, whose units are off for some of the three inputs).
+            let weights = &grad[shape.first_layer_offset()..];
+            let moved = weights.iter().filter(|&&g| g != 0.0).count();
+            assert!(
+                moved > weights.len() / 5,
+                "{act:?} {hidden:?}: {moved} of {}",
+                weights.len()
+            );
+        }
+    }
+}

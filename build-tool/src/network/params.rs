@@ -1,0 +1,110 @@
+//! [`Params`]: a network's parameters as one flat `f64` array in the layout of
+//! [`nuld_core::network`], with a deterministic initialization and f16 rounding.
+
+use crate::seeding::rng;
+use nuld_core::network::{input_features, Network, Shape, Trace, INPUTS, OUTPUTS};
+use nuld_core::quantize::{f16_decode, f16_encode};
+use rand::Rng;
+
+/// A network's parameters (`shape.param_len()` numbers, order of
+/// [`nuld_core::network`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Params {
+    /// The architecture.
+    pub shape: Shape,
+    /// The flat parameter array.
+    pub values: Vec<f64>,
+}
+
+impl Params {
+    /// He-style initialization from `seed`: every weight of a layer with fan-in
+    /// `m` uniform in `±sqrt(6 / m)` (`±sqrt(3 / m)` for the output layer, so that
+    /// the sigmoid starts away from saturation), biases and the per-index rows `E`
+    /// zero. Bit-identical for a seed.
+    pub fn init(shape: Shape, seed: u64) -> Self {
+        let mut values = vec![0.0; shape.param_len()];
+        let mut r = rng(seed, 0x6e65_7477);
+        let mut off = shape.first_layer_offset();
+        let mut fan_in = INPUTS;
+        let widths: Vec<(usize, f64)> = shape
+            .hidden()
+            .iter()
+            .map(|&h| (h as usize, 6.0))
+            .chain(std::iter::once((OUTPUTS, 3.0)))
+            .collect();
+        for (h, gain) in widths {
+            let bound = (gain / fan_in as f64).sqrt();
+            for w in &mut values[off..off + h * fan_in] {
+                *w = bound * (2.0 * r.random::<f64>() - 1.0);
+            }
+            off += h * fan_in + h;
+            fan_in = h;
+        }
+        Self { shape, values }
+    }
+
+    /// The network over these parameters, as the forward pass reads them.
+    pub fn network(&self) -> Network<&[f64]> {
+        Network {
+            shape: self.shape,
+            params: &self.values,
+        }
+    }
+
+    /// The forward pass of index `i`, instance `k`, normalized condition `c`.
+    pub fn trace(&self, c: [f64; 2], k: u32, i: u32) -> Trace<f64> {
+        self.network()
+            .forward(i, input_features(&self.shape, c, k, i))
+    }
+
+    /// The parameters as f16 bits (round to nearest even through `f32`).
+    pub fn to_f16_bits(&self) -> Vec<u16> {
+        self.values.iter().map(|&x| f16_encode(x as f32)).collect()
+    }
+
+    /// The parameters rounded to f16 and read back as `f64`: exactly the values a
+    /// blob ships.
+    pub fn rounded_to_f16(&self) -> Self {
+        Self {
+            shape: self.shape,
+            values: self
+                .to_f16_bits()
+                .into_iter()
+                .map(|b| f16_decode(b) as f64)
+                .collect(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nuld_core::network::Activation;
+
+    #[test]
+    fn init_is_deterministic_sized_and_bounded() {
+        let shape = Shape::new(16, &[8, 8], Activation::Relu, 5).unwrap();
+        let a = Params::init(shape, 3);
+        assert_eq!(a.values.len(), shape.param_len());
+        assert_eq!(a, Params::init(shape, 3));
+        assert_ne!(a, Params::init(shape, 4));
+        // E and the first layer's biases start at zero; weights within the bound.
+        assert!(a.values[..16 * 8].iter().all(|&x| x == 0.0));
+        let w1 = &a.values[128..128 + 8 * INPUTS];
+        let bound = (6.0 / INPUTS as f64).sqrt();
+        assert!(w1.iter().all(|&x| x.abs() <= bound) && w1.iter().any(|&x| x != 0.0));
+        assert!(a.values[128 + 8 * INPUTS..128 + 8 * INPUTS + 8]
+            .iter()
+            .all(|&x| x == 0.0));
+    }
+
+    #[test]
+    fn f16_rounding_is_within_half_an_ulp() {
+        let shape = Shape::new(4, &[6], Activation::Silu, 1).unwrap();
+        let p = Params::init(shape, 1);
+        let r = p.rounded_to_f16();
+        for (&x, &y) in p.values.iter().zip(&r.values) {
+            assert!((x - y).abs() <= x.abs() / 2048.0 + 6e-8, "{x} -> {y}");
+        }
+    }
+}

@@ -1,0 +1,540 @@
+//! Training the conditional sampler's network (paper §4) on the direction
+//! optimizer's cap loss.
+//!
+//! A step draws `B` conditions from the [`ConditionPool`] (half uniformly, half by
+//! tournament toward the conditions whose running loss is worst relative to the
+//! warped Owen-Sobol baseline) and `S` random instances of each, evaluates the
+//! network for every index of every set, and minimizes
+//!
+//! ```text
+//! L = (1 / (B S)) sum_{b,s} loss(X_bs) + lambda (1 / B) sum_b loss(X_b1 u ... u X_bS)
+//! ```
+//!
+//! with `loss` the spherical-cap estimator of [`crate::discrepancy::caps`] (exact
+//! counts, sigmoid surrogate gradients, per-point sharpness in local units) on a
+//! window of the condition's caps. The union term asks the `S` instances of a
+//! condition to be different sets that together follow the target, as
+//! independently scrambled sets do; without it a network learns to ignore the
+//! instance. Gradients flow back through the hemisphere map, the sigmoid and the
+//! network ([`crate::network::backward`]); Adam with cosine decay; the sigmoid
+//! sharpness ramps linearly in units of each loss's point spacing.
+//!
+//! Deterministic: every random draw of step `t` comes from `(seed, t)`, conditions
+//! are processed in parallel but summed in batch order, so a seed fixes the result
+//! bit for bit at any thread count, and a run resumed from a [`Checkpoint`]
+//! continues exactly as the uninterrupted run.
+
+pub mod checkpoint;
+pub mod pool;
+
+pub use checkpoint::Checkpoint;
+pub use pool::{ConditionPool, PoolCondition};
+
+use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
+use crate::discrepancy::GradientPath;
+use crate::network::{backward, hemisphere_square_gradient, output_gradient, Params};
+use crate::optimize::adam::Adam;
+use crate::optimize::epoch_schedule;
+use crate::seeding::rng;
+use glam::{DVec2, DVec3};
+use nuld_core::network::{Activation, Shape};
+use nuld_core::sphere::square_to_hemisphere;
+use pool::HEMISPHERE_AREA;
+use rand::Rng;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Settings of a training run. Defaults chosen by measurement (README.md).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TrainConfig {
+    /// Points per set `N`.
+    pub n: u32,
+    /// Hidden widths.
+    pub hidden: Vec<u32>,
+    /// `true` for SiLU hidden units, `false` for ReLU.
+    pub silu: bool,
+    /// Gradient steps on the cap loss.
+    pub steps: usize,
+    /// Steps before those that fit the network to the renderer's warp of its
+    /// folded shifted-lattice input (squared distance in the square), a starting
+    /// point near the baseline instead of a random map.
+    pub pretrain_steps: usize,
+    /// Conditions per step `B`.
+    pub conditions_per_step: usize,
+    /// Instances per condition and step `S`.
+    pub instances_per_condition: usize,
+    /// Weight `lambda` of the union term.
+    pub union_weight: f64,
+    /// Conditions in the pool.
+    pub pool_conditions: usize,
+    /// Caps measured per pool condition.
+    pub pool_caps: usize,
+    /// Caps per condition and step `M` (a window of the pool's caps).
+    pub caps_per_step: usize,
+    /// Adam step at the start.
+    pub learning_rate: f64,
+    /// Step at the end relative to the start (cosine decay).
+    pub final_learning_rate_ratio: f64,
+    /// Sigmoid sharpness at the start, in inverse point spacings.
+    pub alpha_start: f64,
+    /// Sigmoid sharpness at the end, in inverse point spacings.
+    pub alpha_end: f64,
+    /// Fixes the initialization, the pool and every draw.
+    pub seed: u64,
+}
+
+impl Default for TrainConfig {
+    fn default() -> Self {
+        Self {
+            n: 64,
+            hidden: vec![32, 32],
+            silu: false,
+            steps: 2000,
+            pretrain_steps: 300,
+            conditions_per_step: 8,
+            instances_per_condition: 8,
+            union_weight: 4.0,
+            pool_conditions: 256,
+            pool_caps: 2048,
+            caps_per_step: 256,
+            learning_rate: 6e-3,
+            final_learning_rate_ratio: 0.03,
+            alpha_start: 8.0,
+            alpha_end: 64.0,
+            seed: 0,
+        }
+    }
+}
+
+impl TrainConfig {
+    /// The network architecture, or `None` if a count is out of range.
+    pub fn shape(&self) -> Option<Shape> {
+        let act = if self.silu {
+            Activation::Silu
+        } else {
+            Activation::Relu
+        };
+        Shape::new(self.n, &self.hidden, act, lattice_generator(self.n))
+    }
+}
+
+/// The rank-1 lattice generator `g` for `n` points: the `g` in `1..n` coprime to
+/// `n` whose lattice `(i/n, frac(i g / n))` has the largest minimum distance on the
+/// torus (the shortest nonzero lattice vector; ties to the smallest `g`). `O(n^2)`.
+pub fn lattice_generator(n: u32) -> u32 {
+    let gcd = |mut a: u32, mut b: u32| {
+        while b != 0 {
+            (a, b) = (b, a % b);
+        }
+        a
+    };
+    let wrap = |x: f64| x.min(1.0 - x);
+    let mut best = (1u32, -1.0);
+    for g in 1..n.max(2) {
+        if gcd(g, n) != 1 {
+            continue;
+        }
+        let mut shortest = f64::INFINITY;
+        for i in 1..n {
+            let x = wrap(i as f64 / n as f64);
+            let y = wrap(((i as u64 * g as u64) % n as u64) as f64 / n as f64);
+            shortest = shortest.min(x * x + y * y);
+        }
+        if shortest > best.1 {
+            best = (g, shortest);
+        }
+    }
+    best.0
+}
+
+/// What one step reports.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepReport {
+    /// Index of the step just taken.
+    pub step: usize,
+    /// The loss `L` of the batch.
+    pub loss: f64,
+    /// Mean cap loss of single sets, relative to the conditions' baselines.
+    pub set_ratio: f64,
+    /// Sigmoid sharpness in inverse point spacings.
+    pub alpha: f64,
+    /// Adam step.
+    pub learning_rate: f64,
+}
+
+/// A trainer: configuration, pool and the state that checkpoints hold.
+pub struct Trainer {
+    /// The settings.
+    pub config: TrainConfig,
+    /// The conditions.
+    pub pool: ConditionPool,
+    /// Parameters, Adam state, step, running losses.
+    pub state: Checkpoint,
+}
+
+/// How many random pool members a tournament compares.
+const TOURNAMENT: usize = 4;
+
+impl Trainer {
+    /// A fresh trainer (parameters from the seed) or one resuming `resume`.
+    ///
+    /// # Panics
+    /// If the configuration's shape is invalid, or `resume` was written for another
+    /// configuration.
+    pub fn new(config: TrainConfig, resume: Option<Checkpoint>) -> Self {
+        let shape = config.shape().expect("valid network shape");
+        let pool = ConditionPool::new(
+            config.pool_conditions,
+            config.pool_caps,
+            config.caps_per_step,
+            config.n as usize,
+            config.seed,
+        );
+        let state = match resume {
+            Some(c) => {
+                assert_eq!(c.config, config, "checkpoint of another configuration");
+                c
+            }
+            None => {
+                let params = Params::init(shape, config.seed);
+                Checkpoint::fresh(config.clone(), params.values, pool.len())
+            }
+        };
+        Self {
+            config,
+            pool,
+            state,
+        }
+    }
+
+    /// The current parameters.
+    pub fn params(&self) -> Params {
+        Params {
+            shape: self.config.shape().expect("valid network shape"),
+            values: self.state.params.clone(),
+        }
+    }
+
+    /// Whether every step has been taken.
+    pub fn done(&self) -> bool {
+        self.state.step >= self.total_steps()
+    }
+
+    /// Pretraining and cap-loss steps together.
+    pub fn total_steps(&self) -> usize {
+        self.config.pretrain_steps + self.config.steps
+    }
+
+    /// Takes one step.
+    pub fn step(&mut self) -> StepReport {
+        let cfg = &self.config;
+        let t = self.state.step;
+        let pretraining = t < cfg.pretrain_steps;
+        let (alpha, lr_ratio) = epoch_schedule(
+            t.saturating_sub(cfg.pretrain_steps),
+            cfg.steps,
+            (cfg.alpha_start, cfg.alpha_end),
+            cfg.final_learning_rate_ratio,
+        );
+        let lr = cfg.learning_rate * lr_ratio;
+        let mut r = rng(cfg.seed, 1 + t as u64);
+        let p = self.pool.len();
+        let score = |j: usize| self.state.running[j] / self.pool.conditions[j].baseline_loss;
+        let mut batch = Vec::with_capacity(cfg.conditions_per_step);
+        for b in 0..cfg.conditions_per_step {
+            let mut pick = r.random_range(0..p);
+            if b >= cfg.conditions_per_step / 2 {
+                for _ in 1..TOURNAMENT {
+                    let other = r.random_range(0..p);
+                    if score(other) > score(pick) {
+                        pick = other;
+                    }
+                }
+            }
+            let instances: Vec<u32> = (0..cfg.instances_per_condition)
+                .map(|_| r.random())
+                .collect();
+            let start = r.random_range(0..cfg.pool_caps);
+            batch.push((pick, instances, start));
+        }
+        let params = self.params();
+        let results: Vec<(f64, f64, Vec<f64>)> = batch
+            .par_iter()
+            .map(|(pick, instances, start)| {
+                if pretraining {
+                    return pretrain_step(cfg, &params, &self.pool.conditions[*pick], instances);
+                }
+                condition_step(
+                    cfg,
+                    &params,
+                    &self.pool.conditions[*pick],
+                    instances,
+                    *start,
+                    alpha,
+                )
+            })
+            .collect();
+        let mut grad = vec![0.0; params.values.len()];
+        let (mut loss, mut ratio) = (0.0, 0.0);
+        let inv_b = 1.0 / batch.len() as f64;
+        for ((pick, _, _), (set_loss, union_loss, g)) in batch.iter().zip(&results) {
+            loss += (set_loss + cfg.union_weight * union_loss) * inv_b;
+            ratio += set_loss / self.pool.conditions[*pick].baseline_loss * inv_b;
+            for (a, b) in grad.iter_mut().zip(g) {
+                *a += b;
+            }
+            if pretraining {
+                continue;
+            }
+            let run = &mut self.state.running[*pick];
+            *run = if run.is_finite() {
+                0.8 * *run + 0.2 * set_loss
+            } else {
+                *set_loss
+            };
+        }
+        let mut adam = Adam::<f64>::from_state(
+            std::mem::take(&mut self.state.adam_m),
+            std::mem::take(&mut self.state.adam_v),
+            self.state.adam_t,
+        );
+        adam.step(&mut self.state.params, &grad, lr);
+        let (m, v, at) = adam.state();
+        self.state.adam_m = m.to_vec();
+        self.state.adam_v = v.to_vec();
+        self.state.adam_t = at;
+        self.state.losses.push(loss);
+        self.state.step += 1;
+        StepReport {
+            step: t,
+            loss,
+            set_ratio: ratio,
+            alpha,
+            learning_rate: lr,
+        }
+    }
+}
+
+/// A pretraining step for one condition: the squared distance of the network's
+/// square points to the warp's ([`PoolCondition::warp_targets`]) for the
+/// pretraining instance `instances[j] mod PRETRAIN_INSTANCES`; returns
+/// `(mean squared distance, 0, gradient)`.
+fn pretrain_step(
+    cfg: &TrainConfig,
+    params: &Params,
+    pc: &PoolCondition,
+    instances: &[u32],
+) -> (f64, f64, Vec<f64>) {
+    let n = cfg.n as usize;
+    let w = 1.0 / (cfg.conditions_per_step * instances.len() * n) as f64;
+    let mut grad = vec![0.0; params.values.len()];
+    let mut loss = 0.0;
+    for &r in instances {
+        let k = r % pool::PRETRAIN_INSTANCES;
+        for i in 0..cfg.n {
+            let t = params.trace(pc.unit, k, i);
+            let s = t.square_point();
+            let d = DVec2::new(s[0], s[1]) - pc.warp_targets[k as usize * n + i as usize];
+            loss += d.length_squared() / (instances.len() * n) as f64;
+            let d_out = output_gradient(&t, 2.0 * w * d);
+            backward(&params.shape, &params.values, &t, i, d_out, &mut grad);
+        }
+    }
+    (loss, 0.0, grad)
+}
+
+/// The sets of one condition in a batch: `(mean set loss, union loss, dL/dparams)`,
+/// the gradient already scaled by the batch's weights.
+fn condition_step(
+    cfg: &TrainConfig,
+    params: &Params,
+    pc: &PoolCondition,
+    instances: &[u32],
+    start: usize,
+    alpha: f64,
+) -> (f64, f64, Vec<f64>) {
+    let n = cfg.n as usize;
+    let s = instances.len();
+    let b = cfg.conditions_per_step as f64;
+    let m = cfg.caps_per_step.min(pc.caps.len());
+    let idx = |j: usize| (start + j) % pc.caps.len();
+    let caps: Vec<Cap> = (0..m).map(|j| pc.caps[idx(j)]).collect();
+    let mu: Vec<f64> = (0..m).map(|j| pc.measures[idx(j)]).collect();
+    let mut traces = Vec::with_capacity(s * n);
+    let mut squares = Vec::with_capacity(s * n);
+    let mut dirs = Vec::with_capacity(s * n);
+    for &k in instances {
+        for i in 0..cfg.n {
+            let t = params.trace(pc.unit, k, i);
+            let sq = t.square_point();
+            let p = DVec2::new(sq[0], sq[1]);
+            traces.push(t);
+            squares.push(p);
+            dirs.push(square_to_hemisphere(p));
+        }
+    }
+    let local: Vec<f64> = dirs.iter().map(|&x| pc.local_factor(x)).collect();
+    let spacing = |points: usize| (HEMISPHERE_AREA / points as f64).sqrt();
+    let mut grad3 = vec![DVec3::ZERO; s * n];
+    let mut g = vec![DVec3::ZERO; s * n];
+    let mut set_loss = 0.0;
+    for j in 0..s {
+        let range = j * n..(j + 1) * n;
+        set_loss += cap_loss_and_gradient(
+            &dirs[range.clone()],
+            &caps,
+            CapArea::Precomputed(&mu),
+            alpha / spacing(n),
+            Some(&local[range.clone()]),
+            GradientPath::Fast,
+            &mut g[range.clone()],
+        );
+        let w = 1.0 / (b * s as f64);
+        for (a, &x) in grad3[range.clone()].iter_mut().zip(&g[range]) {
+            *a += w * x;
+        }
+    }
+    set_loss /= s as f64;
+    let mut union_loss = 0.0;
+    if cfg.union_weight > 0.0 {
+        union_loss = cap_loss_and_gradient(
+            &dirs,
+            &caps,
+            CapArea::Precomputed(&mu),
+            alpha / spacing(s * n),
+            Some(&local),
+            GradientPath::Fast,
+            &mut g,
+        );
+        let w = cfg.union_weight / b;
+        for (a, &x) in grad3.iter_mut().zip(&g) {
+            *a += w * x;
+        }
+    }
+    let mut grad = vec![0.0; params.values.len()];
+    for (j, ((t, &p), &g3)) in traces.iter().zip(&squares).zip(&grad3).enumerate() {
+        let d_out = output_gradient(t, hemisphere_square_gradient(p, g3));
+        let i = (j % n) as u32;
+        backward(&params.shape, &params.values, t, i, d_out, &mut grad);
+    }
+    (set_loss, union_loss, grad)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tiny() -> TrainConfig {
+        TrainConfig {
+            n: 8,
+            hidden: vec![6, 5],
+            steps: 6,
+            pretrain_steps: 2,
+            conditions_per_step: 4,
+            instances_per_condition: 3,
+            pool_conditions: 5,
+            pool_caps: 64,
+            caps_per_step: 32,
+            seed: 7,
+            ..TrainConfig::default()
+        }
+    }
+
+    fn bits(v: &[f64]) -> Vec<u64> {
+        v.iter().map(|x| x.to_bits()).collect()
+    }
+
+    fn train_with_threads(threads: usize, config: &TrainConfig) -> Checkpoint {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut t = Trainer::new(config.clone(), None);
+            while !t.done() {
+                t.step();
+            }
+            t.state
+        })
+    }
+
+    #[test]
+    fn a_seed_fixes_the_run_bit_for_bit_at_any_thread_count() {
+        let cfg = tiny();
+        let a = train_with_threads(1, &cfg);
+        let b = train_with_threads(3, &cfg);
+        assert_eq!(bits(&a.params), bits(&b.params));
+        assert_eq!(bits(&a.losses), bits(&b.losses));
+        assert_eq!(a.losses.len(), 8);
+        // Training moved the parameters, and another seed trains differently.
+        let init = Params::init(cfg.shape().unwrap(), cfg.seed);
+        assert_ne!(bits(&a.params), bits(&init.values));
+        let c = train_with_threads(2, &TrainConfig { seed: 8, ..cfg });
+        assert_ne!(bits(&a.params), bits(&c.params));
+    }
+
+    #[test]
+    fn a_resumed_run_continues_bit_identically() {
+        let cfg = tiny();
+        let mut straight = Trainer::new(cfg.clone(), None);
+        while !straight.done() {
+            straight.step();
+        }
+        let mut first = Trainer::new(cfg.clone(), None);
+        for _ in 0..4 {
+            first.step();
+        }
+        let dir = std::env::temp_dir().join(format!("nuld-train-resume-{}", std::process::id()));
+        crate::output::ensure_dir(&dir).unwrap();
+        let path = dir.join("checkpoint.bin");
+        first.state.save(&path).unwrap();
+        drop(first);
+        let mut resumed = Trainer::new(cfg, Some(Checkpoint::load(&path).unwrap()));
+        assert_eq!(resumed.state.step, 4);
+        while !resumed.done() {
+            resumed.step();
+        }
+        assert_eq!(resumed.state, straight.state);
+        assert_eq!(bits(&resumed.state.params), bits(&straight.state.params));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn pretraining_fits_the_warp_and_the_cap_loss_falls() {
+        let cfg = TrainConfig {
+            n: 16,
+            hidden: vec![16, 16],
+            steps: 60,
+            pretrain_steps: 60,
+            conditions_per_step: 4,
+            instances_per_condition: 4,
+            pool_conditions: 8,
+            pool_caps: 256,
+            caps_per_step: 128,
+            learning_rate: 1e-2,
+            ..TrainConfig::default()
+        };
+        let mut t = Trainer::new(cfg, None);
+        let mut losses = Vec::new();
+        while !t.done() {
+            losses.push(t.step().loss);
+        }
+        let mean = |s: &[f64]| s.iter().sum::<f64>() / s.len() as f64;
+        // Squared square distance to the warp's points.
+        assert!(
+            mean(&losses[50..60]) < 0.5 * mean(&losses[..10]),
+            "{losses:?}"
+        );
+        // Cap loss.
+        assert!(mean(&losses[110..]) < mean(&losses[60..70]), "{losses:?}");
+    }
+
+    #[test]
+    fn lattice_generator_maximizes_the_shortest_vector() {
+        // Fibonacci lattices are the best rank-1 lattices of Fibonacci sizes.
+        assert_eq!(lattice_generator(8), 3);
+        let g = lattice_generator(89);
+        assert!(g == 34 || g == 55, "{g}");
+        assert_eq!(lattice_generator(1), 1);
+    }
+}
