@@ -9,11 +9,15 @@
 //!
 //! * `features` ([`input_features`], [`INPUTS`] numbers): five polynomial features of
 //!   the condition normalized to `[0,1]^2` ([`condition_features`]), the instance's
-//!   pseudo-random offset `z_k` ([`instance_offset`]), and the rank-1 lattice point
-//!   `l_i = (i/N, frac(i g / N))` shifted by `z_k` on the torus, through triangle
-//!   waves that are continuous across the torus' seams ([`lattice_features`]). The
-//!   shifted lattice makes every instance a different set by construction; the
-//!   network warps it toward the target.
+//!   pseudo-random offset `z_k` ([`instance_offset`]), and two points of the unit
+//!   square ([`lattice_features`]): the rank-1 lattice point
+//!   `l_i = (i/N, frac(i g / N))` shifted by `z_k` on the torus, `p = frac(l_i + z_k)`,
+//!   and `l_i` itself. The shifted lattice makes every instance a different set by
+//!   construction (a warp of `p` is a warp of a randomly shifted lattice, the way a
+//!   renderer warps a scrambled point); `l_i` names the index the way `E[i]` does,
+//!   so the network can also place each point on its own. A discontinuity in `z_k`
+//!   (where `p` wraps) costs nothing: instances are separate sets, and only
+//!   continuity in the condition matters (table interpolation).
 //! * `g` ([`Network::forward`]): a multilayer perceptron. Its first hidden layer adds
 //!   a learned per-index vector `E[i]` (the paper's per-index embedding `e_i`,
 //!   composed with the first layer's weights: an `H`-wide bias per index costs no
@@ -483,33 +487,30 @@ pub fn shifted_lattice_point<T: Real>(i: u32, n: u32, g: u32, z: [T; 2]) -> [T; 
     [frac(l[0] + z[0]), frac(l[1] + z[1])]
 }
 
-/// Triangle-wave features of a torus point `u`: per coordinate `tri(x)` and
-/// `tri(x + 1/4)` with `tri(x) = 4 |frac(x) - 1/2| - 1`, in `[-1,1]`. Continuous
-/// across the seams, and the pair identifies the position on the circle (the
-/// piecewise-linear analogue of `(cos, sin)`, without a transcendental).
+/// The lattice features: the shifted lattice point `p` and the lattice point `l`,
+/// each coordinate mapped from `[0,1)` to `[-1,1)` by `2x - 1`:
+/// `(2 p0 - 1, 2 p1 - 1, 2 l0 - 1, 2 l1 - 1)`.
 #[inline]
-pub fn lattice_features<T: Real>(u: [T; 2]) -> [T; 4] {
-    let half = T::of(0.5);
-    let quarter = T::of(0.25);
-    let four = T::of(4.0);
-    let tri = |x: T| four * (x - x.floor() - half).abs() - T::ONE;
+pub fn lattice_features<T: Real>(p: [T; 2], l: [T; 2]) -> [T; 4] {
+    let two = T::of(2.0);
     [
-        tri(u[0]),
-        tri(u[0] + quarter),
-        tri(u[1]),
-        tri(u[1] + quarter),
+        two * p[0] - T::ONE,
+        two * p[1] - T::ONE,
+        two * l[0] - T::ONE,
+        two * l[1] - T::ONE,
     ]
 }
 
 /// The network input of index `i`, instance `k`, normalized condition `c` (in
-/// `[0,1]^2`): `[condition_features(c), 2 z_k - 1, lattice_features(shifted
-/// lattice point)]`.
+/// `[0,1]^2`): `[condition_features(c), 2 z_k - 1, lattice_features(p, l_i)]` with
+/// `p` the [`shifted_lattice_point`] and `l_i` the [`lattice_point`].
 #[inline]
 pub fn input_features<T: Real>(shape: &Shape, c: [T; 2], k: u32, i: u32) -> [T; INPUTS] {
     let z = instance_offset::<T>(k);
-    let u = shifted_lattice_point(i, shape.n, shape.lattice_generator, z);
+    let (n, g) = (shape.n, shape.lattice_generator);
+    let p = shifted_lattice_point(i, n, g, z);
     let cf = condition_features(c);
-    let lf = lattice_features(u);
+    let lf = lattice_features(p, lattice_point(i, n, g));
     let two = T::of(2.0);
     [
         cf[0],
@@ -628,11 +629,16 @@ mod tests {
     }
 
     #[test]
-    fn lattice_features_are_continuous_on_the_torus() {
-        let a = lattice_features::<f64>([1.0 - 1e-12, 0.3]);
-        let b = lattice_features::<f64>([0.0, 0.3]);
-        assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-9));
-        assert_eq!(lattice_features::<f64>([0.5, 0.25]), [-1.0, 0.0, 0.0, -1.0]);
+    fn input_features_hold_the_shifted_and_the_plain_lattice_point() {
+        let shape = Shape::new(8, &[4], Activation::Relu, 3).unwrap();
+        let f = input_features::<f64>(&shape, [0.5, 0.25], 5, 11);
+        let z = instance_offset::<f64>(5);
+        // Index 11 wraps to 3: l = (3/8, 1/8).
+        let p = [(0.375 + z[0]) % 1.0, (0.125 + z[1]) % 1.0];
+        let want = [2.0 * p[0] - 1.0, 2.0 * p[1] - 1.0, -0.25, -0.75];
+        assert!(f[7..].iter().zip(&want).all(|(a, b)| (a - b).abs() < 1e-15));
+        assert_eq!(&f[5..7], &[2.0 * z[0] - 1.0, 2.0 * z[1] - 1.0]);
+        assert_eq!(&f[..5], &condition_features([0.5, 0.25]));
     }
 
     #[test]

@@ -56,7 +56,7 @@ pub struct TrainConfig {
     /// Gradient steps on the cap loss.
     pub steps: usize,
     /// Steps before those that fit the network to the renderer's warp of its
-    /// folded shifted-lattice input (squared distance in the square), a starting
+    /// shifted-lattice input (squared distance in the square), a starting
     /// point near the baseline instead of a random map.
     pub pretrain_steps: usize,
     /// Conditions per step `B`.
@@ -89,7 +89,7 @@ impl Default for TrainConfig {
             n: 64,
             hidden: vec![32, 32],
             silu: false,
-            steps: 2000,
+            steps: 8_000,
             pretrain_steps: 300,
             conditions_per_step: 8,
             instances_per_condition: 8,

@@ -56,7 +56,7 @@ pub struct PoolCondition {
     /// Their target measures.
     pub measures: Vec<f64>,
     /// Square points of the renderer's warp ([`BrdfTarget::sample`]) applied to
-    /// the folded shifted lattice of instances `0..PRETRAIN_INSTANCES`, in
+    /// the shifted lattice of instances `0..PRETRAIN_INSTANCES`, in
     /// `[instance][index]` order: the pretraining targets
     /// ([`super::TrainConfig::pretrain_steps`]).
     pub warp_targets: Vec<DVec2>,
@@ -82,10 +82,9 @@ impl PoolCondition {
 pub const PRETRAIN_INSTANCES: u32 = 8;
 
 /// The warp's square points for the shifted lattices of the first
-/// [`PRETRAIN_INSTANCES`] instances, each lattice coordinate folded by the tent map
-/// `u -> 2 |u - 1/2|` (which keeps the uniform measure, and which the network's
-/// triangle-wave features express exactly, so the targets are continuous in the
-/// instance offset).
+/// [`PRETRAIN_INSTANCES`] instances: the renderer's mixture warp
+/// ([`BrdfTarget::sample`]) of each shifted lattice point, which the network reads
+/// as an input, so the start is a warped randomly shifted lattice.
 fn warp_targets(target: &BrdfTarget, n: usize) -> Vec<DVec2> {
     let shape_n = n as u32;
     let g = super::lattice_generator(shape_n);
@@ -94,8 +93,7 @@ fn warp_targets(target: &BrdfTarget, n: usize) -> Vec<DVec2> {
             let z = instance_offset::<f64>(k);
             (0..shape_n).map(move |i| {
                 let u = shifted_lattice_point(i, shape_n, g, z);
-                let v = DVec2::new(2.0 * (u[0] - 0.5).abs(), 2.0 * (u[1] - 0.5).abs());
-                hemisphere_to_square(target.sample(v))
+                hemisphere_to_square(target.sample(DVec2::new(u[0], u[1])))
             })
         })
         .collect()
