@@ -22,7 +22,7 @@ pub struct BakeArgs {
     /// Point-table grid nodes: roughness,theta_o (each >= 2).
     #[arg(long, default_value = "10,12")]
     pub grid: String,
-    /// Training steps after 300 steps of pretraining on the warp [default: 8000, about 5 min on 2 cores]
+    /// Training steps after 300 steps of pretraining on the warp [default: 12000, about 7 min on 2 cores]
     #[arg(long, allow_negative_numbers = true, value_parser = super::count)]
     pub steps: Option<usize>,
     /// Seed; fixes the output bit for bit whatever the thread count.

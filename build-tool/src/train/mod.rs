@@ -89,7 +89,7 @@ impl Default for TrainConfig {
             n: 64,
             hidden: vec![32, 32],
             silu: false,
-            steps: 8_000,
+            steps: 12_000,
             pretrain_steps: 300,
             conditions_per_step: 8,
             instances_per_condition: 8,
