@@ -12,12 +12,14 @@
 //!   (independent Owen-Sobol sets: about 0.65; identical sets: 0).
 
 use crate::baselines::seeded_owen_sobol;
+use crate::eval::conditional::diversity;
 use crate::network::Params;
 use crate::sphere::metrics::{CapRadius, MeasuredCaps};
 use crate::sphere::{BrdfTarget, DirectionDensity};
 use crate::train::pool::normalized;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
+use nuld_core::network::input_features;
 use nuld_core::sphere::square_to_hemisphere;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -93,7 +95,9 @@ pub fn instance_directions(params: &Params, cond: [f64; 2], k: u32) -> Vec<DVec3
     let unit = normalized(cond);
     (0..params.shape.n())
         .map(|i| {
-            let s = params.trace(unit, k, i).square_point();
+            let s = params
+                .network()
+                .square_point(i, input_features(&params.shape, unit, k, i));
             square_to_hemisphere(DVec2::new(s[0], s[1]))
         })
         .collect()
@@ -117,7 +121,7 @@ pub fn evaluate(params: &Params, config: &QualityConfig) -> Quality {
                 |w, t| target.cap_measure(w, t),
             );
             let d = |pts: &[DVec3]| caps.l2_squared(pts, CapRadius::ThetaUniform).0.sqrt();
-            let sets: Vec<Vec<DVec3>> = (0..config.union_instances.max(config.instances))
+            let sets: Vec<Vec<DVec3>> = (0..config.union_instances.max(config.instances).max(2))
                 .into_par_iter()
                 .map(|k| instance_directions(&shipped, cond, k))
                 .collect();
@@ -140,25 +144,16 @@ pub fn evaluate(params: &Params, config: &QualityConfig) -> Quality {
                     })
                     .collect(),
             );
-            let union: Vec<DVec3> = sets[..config.union_instances as usize].concat();
-            let within = mean(
-                sets[..config.instances as usize]
-                    .iter()
-                    .map(|s| nearest_angle(s, s, true))
-                    .collect(),
-            );
-            let across = mean(
-                (0..config.instances as usize)
-                    .map(|a| nearest_angle(&sets[a], &sets[(a + 1) % sets.len()], false))
-                    .collect(),
-            );
+            // Nearest neighbours within a set need two points (`bake --n 1` has one).
+            let spread =
+                (n >= 2).then(|| diversity(&sets[..config.union_instances.max(2) as usize], &caps));
             ConditionQuality {
                 condition: cond,
                 ours,
                 baseline,
                 ratio: ours / baseline,
-                union_ratio: d(&union) / ours,
-                nn_ratio: across / within,
+                union_ratio: spread.as_ref().map_or(f64::NAN, |s| s.union_ratio),
+                nn_ratio: spread.as_ref().map_or(f64::NAN, |s| s.nn_ratio),
             }
         })
         .collect();
@@ -170,23 +165,4 @@ pub fn evaluate(params: &Params, config: &QualityConfig) -> Quality {
         mean_nn_ratio: conditions.iter().map(|c| c.nn_ratio).sum::<f64>() / m,
         conditions,
     }
-}
-
-/// Mean over `a` of the angle to the nearest point of `b` (excluding the point
-/// itself when `same`).
-fn nearest_angle(a: &[DVec3], b: &[DVec3], same: bool) -> f64 {
-    let total: f64 = a
-        .iter()
-        .enumerate()
-        .map(|(i, x)| {
-            let best = b
-                .iter()
-                .enumerate()
-                .filter(|&(j, _)| !(same && i == j))
-                .map(|(_, y)| x.dot(*y))
-                .fold(-1.0, f64::max);
-            best.clamp(-1.0, 1.0).acos()
-        })
-        .sum();
-    total / a.len().max(1) as f64
 }
