@@ -170,6 +170,9 @@ pub struct Trainer {
     pub pool: ConditionPool,
     /// Parameters, Adam state, step, running losses.
     pub state: Checkpoint,
+    /// The network's architecture (`config.shape()`, whose lattice-generator
+    /// search is built once here).
+    shape: Shape,
 }
 
 /// How many random pool members a tournament compares.
@@ -187,7 +190,7 @@ impl Trainer {
             config.pool_conditions,
             config.pool_caps,
             config.caps_per_step,
-            config.n as usize,
+            &shape,
             config.seed,
         );
         let state = match resume {
@@ -204,13 +207,14 @@ impl Trainer {
             config,
             pool,
             state,
+            shape,
         }
     }
 
     /// The current parameters.
     pub fn params(&self) -> Params {
         Params {
-            shape: self.config.shape().expect("valid network shape"),
+            shape: self.shape,
             values: self.state.params.clone(),
         }
     }

@@ -18,7 +18,7 @@ use crate::seeding::derive_seed;
 use crate::sphere::{BrdfTarget, DirectionDensity};
 use glam::{DVec2, DVec3};
 use nuld_core::brdf::{view_direction, BrdfModel, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
-use nuld_core::network::{instance_offset, shifted_lattice_point};
+use nuld_core::network::{instance_offset, shifted_lattice_point, Shape};
 use nuld_core::sphere::hemisphere_to_square;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -85,9 +85,8 @@ pub const PRETRAIN_INSTANCES: u32 = 8;
 /// [`PRETRAIN_INSTANCES`] instances: the renderer's mixture warp
 /// ([`BrdfTarget::sample`]) of each shifted lattice point, which the network reads
 /// as an input, so the start is a warped randomly shifted lattice.
-fn warp_targets(target: &BrdfTarget, n: usize) -> Vec<DVec2> {
-    let shape_n = n as u32;
-    let g = super::lattice_generator(shape_n);
+fn warp_targets(target: &BrdfTarget, shape: &Shape) -> Vec<DVec2> {
+    let (shape_n, g) = (shape.n(), shape.lattice_generator());
     (0..PRETRAIN_INSTANCES)
         .flat_map(|k| {
             let z = instance_offset::<f64>(k);
@@ -106,9 +105,9 @@ pub struct ConditionPool {
 }
 
 impl ConditionPool {
-    /// `count` conditions with `caps` caps each, for sets of `n` points, from
-    /// `seed`; built in parallel, identical for any thread count.
-    pub fn new(count: usize, caps: usize, window: usize, n: usize, seed: u64) -> Self {
+    /// `count` conditions with `caps` caps each, for the sets of a network of
+    /// `shape`, from `seed`; built in parallel, identical for any thread count.
+    pub fn new(count: usize, caps: usize, window: usize, shape: &Shape, seed: u64) -> Self {
         let scramble = derive_seed(seed, 0x706f_6f6c) as u32;
         let conditions = (0..count)
             .into_par_iter()
@@ -119,7 +118,7 @@ impl ConditionPool {
                 ];
                 let cond: [f64; 2] =
                     core::array::from_fn(|a| COND_MIN[a] + u[a] * (COND_MAX[a] - COND_MIN[a]));
-                condition(cond, caps, window, n, derive_seed(seed, p as u64))
+                condition(cond, caps, window, shape, derive_seed(seed, p as u64))
             })
             .collect();
         Self { conditions }
@@ -136,7 +135,14 @@ impl ConditionPool {
     }
 }
 
-fn condition(cond: [f64; 2], caps: usize, window: usize, n: usize, seed: u64) -> PoolCondition {
+fn condition(
+    cond: [f64; 2],
+    caps: usize,
+    window: usize,
+    shape: &Shape,
+    seed: u64,
+) -> PoolCondition {
+    let n = shape.n() as usize;
     let target = BrdfTarget::coarse(cond[0], cond[1], POOL_RULE_POINTS)
         .expect("pool conditions lie in the condition range");
     let caps = epoch_caps(seed, 0, caps);
@@ -151,7 +157,7 @@ fn condition(cond: [f64; 2], caps: usize, window: usize, n: usize, seed: u64) ->
         albedo: target.albedo(),
         caps,
         measures,
-        warp_targets: warp_targets(&target, n),
+        warp_targets: warp_targets(&target, shape),
         baseline_loss: 0.0,
     };
     let w = window.min(pc.caps.len());
