@@ -19,5 +19,6 @@ pub mod pointset;
 pub mod progress;
 pub mod runtime_speed;
 pub mod seeding;
+pub mod shader;
 pub mod sphere;
 pub mod train;

@@ -378,8 +378,8 @@ impl<W> Network<W> {
 
 /// Partial sums of [`dot`]: products `k ≡ c (mod DOT_LANES)` go to partial `c`,
 /// so the sum is a fixed tree that compilers turn into SIMD, and is the same on
-/// every platform.
-const DOT_LANES: usize = 8;
+/// every platform (shaders sum in the same order, runtime/shaders/nuld.wgsl).
+pub const DOT_LANES: usize = 8;
 
 /// `sum_k w[k] x[k]` over the shorter length, in this order of operations: partial
 /// sums `s[c] = sum over k ≡ c (mod 8), k ascending`, then

@@ -53,6 +53,10 @@
 //!   `AlignedBuf::read` with `std` (`runtime/examples/load_file.rs`). Without the
 //!   features, copy the bytes into any 16-byte aligned storage of your own.
 //!
+//! On a GPU, upload the blob's bytes unchanged as a storage buffer and sample it
+//! from your shader with the WGSL of [`shader`] (one function per runtime
+//! function).
+//!
 //! ## Features
 //! * none (default): `no_std`, no allocator;
 //! * `alloc`: `AlignedBuf`, an owned aligned copy of a blob;
@@ -70,6 +74,7 @@ mod aligned;
 mod aligned_buf;
 mod conditional;
 mod points;
+pub mod shader;
 
 /// The `glam` this crate returns its vectors in; use it instead of a `glam`
 /// dependency of your own so that the versions always match.

@@ -7,6 +7,7 @@ pub mod export;
 pub mod metrics;
 pub mod optimize;
 pub mod sample;
+pub mod shader;
 pub mod sobol;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -38,6 +39,8 @@ pub enum Command {
     Bake(bake::BakeArgs),
     /// Time the optimizer: fast vs dense gradient per epoch, and full default runs.
     Bench(bench::BenchArgs),
+    /// Write the sampling kernel (WGSL sampler + compute entry point) in a shading language.
+    Shader(shader::ShaderArgs),
     /// Evaluate the paper's §5 figures (fig2, fig3, fig5, fig6, fig7, all): CSV, JSON, plots.
     Eval(eval::EvalArgs),
 }
@@ -91,5 +94,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Metrics(a) => metrics::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Eval(a) => eval::run(a),
+        Command::Shader(a) => shader::run(a),
     }
 }

@@ -1,0 +1,676 @@
+// nuld shader-side samplers (WGSL): the sampling functions of `nuld-runtime`, over
+// the bytes of a `.nuld` blob uploaded unchanged as one storage buffer.
+//
+// Declare the buffer once in your module, under this name, at any group and
+// binding (WGSL resolves module-scope names in any order, so before or after this
+// text):
+//
+//     @group(0) @binding(0) var<storage, read> nuld_blob: array<u32>;
+//
+// Word `w` of `nuld_blob` holds bytes `4w..4w+4` of the blob (little-endian, as
+// every GPU reads a storage buffer). The byte layout and the order of operations
+// are those of core/FORMAT.md; every header field and section offset is read from
+// the buffer, so one shader serves any blob of a kind.
+//
+// Validate the blob on the CPU before uploading it (`nuld_runtime::Blob::parse`):
+// the functions here trust what it checks. On a blob it rejects they still do not
+// read outside the buffer (WGSL bounds every array access) but return meaningless
+// values.
+//
+// Each `nuld_*` function is the Rust function it names, in the same order of
+// operations. Table mode and the point lookups reproduce the runtime to `f32`
+// rounding of the driver's `sin`, `cos`, `sqrt`, `acos` and division; network mode
+// adds the driver's `exp` and the order of its multiply-adds (the runtime's dot
+// product order is kept; a driver may still fuse a multiply and an add).
+
+// ---- Blob layout (core/FORMAT.md): byte offsets and codes ----------------------
+
+// `Header::kind` (core/src/blob.rs).
+const NULD_HEADER_KIND: u32 = 12u;
+// `Header::section_count`.
+const NULD_HEADER_SECTION_COUNT: u32 = 40u;
+// `HEADER_LEN`: the section table starts here.
+const NULD_HEADER_LEN: u32 = 48u;
+// `SECTION_ENTRY_LEN`: bytes per section table row.
+const NULD_SECTION_ENTRY_LEN: u32 = 32u;
+// `SectionEntry::tag`, `SectionEntry::offset` (a u64; its high word is 0 in any
+// blob that fits a buffer).
+const NULD_SECTION_TAG: u32 = 0u;
+const NULD_SECTION_OFFSET: u32 = 8u;
+// `MAX_SECTIONS`: rows a valid blob has at most.
+const NULD_MAX_SECTIONS: u32 = 64u;
+
+// `BlobKind` codes.
+const NULD_KIND_POINT_SET_2D: u32 = 1u;
+const NULD_KIND_DIRECTION_SET: u32 = 2u;
+const NULD_KIND_CONDITIONAL: u32 = 3u;
+
+// `SectionTag` codes.
+const NULD_TAG_POINT_SET_INFO: u32 = 1u;
+const NULD_TAG_POINTS: u32 = 2u;
+const NULD_TAG_CONDITIONAL_INFO: u32 = 3u;
+const NULD_TAG_NETWORK_PARAMS: u32 = 4u;
+const NULD_TAG_POINT_TABLE: u32 = 5u;
+const NULD_TAG_WEIGHT_TABLE: u32 = 6u;
+
+// `Domain` codes.
+const NULD_DOMAIN_SQUARE: u32 = 0u;
+const NULD_DOMAIN_SPHERE: u32 = 1u;
+const NULD_DOMAIN_HEMISPHERE: u32 = 2u;
+
+// `PointSetInfo` fields.
+const NULD_POINT_SET_LEN: u32 = 0u;
+const NULD_POINT_SET_COUNT: u32 = 4u;
+const NULD_POINT_SET_DOMAIN: u32 = 8u;
+
+// `ConditionalInfo` fields (two-element fields: the second element 4 bytes on).
+const NULD_INFO_N: u32 = 0u;
+const NULD_INFO_INSTANCES: u32 = 4u;
+const NULD_INFO_DOMAIN: u32 = 8u;
+const NULD_INFO_TARGET: u32 = 12u;
+const NULD_INFO_GRID: u32 = 16u;
+const NULD_INFO_WEIGHT_GRID: u32 = 24u;
+const NULD_INFO_COND_MIN: u32 = 32u;
+const NULD_INFO_COND_MAX: u32 = 40u;
+const NULD_INFO_HIDDEN: u32 = 48u;
+const NULD_INFO_ACTIVATION: u32 = 60u;
+const NULD_INFO_LATTICE_GENERATOR: u32 = 64u;
+
+// `nuld_core::network`: `INPUTS`, `MAX_WIDTH`, `MAX_HIDDEN_LAYERS`, `OUTPUTS`, and
+// the dot product's partial sums (`DOT_LANES`).
+const NULD_INPUTS: u32 = 11u;
+const NULD_MAX_WIDTH: u32 = 128u;
+const NULD_MAX_HIDDEN_LAYERS: u32 = 3u;
+const NULD_OUTPUTS: u32 = 2u;
+const NULD_DOT_LANES: u32 = 8u;
+// `Activation` codes.
+const NULD_ACTIVATION_RELU: u32 = 0u;
+const NULD_ACTIVATION_SILU: u32 = 1u;
+
+// `f32` constants written as the runtime's `f32` values (a decimal literal would be
+// rounded from the exact value, which is not always the same `f32`).
+// `FRAC_PI_4`, `FRAC_PI_2` rounded to f32.
+const NULD_FRAC_PI_4: f32 = 0.78539818525314331055;
+const NULD_FRAC_PI_2: f32 = 1.57079637050628662109;
+// `DEGREES_PER_RADIAN` of runtime/src/conditional.rs: `180 / PI` divided in f32.
+const NULD_DEGREES_PER_RADIAN: f32 = 57.2957763671875;
+// `1 / UNORM16_CELLS` (core/src/quantize.rs).
+const NULD_UNORM16_SCALE: f32 = 0.0000152587890625;
+// `2^-24`: the instance offset's unit (core/src/network.rs `instance_offset`).
+const NULD_INSTANCE_UNIT: f32 = 0.000000059604644775390625;
+// `2^-24`: the smallest binary16 subnormal (`f16_decode_finite(1)`).
+const NULD_F16_SUBNORMAL: f32 = 0.000000059604644775390625;
+
+// ---- Buffer access ------------------------------------------------------------
+
+// The u32 at byte offset `byte` (a multiple of 4).
+fn nuld_u32(byte: u32) -> u32 {
+    return nuld_blob[byte / 4u];
+}
+
+// The f32 at byte offset `byte` (a multiple of 4).
+fn nuld_f32(byte: u32) -> f32 {
+    return bitcast<f32>(nuld_blob[byte / 4u]);
+}
+
+// Rust: `Layout::header().kind` (core/src/blob.rs).
+fn nuld_kind() -> u32 {
+    return nuld_u32(NULD_HEADER_KIND);
+}
+
+// Rust: `Layout::section` (core/src/blob.rs): the byte offset of the first section
+// with this tag; 0 (the header) if there is none, which a valid blob of the kind
+// that needs the section never has.
+fn nuld_section(tag: u32) -> u32 {
+    let count = min(nuld_u32(NULD_HEADER_SECTION_COUNT), NULD_MAX_SECTIONS);
+    for (var r = 0u; r < count; r++) {
+        let row = NULD_HEADER_LEN + r * NULD_SECTION_ENTRY_LEN;
+        if nuld_u32(row + NULD_SECTION_TAG) == tag {
+            return nuld_u32(row + NULD_SECTION_OFFSET);
+        }
+    }
+    return 0u;
+}
+
+// ---- Scalars (core/src/quantize.rs, core/src/real.rs) -------------------------
+
+// Rust: `unorm16_decode`: the cell centre `(q + 0.5) / 65536` of a u16 code.
+fn nuld_unorm16_decode(q: u32) -> f32 {
+    return (f32(q) + 0.5) * NULD_UNORM16_SCALE;
+}
+
+// Rust: `f32::is_nan`, on the bits: a driver may assume that no float is NaN and
+// fold `x != x` away, but not an integer test.
+fn nuld_is_nan(x: f32) -> bool {
+    return (bitcast<u32>(x) & 0x7fffffffu) > 0x7f800000u;
+}
+
+// Rust: `f32::is_finite`, on the bits.
+fn nuld_is_finite(x: f32) -> bool {
+    return (bitcast<u32>(x) & 0x7f800000u) != 0x7f800000u;
+}
+
+// Rust: `f32::copysign`: the magnitude of `x` with the sign bit of `s`.
+fn nuld_copysign(x: f32, s: f32) -> f32 {
+    return bitcast<f32>((bitcast<u32>(x) & 0x7fffffffu) | (bitcast<u32>(s) & 0x80000000u));
+}
+
+// ---- Equal-area maps (core/src/sphere.rs, core/src/domain.rs) -----------------
+
+// Rust: `square_to_sphere_real`: the octahedral equal-area map (Clarberg 2008, as
+// pbrt-v4's `EqualAreaSquareToSphere`) from `[0,1]^2` to the unit sphere.
+fn nuld_square_to_sphere(p: vec2<f32>) -> vec3<f32> {
+    let u = 2.0 * p.x - 1.0;
+    let v = 2.0 * p.y - 1.0;
+    let up = abs(u);
+    let vp = abs(v);
+    let signed_distance = 1.0 - (up + vp);
+    let d = abs(signed_distance);
+    let r = 1.0 - d;
+    var phi = 1.0;
+    if r != 0.0 {
+        phi = (vp - up) / r + 1.0;
+    }
+    phi = phi * NULD_FRAC_PI_4;
+    let z = nuld_copysign(1.0 - r * r, signed_distance);
+    let cos_phi = nuld_copysign(cos(phi), u);
+    let sin_phi = nuld_copysign(sin(phi), v);
+    let s = r * sqrt(max(2.0 - r * r, 0.0));
+    return vec3<f32>(cos_phi * s, sin_phi * s, z);
+}
+
+// Rust: `square_to_hemisphere_real` (with `concentric_polar`, core/src/warp.rs):
+// the Shirley-Chiu concentric map lifted to the upper hemisphere, equal-area.
+fn nuld_square_to_hemisphere(p: vec2<f32>) -> vec3<f32> {
+    let a = 2.0 * p.x - 1.0;
+    let b = 2.0 * p.y - 1.0;
+    if a == 0.0 && b == 0.0 {
+        return vec3<f32>(0.0, 0.0, 1.0);
+    }
+    var r: f32;
+    var theta: f32;
+    if abs(a) > abs(b) {
+        r = a;
+        theta = NULD_FRAC_PI_4 * (b / a);
+    } else {
+        r = b;
+        theta = NULD_FRAC_PI_2 - NULD_FRAC_PI_4 * (a / b);
+    }
+    let r2 = r * r;
+    let s = r * sqrt(max(2.0 - r2, 0.0));
+    return vec3<f32>(s * cos(theta), s * sin(theta), 1.0 - r2);
+}
+
+// Rust: `Domain::to_direction_real`: the hemisphere map for the hemisphere, the
+// sphere map otherwise.
+fn nuld_to_direction(domain: u32, p: vec2<f32>) -> vec3<f32> {
+    if domain == NULD_DOMAIN_HEMISPHERE {
+        return nuld_square_to_hemisphere(p);
+    }
+    return nuld_square_to_sphere(p);
+}
+
+// ---- Point and direction sets (kinds 1 and 2; runtime/src/points.rs) ----------
+
+// Rust: `PointSet2D::len`, `DirectionSet::len`, `ConditionalSampler::len`: points
+// per set, for any kind.
+fn nuld_len() -> u32 {
+    if nuld_kind() == NULD_KIND_CONDITIONAL {
+        return nuld_u32(nuld_section(NULD_TAG_CONDITIONAL_INFO) + NULD_INFO_N);
+    }
+    return nuld_u32(nuld_section(NULD_TAG_POINT_SET_INFO) + NULD_POINT_SET_LEN);
+}
+
+// Rust: `PointSet2D::set_count`, `DirectionSet::set_count`.
+fn nuld_set_count() -> u32 {
+    return nuld_u32(nuld_section(NULD_TAG_POINT_SET_INFO) + NULD_POINT_SET_COUNT);
+}
+
+// Rust: `DirectionSet::domain` (a `Domain` code).
+fn nuld_domain() -> u32 {
+    if nuld_kind() == NULD_KIND_CONDITIONAL {
+        return nuld_u32(nuld_section(NULD_TAG_CONDITIONAL_INFO) + NULD_INFO_DOMAIN);
+    }
+    return nuld_u32(nuld_section(NULD_TAG_POINT_SET_INFO) + NULD_POINT_SET_DOMAIN);
+}
+
+// Rust: `PointSet2D::raw`: the u16 codes `(qx, qy)` of point `i` (mod len) of set
+// `set_index` (mod set count).
+fn nuld_raw(set_index: u32, i: u32) -> vec2<u32> {
+    let info = nuld_section(NULD_TAG_POINT_SET_INFO);
+    let len = nuld_u32(info + NULD_POINT_SET_LEN);
+    let sets = nuld_u32(info + NULD_POINT_SET_COUNT);
+    let w = nuld_u32(nuld_section(NULD_TAG_POINTS) + 4u * ((set_index % sets) * len + i % len));
+    return vec2<u32>(w & 0xffffu, w >> 16u);
+}
+
+// Rust: `PointSet2D::point` (also `DirectionSet::square_point`): point `i` of set
+// `set_index` in `(0,1)^2`, exactly the runtime's value.
+fn nuld_point(set_index: u32, i: u32) -> vec2<f32> {
+    let q = nuld_raw(set_index, i);
+    return vec2<f32>(nuld_unorm16_decode(q.x), nuld_unorm16_decode(q.y));
+}
+
+// Rust: `DirectionSet::direction`: direction `i` of set `set_index`, a unit vector.
+// The runtime maps in `f64` and rounds; this maps in `f32` (a few ulps apart).
+fn nuld_direction(set_index: u32, i: u32) -> vec3<f32> {
+    return nuld_to_direction(nuld_domain(), nuld_point(set_index, i));
+}
+
+// ---- Conditional samplers (kind 3; core/src/conditional.rs) -------------------
+
+// Rust: `ConditionalInfo` (core/src/conditional.rs), field for field at the same
+// byte offsets and of the same size (`target` is a reserved word in WGSL; `hidden`
+// is a vector and the zero `reserved` tail is left to the struct's padding, since
+// naga's GLSL front end does not read back arrays in struct constructors).
+struct NuldConditionalInfo {
+    n: u32,
+    instances: u32,
+    domain: u32,
+    target_code: u32,
+    grid: vec2<u32>,
+    weight_grid: vec2<u32>,
+    cond_min: vec2<f32>,
+    cond_max: vec2<f32>,
+    hidden: vec3<u32>,
+    activation: u32,
+    lattice_generator: u32,
+}
+
+// Rust: `ConditionalSampler::info` (the info section read from the buffer).
+fn nuld_info() -> NuldConditionalInfo {
+    let o = nuld_section(NULD_TAG_CONDITIONAL_INFO);
+    var info: NuldConditionalInfo;
+    info.n = nuld_u32(o + NULD_INFO_N);
+    info.instances = nuld_u32(o + NULD_INFO_INSTANCES);
+    info.domain = nuld_u32(o + NULD_INFO_DOMAIN);
+    info.target_code = nuld_u32(o + NULD_INFO_TARGET);
+    info.grid = vec2<u32>(nuld_u32(o + NULD_INFO_GRID), nuld_u32(o + NULD_INFO_GRID + 4u));
+    info.weight_grid = vec2<u32>(
+        nuld_u32(o + NULD_INFO_WEIGHT_GRID),
+        nuld_u32(o + NULD_INFO_WEIGHT_GRID + 4u),
+    );
+    info.cond_min = vec2<f32>(nuld_f32(o + NULD_INFO_COND_MIN), nuld_f32(o + NULD_INFO_COND_MIN + 4u));
+    info.cond_max = vec2<f32>(nuld_f32(o + NULD_INFO_COND_MAX), nuld_f32(o + NULD_INFO_COND_MAX + 4u));
+    for (var l = 0u; l < NULD_MAX_HIDDEN_LAYERS; l++) {
+        info.hidden[l] = nuld_u32(o + NULD_INFO_HIDDEN + 4u * l);
+    }
+    info.activation = nuld_u32(o + NULD_INFO_ACTIVATION);
+    info.lattice_generator = nuld_u32(o + NULD_INFO_LATTICE_GENERATOR);
+    return info;
+}
+
+// Rust: `ConditionalSampler::instances`: instances stored in the point table.
+fn nuld_instances() -> u32 {
+    return nuld_u32(nuld_section(NULD_TAG_CONDITIONAL_INFO) + NULD_INFO_INSTANCES);
+}
+
+// Rust: `ConditionalInfo::normalize`: the condition clamped into
+// `[cond_min, cond_max]` per axis (NaN to `cond_min`), mapped to `[0,1]`.
+fn nuld_normalize(info: NuldConditionalInfo, c: vec2<f32>) -> vec2<f32> {
+    var u = vec2<f32>(0.0, 0.0);
+    for (var a = 0u; a < 2u; a++) {
+        let lo = info.cond_min[a];
+        let hi = info.cond_max[a];
+        var x = lo;
+        if !nuld_is_nan(c[a]) {
+            x = clamp(c[a], lo, hi);
+        }
+        let v = (x - lo) / (hi - lo);
+        if nuld_is_finite(v) {
+            u[a] = clamp(v, 0.0, 1.0);
+        }
+    }
+    return u;
+}
+
+// Rust: `GridCell` (`AxisCell` per axis): the lower corner node `j0` and the
+// fraction `t` within the cell.
+struct NuldGridCell {
+    j0: vec2<u32>,
+    t: vec2<f32>,
+    nodes: vec2<u32>,
+}
+
+// Rust: `GridCell::locate` (`AxisCell::locate` per axis): `s = u (nodes - 1)`,
+// `j0 = min(floor(s), nodes - 2)`, `t = s - j0`.
+fn nuld_locate(u: vec2<f32>, nodes: vec2<u32>) -> NuldGridCell {
+    var cell: NuldGridCell;
+    cell.nodes = nodes;
+    for (var a = 0u; a < 2u; a++) {
+        cell.j0[a] = 0u;
+        cell.t[a] = 0.0;
+        if nodes[a] >= 2u {
+            var x = 0.0;
+            if !nuld_is_nan(u[a]) {
+                x = clamp(u[a], 0.0, 1.0);
+            }
+            let s = x * f32(nodes[a] - 1u);
+            let j0 = min(u32(s), nodes[a] - 2u);
+            cell.j0[a] = j0;
+            cell.t[a] = s - f32(j0);
+        }
+    }
+    return cell;
+}
+
+// Rust: `GridCell::node`: the linear index `j1 nodes[0] + j0` of corner `(dx, dy)`.
+fn nuld_node(cell: NuldGridCell, dx: u32, dy: u32) -> u32 {
+    return (cell.j0.y + dy) * cell.nodes.x + (cell.j0.x + dx);
+}
+
+// Rust: `GridCell::lerp`, in its order of operations.
+fn nuld_lerp(cell: NuldGridCell, v00: f32, v10: f32, v01: f32, v11: f32) -> f32 {
+    let a = v00 + (v10 - v00) * cell.t.x;
+    let b = v01 + (v11 - v01) * cell.t.x;
+    return a + (b - a) * cell.t.y;
+}
+
+// Rust: `ConditionalSampler::weight`: the weight table interpolated at `cond`.
+fn nuld_weight(cond: vec2<f32>) -> f32 {
+    let info = nuld_info();
+    let cell = nuld_locate(nuld_normalize(info, cond), info.weight_grid);
+    let w = nuld_section(NULD_TAG_WEIGHT_TABLE);
+    return nuld_lerp(
+        cell,
+        nuld_f32(w + 4u * nuld_node(cell, 0u, 0u)),
+        nuld_f32(w + 4u * nuld_node(cell, 1u, 0u)),
+        nuld_f32(w + 4u * nuld_node(cell, 0u, 1u)),
+        nuld_f32(w + 4u * nuld_node(cell, 1u, 1u)),
+    );
+}
+
+// Rust: `ConditionalSampler::square_point` (table mode): the four stored points of
+// the cell around `cond`, interpolated bilinearly per coordinate.
+fn nuld_square_point(cond: vec2<f32>, instance: u32, i: u32) -> vec2<f32> {
+    let info = nuld_info();
+    let cell = nuld_locate(nuld_normalize(info, cond), info.grid);
+    let table = nuld_section(NULD_TAG_POINT_TABLE);
+    let k = instance % info.instances;
+    let j = i % info.n;
+    // `ConditionalInfo::point_table_index`: layout [node][instance][index].
+    let q00 = nuld_u32(table + 4u * ((nuld_node(cell, 0u, 0u) * info.instances + k) * info.n + j));
+    let q10 = nuld_u32(table + 4u * ((nuld_node(cell, 1u, 0u) * info.instances + k) * info.n + j));
+    let q01 = nuld_u32(table + 4u * ((nuld_node(cell, 0u, 1u) * info.instances + k) * info.n + j));
+    let q11 = nuld_u32(table + 4u * ((nuld_node(cell, 1u, 1u) * info.instances + k) * info.n + j));
+    let x = nuld_lerp(
+        cell,
+        nuld_unorm16_decode(q00 & 0xffffu),
+        nuld_unorm16_decode(q10 & 0xffffu),
+        nuld_unorm16_decode(q01 & 0xffffu),
+        nuld_unorm16_decode(q11 & 0xffffu),
+    );
+    let y = nuld_lerp(
+        cell,
+        nuld_unorm16_decode(q00 >> 16u),
+        nuld_unorm16_decode(q10 >> 16u),
+        nuld_unorm16_decode(q01 >> 16u),
+        nuld_unorm16_decode(q11 >> 16u),
+    );
+    return vec2<f32>(x, y);
+}
+
+// ---- Network mode (core/src/network.rs) ----------------------------------------
+
+// Rust: `sigmoid`: `1 / (1 + exp(-x))`.
+fn nuld_sigmoid(x: f32) -> f32 {
+    return 1.0 / (1.0 + exp(-x));
+}
+
+// Rust: `Activation::apply`.
+fn nuld_activation(code: u32, x: f32) -> f32 {
+    if code == NULD_ACTIVATION_SILU {
+        return x * nuld_sigmoid(x);
+    }
+    return max(x, 0.0);
+}
+
+// Rust: `hash_u32` (lowbias32), wrapping u32 arithmetic.
+fn nuld_hash_u32(x0: u32) -> u32 {
+    var x = x0;
+    x ^= x >> 16u;
+    x *= 0x7feb352du;
+    x ^= x >> 15u;
+    x *= 0x846ca68bu;
+    x ^= x >> 16u;
+    return x;
+}
+
+// Rust: `instance_offset`: the instance's pseudo-random point of `[0,1)^2`.
+fn nuld_instance_offset(k: u32) -> vec2<f32> {
+    let k2 = k * 2u;
+    return vec2<f32>(
+        f32(nuld_hash_u32(k2) >> 8u) * NULD_INSTANCE_UNIT,
+        f32(nuld_hash_u32(k2 + 1u) >> 8u) * NULD_INSTANCE_UNIT,
+    );
+}
+
+// `(a b) mod n` for `a < n` as if in 64 bits (WGSL has no u64): the product
+// directly when it fits in 32 bits, else by doubling and adding, each step reduced
+// mod `n`.
+fn nuld_mul_mod(a: u32, b0: u32, n: u32) -> u32 {
+    let b = b0 % n;
+    if b == 0u || a <= 0xffffffffu / b {
+        return (a * b) % n;
+    }
+    var r = 0u;
+    for (var bit = 31i; bit >= 0i; bit--) {
+        // r = 2 r mod n, without overflow (r < n).
+        if r >= n - r {
+            r = r - (n - r);
+        } else {
+            r = r + r;
+        }
+        if ((b >> u32(bit)) & 1u) == 1u {
+            // r = r + a mod n.
+            if r >= n - a {
+                r = r - (n - a);
+            } else {
+                r = r + a;
+            }
+        }
+    }
+    return r;
+}
+
+// Rust: `lattice_point`: the rank-1 lattice point `(i/n, ((i g) mod n)/n)`,
+// `i` mod `n`, `i g` in 64 bits.
+fn nuld_lattice_point(i0: u32, n0: u32, g: u32) -> vec2<f32> {
+    let n = max(n0, 1u);
+    let i = i0 % n;
+    let j = nuld_mul_mod(i, g, n);
+    let nf = f32(n);
+    return vec2<f32>(f32(i) / nf, f32(j) / nf);
+}
+
+// Rust: `input_features`: the network's 11 inputs (condition, instance offset,
+// shifted lattice point, lattice point), each mapped by `2x - 1`.
+fn nuld_input_features(info: NuldConditionalInfo, c: vec2<f32>, k: u32, i: u32) -> array<f32, 11> {
+    let z = nuld_instance_offset(k);
+    let l = nuld_lattice_point(i, info.n, info.lattice_generator);
+    // `shifted_lattice_point`: `frac(l + z)` with `frac(x) = x - floor(x)`.
+    let lz = l + z;
+    let p = lz - floor(lz);
+    // `condition_features`: `(u, v, u v, u^2, v^2)` of the clamped condition.
+    var cu = vec2<f32>(0.0, 0.0);
+    for (var a = 0u; a < 2u; a++) {
+        if !nuld_is_nan(c[a]) {
+            cu[a] = min(max(c[a], 0.0), 1.0);
+        }
+    }
+    let u = cu.x;
+    let v = cu.y;
+    return array<f32, 11>(
+        2.0 * u - 1.0,
+        2.0 * v - 1.0,
+        2.0 * (u * v) - 1.0,
+        2.0 * (u * u) - 1.0,
+        2.0 * (v * v) - 1.0,
+        2.0 * z.x - 1.0,
+        2.0 * z.y - 1.0,
+        2.0 * p.x - 1.0,
+        2.0 * p.y - 1.0,
+        2.0 * l.x - 1.0,
+        2.0 * l.y - 1.0,
+    );
+}
+
+// Rust: `f16_decode_finite` (core/src/quantize.rs): finite IEEE binary16 bits to
+// the exact `f32`, in integer operations. (`unpack2x16float` would do, but wgpu and
+// naga require a capability for it that Mesa's Vulkan drivers grant only with
+// `shaderFloat16`; and a subnormal `f32` intermediate could be flushed to zero.)
+fn nuld_f16_decode(h: u32) -> f32 {
+    let sign = (h & 0x8000u) << 16u;
+    let e = (h >> 10u) & 0x1fu;
+    let m = h & 0x3ffu;
+    if e == 0u {
+        // Zero or subnormal: m 2^-24, a normal f32 (or zero), exact.
+        return bitcast<f32>(bitcast<u32>(f32(m) * NULD_F16_SUBNORMAL) | sign);
+    }
+    // Rebias the exponent from 15 to 127.
+    return bitcast<f32>(sign | ((e + 112u) << 23u) | (m << 13u));
+}
+
+// Rust: `F16Params::get`: parameter `j` of the network section starting at byte
+// `params`; the low half of a word is the even parameter.
+fn nuld_param(params: u32, j: u32) -> f32 {
+    let word = nuld_blob[params / 4u + j / 2u];
+    return nuld_f16_decode((word >> (16u * (j & 1u))) & 0xffffu);
+}
+
+// Rust: `dot` (core/src/network.rs): `sum_k w[k] x[k]` over `len` terms, the
+// weights from parameter `w`, in eight partial sums `s[k mod 8]` (k ascending),
+// combined as `((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7))`.
+fn nuld_dot(params: u32, w: u32, x: ptr<function, array<f32, 128>>, len: u32) -> f32 {
+    var s = array<f32, 8>(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for (var k = 0u; k < len; k++) {
+        let c = k % NULD_DOT_LANES;
+        s[c] = s[c] + nuld_param(params, w + k) * (*x)[k];
+    }
+    return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
+}
+
+// Rust: `Network::evaluate`: the two outputs (before the sigmoid) of the network on
+// `input` for index `i`: hidden layer 1 `act((b1[o] + E[i][o]) + dot(W1[o], a))`,
+// further layers `act(b[o] + dot(W[o], a))`, outputs `bo[o] + dot(Wo[o], a)`.
+fn nuld_network_evaluate(info: NuldConditionalInfo, i: u32, input: array<f32, 11>) -> vec2<f32> {
+    let params = nuld_section(NULD_TAG_NETWORK_PARAMS);
+    var a: array<f32, 128>;
+    var b: array<f32, 128>;
+    for (var k = 0u; k < NULD_INPUTS; k++) {
+        a[k] = input[k];
+    }
+    var fan_in = NULD_INPUTS;
+    let h1 = info.hidden[0];
+    // `Shape::first_layer_offset` and `Shape::embedding_offset`.
+    var off = info.n * h1;
+    let embedding = (i % info.n) * h1;
+    for (var l = 0u; l < NULD_MAX_HIDDEN_LAYERS; l++) {
+        let h = min(info.hidden[l], NULD_MAX_WIDTH);
+        if h == 0u {
+            break;
+        }
+        let bias = off + h * fan_in;
+        for (var o = 0u; o < h; o++) {
+            var acc = nuld_param(params, bias + o);
+            if l == 0u {
+                acc = acc + nuld_param(params, embedding + o);
+            }
+            b[o] = nuld_activation(info.activation, acc + nuld_dot(params, off + o * fan_in, &a, fan_in));
+        }
+        for (var o = 0u; o < h; o++) {
+            a[o] = b[o];
+        }
+        off = bias + h;
+        fan_in = h;
+    }
+    let bias = off + NULD_OUTPUTS * fan_in;
+    return vec2<f32>(
+        nuld_param(params, bias) + nuld_dot(params, off, &a, fan_in),
+        nuld_param(params, bias + 1u) + nuld_dot(params, off + fan_in, &a, fan_in),
+    );
+}
+
+// Rust: `ConditionalSampler::network_square_point` (network mode): the network's
+// outputs through the sigmoid, for any u32 instance.
+fn nuld_network_square_point(cond: vec2<f32>, instance: u32, i: u32) -> vec2<f32> {
+    let info = nuld_info();
+    let u = nuld_normalize(info, cond);
+    let out = nuld_network_evaluate(info, i, nuld_input_features(info, u, instance, i));
+    return vec2<f32>(nuld_sigmoid(out.x), nuld_sigmoid(out.y));
+}
+
+// ---- Samples (runtime/src/conditional.rs) -------------------------------------
+
+// Rust: `Sample`: a unit direction (local frame, `z` = normal) and the estimator
+// weight of its condition. 16 bytes in a storage buffer.
+struct NuldSample {
+    direction: vec3<f32>,
+    weight: f32,
+}
+
+// Rust: `ConditionalSampler::sample` (table mode): direction `i` (mod n) of
+// instance `instance` (mod instances) at condition `cond` (blob units; for BRDF
+// samplers `(roughness, theta_o in degrees)`, the view in the xz-plane, `+x` side).
+fn nuld_sample(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
+    let p = nuld_square_point(cond, instance, i);
+    return NuldSample(nuld_to_direction(nuld_domain(), p), nuld_weight(cond));
+}
+
+// Rust: `ConditionalSampler::sample_network` (network mode): as `nuld_sample`, every
+// u32 instance its own set.
+fn nuld_sample_network(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
+    let p = nuld_network_square_point(cond, instance, i);
+    return NuldSample(nuld_to_direction(nuld_domain(), p), nuld_weight(cond));
+}
+
+// Rust: `view_condition` (runtime/src/conditional.rs): the condition
+// `(roughness, theta_o in degrees)` of the view `wo` (any length; scaled by its
+// largest component first) and its azimuth `(cos phi, sin phi)`; a zero, infinite
+// or NaN view reads as normal incidence with azimuth `(1, 0)`.
+struct NuldView {
+    cond: vec2<f32>,
+    azimuth: vec2<f32>,
+}
+
+fn nuld_view_condition(wo: vec3<f32>, roughness: f32) -> NuldView {
+    let m = max(max(abs(wo.x), abs(wo.y)), abs(wo.z));
+    let finite = nuld_is_finite(wo.x) && nuld_is_finite(wo.y) && nuld_is_finite(wo.z);
+    if !(finite && m > 0.0) {
+        return NuldView(vec2<f32>(roughness, 0.0), vec2<f32>(1.0, 0.0));
+    }
+    let w = vec3<f32>(wo.x / m, wo.y / m, wo.z / m);
+    let len = sqrt((w.x * w.x + w.y * w.y) + w.z * w.z);
+    let cos_theta = clamp(w.z / len, 0.0, 1.0);
+    let theta = acos(cos_theta) * NULD_DEGREES_PER_RADIAN;
+    let planar = sqrt(w.x * w.x + w.y * w.y);
+    var azimuth = vec2<f32>(1.0, 0.0);
+    if planar > 0.0 {
+        azimuth = vec2<f32>(w.x / planar, w.y / planar);
+    }
+    return NuldView(vec2<f32>(roughness, theta), azimuth);
+}
+
+// Rust: `rotate` (runtime/src/conditional.rs): the sample turned about `z` by the
+// azimuth `(cos phi, sin phi)`.
+fn nuld_rotate(s: NuldSample, azimuth: vec2<f32>) -> NuldSample {
+    let d = s.direction;
+    let c = azimuth.x;
+    let sn = azimuth.y;
+    return NuldSample(vec3<f32>(c * d.x - sn * d.y, sn * d.x + c * d.y, d.z), s.weight);
+}
+
+// Rust: `ConditionalSampler::sample_brdf` (table mode, glTF BRDF samplers): the set
+// at `(roughness, theta_o)` of the view `wo` (local frame, `z` = normal, any length),
+// turned about `z` to the view's azimuth.
+fn nuld_sample_brdf(wo: vec3<f32>, roughness: f32, instance: u32, i: u32) -> NuldSample {
+    let view = nuld_view_condition(wo, roughness);
+    return nuld_rotate(nuld_sample(view.cond, instance, i), view.azimuth);
+}
+
+// Rust: `ConditionalSampler::sample_brdf_network` (network mode): as
+// `nuld_sample_brdf` with `nuld_sample_network`.
+fn nuld_sample_brdf_network(wo: vec3<f32>, roughness: f32, instance: u32, i: u32) -> NuldSample {
+    let view = nuld_view_condition(wo, roughness);
+    return nuld_rotate(nuld_sample_network(view.cond, instance, i), view.azimuth);
+}

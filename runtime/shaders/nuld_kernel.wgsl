@@ -1,0 +1,92 @@
+// nuld sampling kernel (WGSL): appended to nuld.wgsl, a complete compute shader
+// that fills a buffer with the samples of a range of (condition, instance, index).
+// `build-tool shader` translates the two texts to GLSL, HLSL, MSL and SPIR-V.
+//
+// Bindings (group 0):
+//   0: the blob, unchanged (`nuld_blob`, as nuld.wgsl expects it);
+//   1: the output, one `NuldSample` (16 bytes: direction xyz, weight) per sample;
+//   2: the range, a `NuldKernelParams` uniform (64 bytes; the Rust mirror is
+//      `nuld_runtime::shader::KernelParams`).
+//
+// Sample `e` of the range is condition `(cx, cy)`, instance `k`, index `i` with
+// `e = ((cy * cond_count.x + cx) * instance_count + k) * index_count + i`; its
+// condition is `cond_first + vec2(cx, cy) * cond_step`, its instance
+// `instance_first + k`, its index `index_first + i`. Dispatch
+// `ceil(total / 64)` workgroups, up to 65535 along x, then rows along y: every
+// invocation past the total returns.
+//
+// What a sample is depends on the blob's kind and `mode`:
+//   kind 3, mode 0: `nuld_sample` (table mode);
+//   kind 3, mode 1: `nuld_sample_network` (network mode);
+//   kind 3, mode 2: `nuld_sample_brdf` at the view `view.xyz`, roughness = the
+//                   condition's x (its y unused);
+//   kind 3, mode 3: `nuld_sample_brdf_network`, likewise;
+//   kind 2: `nuld_direction(instance, index)` (the instance is the set), weight 1;
+//   kind 1: `nuld_point(instance, index)` as `(x, y, 0)`, weight 1.
+
+@group(0) @binding(0) var<storage, read> nuld_blob: array<u32>;
+@group(0) @binding(1) var<storage, read_write> nuld_samples: array<NuldSample>;
+@group(0) @binding(2) var<uniform> nuld_params: NuldKernelParams;
+
+// Rust: `nuld_runtime::shader::KernelParams`, field for field.
+struct NuldKernelParams {
+    cond_first: vec2<f32>,
+    cond_step: vec2<f32>,
+    cond_count: vec2<u32>,
+    instance_first: u32,
+    instance_count: u32,
+    index_first: u32,
+    index_count: u32,
+    mode: u32,
+    reserved: u32,
+    view: vec4<f32>,
+}
+
+// Invocations per workgroup (`KernelParams::WORKGROUP_SIZE` in Rust).
+const NULD_WORKGROUP_SIZE: u32 = 64u;
+
+// Rust: `KernelParams::sample_count`.
+fn nuld_kernel_sample_count(p: NuldKernelParams) -> u32 {
+    return p.cond_count.x * p.cond_count.y * p.instance_count * p.index_count;
+}
+
+@compute @workgroup_size(NULD_WORKGROUP_SIZE)
+fn nuld_fill(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+) {
+    let p = nuld_params;
+    let flat_group = (group.z * groups.y + group.y) * groups.x + group.x;
+    let e = flat_group * NULD_WORKGROUP_SIZE + lane;
+    if e >= nuld_kernel_sample_count(p) || e >= arrayLength(&nuld_samples) {
+        return;
+    }
+    let i = e % p.index_count;
+    let rest = e / p.index_count;
+    let k = rest % p.instance_count;
+    let c = rest / p.instance_count;
+    let cx = c % p.cond_count.x;
+    let cy = c / p.cond_count.x;
+    let cond = p.cond_first + vec2<f32>(f32(cx), f32(cy)) * p.cond_step;
+    let instance = p.instance_first + k;
+    let index = p.index_first + i;
+    var out: NuldSample;
+    let kind = nuld_kind();
+    if kind == NULD_KIND_CONDITIONAL {
+        if p.mode == 1u {
+            out = nuld_sample_network(cond, instance, index);
+        } else if p.mode == 2u {
+            out = nuld_sample_brdf(p.view.xyz, cond.x, instance, index);
+        } else if p.mode == 3u {
+            out = nuld_sample_brdf_network(p.view.xyz, cond.x, instance, index);
+        } else {
+            out = nuld_sample(cond, instance, index);
+        }
+    } else if kind == NULD_KIND_DIRECTION_SET {
+        out = NuldSample(nuld_direction(instance, index), 1.0);
+    } else {
+        out = NuldSample(vec3<f32>(nuld_point(instance, index), 0.0), 1.0);
+    }
+    nuld_samples[e] = out;
+}
