@@ -19,7 +19,8 @@
 //
 // Each `nuld_*` function is the Rust function it names, in the same order of
 // operations. Table mode and the point lookups reproduce the runtime to `f32`
-// rounding of the driver's `sin`, `cos`, `sqrt`, `acos` and division; network mode
+// rounding of the driver's `sin`, `cos`, `sqrt` and division (`acos` is libm's,
+// ported); network mode
 // adds the driver's `exp` and the order of its multiply-adds (the runtime's dot
 // product order is kept; a driver may still fuse a multiply and an add).
 
@@ -624,6 +625,58 @@ fn nuld_sample_network(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
     return NuldSample(nuld_to_direction(nuld_domain(), p), nuld_weight(cond));
 }
 
+// `libm::acosf`'s constants (FreeBSD e_acosf.c): pi/2 split in a high part
+// (bits 0x3fc90fda) and a low part (bits 0x33a22168), and the coefficients of its
+// rational approximation.
+const NULD_ACOS_PIO2_HI: f32 = 1.5707962513e+00;
+const NULD_ACOS_PIO2_LO: f32 = 7.5497894159e-08;
+const NULD_ACOS_P_S0: f32 = 1.6666586697e-01;
+const NULD_ACOS_P_S1: f32 = -4.2743422091e-02;
+const NULD_ACOS_P_S2: f32 = -8.6563630030e-03;
+const NULD_ACOS_Q_S1: f32 = -7.0662963390e-01;
+
+// Rust: `r` of `libm::acosf`.
+fn nuld_acos_r(z: f32) -> f32 {
+    let p = z * (NULD_ACOS_P_S0 + z * (NULD_ACOS_P_S1 + z * NULD_ACOS_P_S2));
+    let q = 1.0 + z * NULD_ACOS_Q_S1;
+    return p / q;
+}
+
+// Rust: `libm::acosf`, operation for operation, for `x` in `[-1, 1]` (NaN outside).
+// The built-in `acos` may be far less accurate (Vulkan allows thousands of ulps),
+// and `theta_o` feeds the table interpolation.
+fn nuld_acos(x: f32) -> f32 {
+    let hx = bitcast<u32>(x);
+    let ix = hx & 0x7fffffffu;
+    if ix >= 0x3f800000u {
+        if ix == 0x3f800000u {
+            if (hx >> 31u) != 0u {
+                return 2.0 * NULD_ACOS_PIO2_HI;
+            }
+            return 0.0;
+        }
+        return bitcast<f32>(0x7fc00000u);
+    }
+    if ix < 0x3f000000u {
+        if ix <= 0x32800000u {
+            return NULD_ACOS_PIO2_HI;
+        }
+        return NULD_ACOS_PIO2_HI - (x - (NULD_ACOS_PIO2_LO - x * nuld_acos_r(x * x)));
+    }
+    if (hx >> 31u) != 0u {
+        let z = (1.0 + x) * 0.5;
+        let s = sqrt(z);
+        let w = nuld_acos_r(z) * s - NULD_ACOS_PIO2_LO;
+        return 2.0 * (NULD_ACOS_PIO2_HI - (s + w));
+    }
+    let z = (1.0 - x) * 0.5;
+    let s = sqrt(z);
+    let df = bitcast<f32>(bitcast<u32>(s) & 0xfffff000u);
+    let c = (z - df * df) / (s + df);
+    let w = nuld_acos_r(z) * s + c;
+    return 2.0 * (df + w);
+}
+
 // Rust: `view_condition` (runtime/src/conditional.rs): the condition
 // `(roughness, theta_o in degrees)` of the view `wo` (any length; scaled by its
 // largest component first) and its azimuth `(cos phi, sin phi)`; a zero, infinite
@@ -642,7 +695,7 @@ fn nuld_view_condition(wo: vec3<f32>, roughness: f32) -> NuldView {
     let w = vec3<f32>(wo.x / m, wo.y / m, wo.z / m);
     let len = sqrt((w.x * w.x + w.y * w.y) + w.z * w.z);
     let cos_theta = clamp(w.z / len, 0.0, 1.0);
-    let theta = acos(cos_theta) * NULD_DEGREES_PER_RADIAN;
+    let theta = nuld_acos(cos_theta) * NULD_DEGREES_PER_RADIAN;
     let planar = sqrt(w.x * w.x + w.y * w.y);
     var azimuth = vec2<f32>(1.0, 0.0);
     if planar > 0.0 {

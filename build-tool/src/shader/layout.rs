@@ -108,6 +108,13 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ),
         ("NULD_UNORM16_SCALE", f(1.0 / UNORM16_CELLS as f32)),
         ("NULD_INSTANCE_UNIT", f((1.0f64 / 16_777_216.0) as f32)),
+        // libm's acosf (FreeBSD e_acosf.c), its literals and hex comments.
+        ("NULD_ACOS_PIO2_HI", 0x3fc9_0fda),
+        ("NULD_ACOS_PIO2_LO", 0x33a2_2168),
+        ("NULD_ACOS_P_S0", f(1.666_658_669_7e-1)),
+        ("NULD_ACOS_P_S1", f(-4.274_342_209_1e-2)),
+        ("NULD_ACOS_P_S2", f(-8.656_363_003_0e-3)),
+        ("NULD_ACOS_Q_S1", f(-7.066_296_339_0e-1)),
         ("NULD_F16_SUBNORMAL", f(f16_decode_finite(1))),
         ("NULD_WORKGROUP_SIZE", KERNEL_WORKGROUP_SIZE as u64),
     ]

@@ -1,0 +1,287 @@
+//! The WGSL sampler (`nuld_runtime::shader`) run by a real Vulkan driver through
+//! wgpu, against `nuld-runtime` on the CPU, over grids of (condition, instance,
+//! index): point and direction sets, a briefly trained and distilled BRDF sampler,
+//! and a random-content sampler with the shapes training does not use (SiLU, three
+//! layers, a lattice generator whose products overflow 32 bits).
+//!
+//! On a machine without an adapter the tests print why and pass, except under CI
+//! (the `CI` environment variable set), where they fail: CI installs lavapipe, the
+//! CPU Vulkan driver (`apt-get install mesa-vulkan-drivers libvulkan1`).
+//!
+//! Tolerances, in absolute terms on unit-vector components and weights:
+//! * 2D point sets: exact;
+//! * directions and weights in table mode, at conditions and at BRDF views
+//!   (`sample_brdf`): [`TABLE_TOLERANCE`] = 8 f32 ulps of 1.0 (`8 * 2^-23`, 9.5e-7):
+//!   both sides evaluate the same `f32` operations in the same order (the shader
+//!   ports libm's `acosf`), and differ by the driver's rounding of `sin`, `cos`,
+//!   `sqrt` and division (and, for direction sets, the runtime's `f64` map). On
+//!   lavapipe the largest difference measured is 6 ulps;
+//! * network mode: [`NETWORK_TOLERANCE`] = 1e-4 (the driver's `exp` and fused
+//!   multiply-adds through the layers).
+//!
+//! Each test prints the largest difference it measured.
+
+#[path = "../examples/shader_sample.rs"]
+mod shader_sample;
+
+use nuld_build_tool::conditional::distill::distill;
+use nuld_build_tool::train::{TrainConfig, Trainer};
+use nuld_core::blob::Domain;
+use nuld_core::network::Activation;
+use nuld_runtime::glam::{Vec2, Vec3};
+use nuld_runtime::shader::{kernel_wgsl, KernelMode, KernelParams, KERNEL_ENTRY_POINT};
+use nuld_runtime::{Blob, ConditionalSampler, Sample};
+use nuld_tests::{conditional_parts, sobol_blob, META};
+use shader_sample::Gpu;
+use std::sync::OnceLock;
+
+/// Table mode (plain and at BRDF views) and point lookups: 8 f32 ulps of 1.0.
+const TABLE_TOLERANCE: f32 = 8.0 * f32::EPSILON;
+/// Network mode.
+const NETWORK_TOLERANCE: f32 = 1e-4;
+
+/// The device and the kernel's pipeline, shared by the tests (the driver compiles
+/// the kernel once).
+struct Kernel {
+    gpu: Gpu,
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl Kernel {
+    /// The kernel's samples of `p` over `blob`.
+    fn run(&self, blob: &[u8], p: &KernelParams) -> Vec<[f32; 4]> {
+        let count = p.sample_count().expect("a small range") as u64;
+        let uniform = Some(bytemuck::bytes_of(p));
+        let groups = p.workgroups();
+        self.gpu.run(&self.pipeline, blob, uniform, count, groups, 1).0
+    }
+}
+
+/// The shared kernel; `None` (after a message) if there is no adapter outside CI.
+///
+/// # Panics
+/// Under CI (`CI` set) when there is no adapter.
+fn kernel() -> Option<&'static Kernel> {
+    static KERNEL: OnceLock<Option<Kernel>> = OnceLock::new();
+    let kernel = KERNEL
+        .get_or_init(|| {
+            let gpu = Gpu::new()?;
+            // Both streams: the CI log shows it with or without --nocapture.
+            println!("shader tests: adapter {}", gpu.adapter);
+            eprintln!("shader tests: adapter {}", gpu.adapter);
+            let pipeline = gpu.pipeline(kernel_wgsl(), KERNEL_ENTRY_POINT);
+            Some(Kernel { gpu, pipeline })
+        })
+        .as_ref();
+    if kernel.is_none() {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "no GPU adapter: CI must run the shader tests on lavapipe \
+             (apt-get install mesa-vulkan-drivers libvulkan1; .ci/run does)"
+        );
+        eprintln!(
+            "shader tests skipped: no GPU adapter (apt-get install mesa-vulkan-drivers libvulkan1)"
+        );
+    }
+    kernel
+}
+
+/// `(condition, instance, index)` of sample `e` of `p`, as the kernel computes them.
+/// The tests' conditions are exact in `f32` (steps of powers of two times small
+/// integers), so a driver that fuses the multiply and the add agrees.
+fn sample_of(p: &KernelParams, e: u32) -> (Vec2, u32, u32) {
+    let i = e % p.index_count;
+    let rest = e / p.index_count;
+    let k = rest % p.instance_count;
+    let c = rest / p.instance_count;
+    let (cx, cy) = (c % p.cond_count[0], c / p.cond_count[0]);
+    let cond = Vec2::new(
+        p.cond_first[0] + cx as f32 * p.cond_step[0],
+        p.cond_first[1] + cy as f32 * p.cond_step[1],
+    );
+    (cond, p.instance_first + k, p.index_first + i)
+}
+
+/// Largest absolute difference of direction components and weight.
+fn gap(gpu: &[f32; 4], cpu: Sample) -> f32 {
+    let d = Vec3::new(gpu[0], gpu[1], gpu[2]) - cpu.direction;
+    d.abs().max_element().max((gpu[3] - cpu.weight).abs())
+}
+
+#[test]
+fn shader_point_and_direction_sets_match_the_runtime() {
+    let Some(kernel) = kernel() else { return };
+    let cases = [
+        (Domain::Square, 100, 3),
+        (Domain::Sphere, 64, 2),
+        (Domain::Hemisphere, 37, 4),
+    ];
+    for (domain, n, sets) in cases {
+        let (_, bytes) = sobol_blob(domain, n, sets, 7);
+        let blob = Blob::parse(bytes.as_slice()).unwrap();
+        // Instances (sets) and indices past the counts wrap.
+        let p = KernelParams::new(
+            KernelMode::Table,
+            [0.0; 2],
+            [0.0; 2],
+            [1, 1],
+            0..sets as u32 + 2,
+            0..n as u32 + 5,
+        );
+        let out = kernel.run(bytes.as_slice(), &p);
+        let mut worst = 0.0f32;
+        for (e, got) in out.iter().enumerate() {
+            let (_, set, i) = sample_of(&p, e as u32);
+            let (set, i) = (set as usize, i as usize);
+            if domain == Domain::Square {
+                let want = blob.point_set_2d().unwrap().point(set, i);
+                assert_eq!(*got, [want.x, want.y, 0.0, 1.0], "set {set} index {i}");
+            } else {
+                let dirs = blob.direction_set().unwrap();
+                let want = Sample {
+                    direction: dirs.direction(set, i),
+                    weight: 1.0,
+                };
+                worst = worst.max(gap(got, want));
+            }
+        }
+        println!(
+            "shader {}: {} samples, max |gpu - cpu| {worst:.2e} (tolerance {TABLE_TOLERANCE:.2e})",
+            domain.name(),
+            out.len()
+        );
+        assert!(worst <= TABLE_TOLERANCE, "{}: {worst}", domain.name());
+    }
+}
+
+/// Compares the kernel with the runtime in table and network mode on a grid of
+/// conditions that runs past the blob's range on every side (clamping), instances
+/// and indices past the stored counts (wrapping), and on views for `sample_brdf`.
+fn check_conditional(kernel: &Kernel, bytes: &[u8], label: &str) {
+    let cs: ConditionalSampler = Blob::parse(bytes).unwrap().conditional().unwrap();
+    let info = *cs.info();
+    // Roughness 0 to 1.0625 by 1/16, theta_o -6 to 90 by 6 degrees.
+    let grid = |mode| {
+        KernelParams::new(
+            mode,
+            [0.0, -6.0],
+            [0.0625, 6.0],
+            [18, 17],
+            0..cs.instances() + 2,
+            0..cs.len() + 3,
+        )
+    };
+    let table = grid(KernelMode::Table);
+    let out = kernel.run(bytes, &table);
+    let mut worst_table = 0.0f32;
+    for (e, got) in out.iter().enumerate() {
+        let (c, k, i) = sample_of(&table, e as u32);
+        worst_table = worst_table.max(gap(got, cs.sample(c, k, i)));
+    }
+    let network = grid(KernelMode::Network);
+    let out = kernel.run(bytes, &network);
+    let mut worst_network = 0.0f32;
+    for (e, got) in out.iter().enumerate() {
+        let (c, k, i) = sample_of(&network, e as u32);
+        worst_network = worst_network.max(gap(got, cs.sample_network(c, k, i)));
+    }
+    // Views: generic, along z, grazing, below the horizon, zero, huge, tiny, NaN.
+    let views = [
+        Vec3::new(0.3, 0.4, 0.866),
+        Vec3::new(-0.7, 0.2, 0.3),
+        Vec3::new(0.0, -2.0, 1.0),
+        Vec3::new(0.0, 0.0, 5.0),
+        Vec3::new(1.0, 0.0, 0.01),
+        Vec3::new(0.5, 0.5, -0.2),
+        Vec3::ZERO,
+        Vec3::new(3e38, -3e38, 3e38),
+        Vec3::new(1e-30, 2e-30, 1e-30),
+        Vec3::NAN,
+    ];
+    let mut worst_view = 0.0f32;
+    let mut worst_view_network = 0.0f32;
+    for wo in views {
+        for (mode, worst) in [
+            (KernelMode::BrdfTable, &mut worst_view),
+            (KernelMode::BrdfNetwork, &mut worst_view_network),
+        ] {
+            let mut p = KernelParams::new(
+                mode,
+                [0.0, 0.0],
+                [0.0625, 0.0],
+                [18, 1],
+                0..cs.instances() + 1,
+                0..cs.len(),
+            );
+            p.view = [wo.x, wo.y, wo.z, 0.0];
+            let out = kernel.run(bytes, &p);
+            for (e, got) in out.iter().enumerate() {
+                let (c, k, i) = sample_of(&p, e as u32);
+                let want = match mode {
+                    KernelMode::BrdfTable => cs.sample_brdf(wo, c.x, k, i),
+                    _ => cs.sample_brdf_network(wo, c.x, k, i),
+                };
+                *worst = worst.max(gap(got, want));
+            }
+        }
+    }
+    println!(
+        "shader {label} (n {}, hidden {:?}, activation {}): max |gpu - cpu| table {worst_table:.2e} \
+         (tolerance {TABLE_TOLERANCE:.2e}), network {worst_network:.2e} ({NETWORK_TOLERANCE:.0e}), \
+         brdf views table {worst_view:.2e}, network {worst_view_network:.2e}",
+        info.n, info.hidden, info.activation
+    );
+    assert!(worst_table <= TABLE_TOLERANCE, "{label} table: {worst_table}");
+    assert!(worst_network <= NETWORK_TOLERANCE, "{label} network: {worst_network}");
+    assert!(worst_view <= TABLE_TOLERANCE, "{label} views: {worst_view}");
+    assert!(
+        worst_view_network <= NETWORK_TOLERANCE,
+        "{label} views, network: {worst_view_network}"
+    );
+}
+
+#[test]
+fn shader_distilled_brdf_sampler_matches_the_runtime() {
+    let Some(kernel) = kernel() else { return };
+    let config = TrainConfig {
+        n: 16,
+        hidden: vec![16, 16],
+        steps: 40,
+        pretrain_steps: 40,
+        conditions_per_step: 4,
+        instances_per_condition: 2,
+        pool_conditions: 8,
+        pool_caps: 128,
+        caps_per_step: 64,
+        ..TrainConfig::default()
+    };
+    let mut trainer = Trainer::new(config, None);
+    while !trainer.done() {
+        trainer.step();
+    }
+    let parts = distill(&trainer.params(), 3, [5, 6], [10, 9]);
+    let bytes = parts.to_blob(&META).unwrap();
+    check_conditional(kernel, bytes.as_slice(), "distilled");
+}
+
+#[test]
+fn shader_random_samplers_of_every_shape_match_the_runtime() {
+    let Some(kernel) = kernel() else { return };
+    let shapes: [(u32, &[u32], Activation, u32); 3] = [
+        (37, &[5, 3, 9], Activation::Silu, 3_000_000_019),
+        (8, &[128], Activation::Relu, 3),
+        (33, &[20, 12], Activation::Silu, 7),
+    ];
+    for (s, (n, hidden, act, g)) in shapes.into_iter().enumerate() {
+        let mut parts = conditional_parts(n, hidden, act, 2, [4, 3], s as u64);
+        // A generator whose products `i g` overflow 32 bits: the shader's
+        // 64-bit-free `(i g) mod n`.
+        parts.info.lattice_generator = g;
+        if s == 2 {
+            // The sphere map (BRDF samplers use the hemisphere).
+            parts.info.domain = Domain::Sphere as u32;
+        }
+        let bytes = parts.to_blob(&META).unwrap();
+        check_conditional(kernel, bytes.as_slice(), &format!("random {s}"));
+    }
+}
