@@ -306,6 +306,26 @@ fn nuld_instances() -> u32 {
     return nuld_u32(nuld_section(NULD_TAG_CONDITIONAL_INFO) + NULD_INFO_INSTANCES);
 }
 
+// Rust: `ConditionalSampler` (`ConditionalSampler::view`): the info record and the
+// byte offsets of the network, point-table and weight sections, read once per
+// sample by the `nuld_sample*` functions and passed to the `*_of` functions.
+struct NuldConditional {
+    info: NuldConditionalInfo,
+    params: u32,
+    table: u32,
+    weights: u32,
+}
+
+// Rust: `Blob::conditional`: the sampler of the blob in `nuld_blob`.
+fn nuld_conditional() -> NuldConditional {
+    return NuldConditional(
+        nuld_info(),
+        nuld_section(NULD_TAG_NETWORK_PARAMS),
+        nuld_section(NULD_TAG_POINT_TABLE),
+        nuld_section(NULD_TAG_WEIGHT_TABLE),
+    );
+}
+
 // Rust: `ConditionalInfo::normalize`: the condition clamped into
 // `[cond_min, cond_max]` per axis (NaN to `cond_min`), mapped to `[0,1]`.
 fn nuld_normalize(info: NuldConditionalInfo, c: vec2<f32>) -> vec2<f32> {
@@ -369,9 +389,14 @@ fn nuld_lerp(cell: NuldGridCell, v00: f32, v10: f32, v01: f32, v11: f32) -> f32 
 
 // Rust: `ConditionalSampler::weight`: the weight table interpolated at `cond`.
 fn nuld_weight(cond: vec2<f32>) -> f32 {
-    let info = nuld_info();
-    let cell = nuld_locate(nuld_normalize(info, cond), info.weight_grid);
-    let w = nuld_section(NULD_TAG_WEIGHT_TABLE);
+    let cs = nuld_conditional();
+    return nuld_weight_of(cs, nuld_normalize(cs.info, cond));
+}
+
+// `nuld_weight` at the normalized condition `u` of the sampler `cs`.
+fn nuld_weight_of(cs: NuldConditional, u: vec2<f32>) -> f32 {
+    let cell = nuld_locate(u, cs.info.weight_grid);
+    let w = cs.weights;
     return nuld_lerp(
         cell,
         nuld_f32(w + 4u * nuld_node(cell, 0u, 0u)),
@@ -384,9 +409,15 @@ fn nuld_weight(cond: vec2<f32>) -> f32 {
 // Rust: `ConditionalSampler::square_point` (table mode): the four stored points of
 // the cell around `cond`, interpolated bilinearly per coordinate.
 fn nuld_square_point(cond: vec2<f32>, instance: u32, i: u32) -> vec2<f32> {
-    let info = nuld_info();
-    let cell = nuld_locate(nuld_normalize(info, cond), info.grid);
-    let table = nuld_section(NULD_TAG_POINT_TABLE);
+    let cs = nuld_conditional();
+    return nuld_square_point_of(cs, nuld_normalize(cs.info, cond), instance, i);
+}
+
+// `nuld_square_point` at the normalized condition `u` of the sampler `cs`.
+fn nuld_square_point_of(cs: NuldConditional, u: vec2<f32>, instance: u32, i: u32) -> vec2<f32> {
+    let info = cs.info;
+    let cell = nuld_locate(u, info.grid);
+    let table = cs.table;
     let k = instance % info.instances;
     let j = i % info.n;
     // `ConditionalInfo::point_table_index`: layout [node][instance][index].
@@ -543,19 +574,44 @@ fn nuld_param(params: u32, j: u32) -> f32 {
 // weights from parameter `w`, in eight partial sums `s[k mod 8]` (k ascending),
 // combined as `((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7))`.
 fn nuld_dot(params: u32, w: u32, x: ptr<function, array<f32, 128>>, len: u32) -> f32 {
-    var s = array<f32, 8>(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    for (var k = 0u; k < len; k++) {
-        let c = k % NULD_DOT_LANES;
-        s[c] = s[c] + nuld_param(params, w + k) * (*x)[k];
+    var s0 = 0.0;
+    var s1 = 0.0;
+    var s2 = 0.0;
+    var s3 = 0.0;
+    var s4 = 0.0;
+    var s5 = 0.0;
+    var s6 = 0.0;
+    var s7 = 0.0;
+    // Whole chunks of NULD_DOT_LANES terms, then the remainder into s0, s1, ...
+    let full = len - len % NULD_DOT_LANES;
+    var k = 0u;
+    for (; k < full; k += NULD_DOT_LANES) {
+        s0 = s0 + nuld_param(params, w + k) * (*x)[k];
+        s1 = s1 + nuld_param(params, w + k + 1u) * (*x)[k + 1u];
+        s2 = s2 + nuld_param(params, w + k + 2u) * (*x)[k + 2u];
+        s3 = s3 + nuld_param(params, w + k + 3u) * (*x)[k + 3u];
+        s4 = s4 + nuld_param(params, w + k + 4u) * (*x)[k + 4u];
+        s5 = s5 + nuld_param(params, w + k + 5u) * (*x)[k + 5u];
+        s6 = s6 + nuld_param(params, w + k + 6u) * (*x)[k + 6u];
+        s7 = s7 + nuld_param(params, w + k + 7u) * (*x)[k + 7u];
     }
-    return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
+    let rest = len - full;
+    if rest > 0u { s0 = s0 + nuld_param(params, w + k) * (*x)[k]; }
+    if rest > 1u { s1 = s1 + nuld_param(params, w + k + 1u) * (*x)[k + 1u]; }
+    if rest > 2u { s2 = s2 + nuld_param(params, w + k + 2u) * (*x)[k + 2u]; }
+    if rest > 3u { s3 = s3 + nuld_param(params, w + k + 3u) * (*x)[k + 3u]; }
+    if rest > 4u { s4 = s4 + nuld_param(params, w + k + 4u) * (*x)[k + 4u]; }
+    if rest > 5u { s5 = s5 + nuld_param(params, w + k + 5u) * (*x)[k + 5u]; }
+    if rest > 6u { s6 = s6 + nuld_param(params, w + k + 6u) * (*x)[k + 6u]; }
+    return ((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7));
 }
 
 // Rust: `Network::evaluate`: the two outputs (before the sigmoid) of the network on
 // `input` for index `i`: hidden layer 1 `act((b1[o] + E[i][o]) + dot(W1[o], a))`,
 // further layers `act(b[o] + dot(W[o], a))`, outputs `bo[o] + dot(Wo[o], a)`.
-fn nuld_network_evaluate(info: NuldConditionalInfo, i: u32, input: array<f32, 11>) -> vec2<f32> {
-    let params = nuld_section(NULD_TAG_NETWORK_PARAMS);
+fn nuld_network_evaluate(cs: NuldConditional, i: u32, input: array<f32, 11>) -> vec2<f32> {
+    let info = cs.info;
+    let params = cs.params;
     var a: array<f32, 128>;
     var b: array<f32, 128>;
     for (var k = 0u; k < NULD_INPUTS; k++) {
@@ -595,9 +651,13 @@ fn nuld_network_evaluate(info: NuldConditionalInfo, i: u32, input: array<f32, 11
 // Rust: `ConditionalSampler::network_square_point` (network mode): the network's
 // outputs through the sigmoid, for any u32 instance.
 fn nuld_network_square_point(cond: vec2<f32>, instance: u32, i: u32) -> vec2<f32> {
-    let info = nuld_info();
-    let u = nuld_normalize(info, cond);
-    let out = nuld_network_evaluate(info, i, nuld_input_features(info, u, instance, i));
+    let cs = nuld_conditional();
+    return nuld_network_square_point_of(cs, nuld_normalize(cs.info, cond), instance, i);
+}
+
+// `nuld_network_square_point` at the normalized condition `u` of the sampler `cs`.
+fn nuld_network_square_point_of(cs: NuldConditional, u: vec2<f32>, instance: u32, i: u32) -> vec2<f32> {
+    let out = nuld_network_evaluate(cs, i, nuld_input_features(cs.info, u, instance, i));
     return vec2<f32>(nuld_sigmoid(out.x), nuld_sigmoid(out.y));
 }
 
@@ -614,15 +674,19 @@ struct NuldSample {
 // instance `instance` (mod instances) at condition `cond` (blob units; for BRDF
 // samplers `(roughness, theta_o in degrees)`, the view in the xz-plane, `+x` side).
 fn nuld_sample(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
-    let p = nuld_square_point(cond, instance, i);
-    return NuldSample(nuld_to_direction(nuld_domain(), p), nuld_weight(cond));
+    let cs = nuld_conditional();
+    let u = nuld_normalize(cs.info, cond);
+    let p = nuld_square_point_of(cs, u, instance, i);
+    return NuldSample(nuld_to_direction(cs.info.domain, p), nuld_weight_of(cs, u));
 }
 
 // Rust: `ConditionalSampler::sample_network` (network mode): as `nuld_sample`, every
 // u32 instance its own set.
 fn nuld_sample_network(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
-    let p = nuld_network_square_point(cond, instance, i);
-    return NuldSample(nuld_to_direction(nuld_domain(), p), nuld_weight(cond));
+    let cs = nuld_conditional();
+    let u = nuld_normalize(cs.info, cond);
+    let p = nuld_network_square_point_of(cs, u, instance, i);
+    return NuldSample(nuld_to_direction(cs.info.domain, p), nuld_weight_of(cs, u));
 }
 
 // `libm::acosf`'s constants (FreeBSD e_acosf.c): pi/2 split in a high part

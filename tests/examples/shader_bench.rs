@@ -1,0 +1,48 @@
+//! Samples per second of the WGSL sampling kernel (`nuld_runtime::shader`) in table
+//! and network mode, on whatever adapter wgpu finds. On this project's machines that
+//! is lavapipe, Mesa's CPU Vulkan driver: the figures are a CPU software driver's
+//! (LLVM-compiled SIMD on the machine's cores), not a GPU's.
+//!
+//! `cargo run --release -p nuld-tests --example shader_bench`
+//!
+//! The blobs have random contents and the shapes `build-tool bench --only runtime`
+//! times on the CPU (n 64, 16 instances, a 10 x 9 point grid; networks [32, 32]
+//! ReLU, the default bake's, and [64, 64] SiLU): speed does not depend on the
+//! values. Each figure is the best of 3 dispatches, from submission to completion,
+//! of one range of (condition, instance, index) filling an output buffer.
+
+#[path = "shader_sample.rs"]
+mod shader_sample;
+
+use nuld_core::network::Activation;
+use nuld_runtime::shader::{kernel_wgsl, KernelMode, KernelParams, KERNEL_ENTRY_POINT};
+use nuld_tests::{conditional_parts, META};
+use shader_sample::Gpu;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let gpu = Gpu::new().ok_or("no GPU adapter (on Linux, install mesa-vulkan-drivers)")?;
+    let pipeline = gpu.pipeline(kernel_wgsl(), KERNEL_ENTRY_POINT);
+    println!("adapter: {} (lavapipe/llvmpipe is a CPU software driver)", gpu.adapter);
+    println!("{:<44} {:>10} {:>12} {:>12}", "mode", "samples", "seconds", "samples/s");
+    let cases: [(&str, &[u32], Activation, KernelMode, u32); 4] = [
+        ("table: nuld_sample", &[32, 32], Activation::Relu, KernelMode::Table, 1 << 8),
+        ("table: nuld_sample_brdf", &[32, 32], Activation::Relu, KernelMode::BrdfTable, 1 << 8),
+        ("network [32,32] relu: nuld_sample_network", &[32, 32], Activation::Relu, KernelMode::Network, 1 << 4),
+        ("network [64,64] silu: nuld_sample_network", &[64, 64], Activation::Silu, KernelMode::Network, 1 << 2),
+    ];
+    for (label, hidden, act, mode, instances) in cases {
+        let bytes = conditional_parts(64, hidden, act, 16, [10, 9], 2).to_blob(&META)?;
+        // 16 x 16 conditions over the blob's range, `instances` instances, 64 indices.
+        let mut p = KernelParams::new(mode, [0.1, 0.0], [0.06, 5.9], [16, 16], 0..instances, 0..64);
+        p.view = [0.3, 0.4, 0.866, 0.0];
+        let count = p.sample_count().ok_or("range too large")?;
+        let (out, seconds) = gpu.run(&pipeline, bytes.as_slice(), Some(bytemuck::bytes_of(&p)), count as u64, p.workgroups(), 3);
+        // Every sample written: a unit direction (guards against timing a no-op).
+        let bad = out.iter().filter(|s| ((s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt() - 1.0).abs() > 1e-4).count();
+        if bad > 0 {
+            return Err(format!("{label}: {bad} samples are not unit directions").into());
+        }
+        println!("{label:<44} {count:>10} {seconds:>12.4} {:>12.3e}", count as f64 / seconds);
+    }
+    Ok(())
+}
