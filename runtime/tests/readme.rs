@@ -1,6 +1,7 @@
-//! The README's Rust snippets are the runtime's examples, verbatim: `cargo test`
-//! compiles `runtime/examples/*.rs`, and this test fails if the README's copy of one
-//! drifts from the file or if a ```rust block in the README is not such a copy.
+//! The README's Rust and WGSL snippets are examples, verbatim: `cargo test` compiles
+//! `runtime/examples/*.rs` and `tests/examples/*.rs` (the WGSL ones are
+//! `include_str!`-ed there), and this test fails if the README's copy of one drifts
+//! from the file or if a ```rust or ```wgsl block in the README is not such a copy.
 
 use std::path::{Path, PathBuf};
 
@@ -11,8 +12,11 @@ fn repo_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
+/// The fences that open a block that must be a verbatim copy.
+const QUOTED_FENCES: [&str; 2] = ["```rust", "```wgsl"];
+
 /// `(file named by the marker, text of the fenced block after it)` for every marker,
-/// and the number of ```rust fences in the text.
+/// and the number of ```rust and ```wgsl fences in the text.
 fn quoted_examples(readme: &str) -> (Vec<(String, String)>, usize) {
     let lines: Vec<&str> = readme.lines().collect();
     let mut quoted = Vec::new();
@@ -21,10 +25,9 @@ fn quoted_examples(readme: &str) -> (Vec<(String, String)>, usize) {
             continue;
         };
         let file = rest.trim_end_matches("-->").trim().to_string();
-        assert_eq!(
-            lines.get(k + 1).copied(),
-            Some("```rust"),
-            "the line after the marker for {file} must open a ```rust block"
+        assert!(
+            lines.get(k + 1).is_some_and(|l| QUOTED_FENCES.contains(l)),
+            "the line after the marker for {file} must open a ```rust or ```wgsl block"
         );
         let body: Vec<&str> = lines[k + 2..]
             .iter()
@@ -33,7 +36,10 @@ fn quoted_examples(readme: &str) -> (Vec<(String, String)>, usize) {
             .collect();
         quoted.push((file, body.join("\n") + "\n"));
     }
-    let fences = lines.iter().filter(|l| l.trim() == "```rust").count();
+    let fences = lines
+        .iter()
+        .filter(|l| QUOTED_FENCES.contains(&l.trim()))
+        .count();
     (quoted, fences)
 }
 
@@ -45,11 +51,11 @@ fn readme_rust_snippets_are_the_examples_verbatim() {
     assert_eq!(
         quoted.len(),
         fences,
-        "every ```rust block in the README must follow a `{MARKER}FILE -->` line"
+        "every ```rust and ```wgsl block in the README must follow a `{MARKER}FILE -->` line"
     );
     for (file, text) in quoted {
         assert!(
-            file.starts_with("runtime/examples/"),
+            file.starts_with("runtime/examples/") || file.starts_with("tests/examples/"),
             "{file}: quote files that `cargo test` compiles"
         );
         let on_disk = std::fs::read_to_string(repo_root().join(&file))

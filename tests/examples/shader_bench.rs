@@ -22,13 +22,43 @@ use shader_sample::Gpu;
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let gpu = Gpu::new().ok_or("no GPU adapter (on Linux, install mesa-vulkan-drivers)")?;
     let pipeline = gpu.pipeline(kernel_wgsl(), KERNEL_ENTRY_POINT);
-    println!("adapter: {} (lavapipe/llvmpipe is a CPU software driver)", gpu.adapter);
-    println!("{:<44} {:>10} {:>12} {:>12}", "mode", "samples", "seconds", "samples/s");
+    println!(
+        "adapter: {} (lavapipe/llvmpipe is a CPU software driver)",
+        gpu.adapter
+    );
+    println!(
+        "{:<44} {:>10} {:>12} {:>12}",
+        "mode", "samples", "seconds", "samples/s"
+    );
     let cases: [(&str, &[u32], Activation, KernelMode, u32); 4] = [
-        ("table: nuld_sample", &[32, 32], Activation::Relu, KernelMode::Table, 1 << 8),
-        ("table: nuld_sample_brdf", &[32, 32], Activation::Relu, KernelMode::BrdfTable, 1 << 8),
-        ("network [32,32] relu: nuld_sample_network", &[32, 32], Activation::Relu, KernelMode::Network, 1 << 4),
-        ("network [64,64] silu: nuld_sample_network", &[64, 64], Activation::Silu, KernelMode::Network, 1 << 2),
+        (
+            "table: nuld_sample",
+            &[32, 32],
+            Activation::Relu,
+            KernelMode::Table,
+            1 << 8,
+        ),
+        (
+            "table: nuld_sample_brdf",
+            &[32, 32],
+            Activation::Relu,
+            KernelMode::BrdfTable,
+            1 << 8,
+        ),
+        (
+            "network [32,32] relu: nuld_sample_network",
+            &[32, 32],
+            Activation::Relu,
+            KernelMode::Network,
+            1 << 4,
+        ),
+        (
+            "network [64,64] silu: nuld_sample_network",
+            &[64, 64],
+            Activation::Silu,
+            KernelMode::Network,
+            1 << 2,
+        ),
     ];
     for (label, hidden, act, mode, instances) in cases {
         let bytes = conditional_parts(64, hidden, act, 16, [10, 9], 2).to_blob(&META)?;
@@ -36,13 +66,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut p = KernelParams::new(mode, [0.1, 0.0], [0.06, 5.9], [16, 16], 0..instances, 0..64);
         p.view = [0.3, 0.4, 0.866, 0.0];
         let count = p.sample_count().ok_or("range too large")?;
-        let (out, seconds) = gpu.run(&pipeline, bytes.as_slice(), Some(bytemuck::bytes_of(&p)), count as u64, p.workgroups(), 3);
+        let (out, seconds) = gpu.run(
+            &pipeline,
+            bytes.as_slice(),
+            Some(bytemuck::bytes_of(&p)),
+            count as u64,
+            p.workgroups(),
+            3,
+        );
         // Every sample written: a unit direction (guards against timing a no-op).
-        let bad = out.iter().filter(|s| ((s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt() - 1.0).abs() > 1e-4).count();
+        let bad = out
+            .iter()
+            .filter(|s| ((s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt() - 1.0).abs() > 1e-4)
+            .count();
         if bad > 0 {
             return Err(format!("{label}: {bad} samples are not unit directions").into());
         }
-        println!("{label:<44} {count:>10} {seconds:>12.4} {:>12.3e}", count as f64 / seconds);
+        println!(
+            "{label:<44} {count:>10} {seconds:>12.4} {:>12.3e}",
+            count as f64 / seconds
+        );
     }
     Ok(())
 }

@@ -37,10 +37,12 @@ impl Gpu {
     /// The compute pipeline of `entry` in the WGSL `source` (compiled by the driver
     /// once; reuse it across dispatches).
     pub fn pipeline(&self, source: &str, entry: &str) -> wgpu::ComputePipeline {
-        let module = self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: None,
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
+        let module = self
+            .device
+            .create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: None,
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            });
         let desc = wgpu::ComputePipelineDescriptor {
             label: None,
             layout: None,
@@ -124,14 +126,16 @@ impl Gpu {
             }
             let start = std::time::Instant::now();
             self.queue.submit([enc.finish()]);
-            d.poll(wgpu::PollType::wait_indefinitely()).expect("device lost");
+            d.poll(wgpu::PollType::wait_indefinitely())
+                .expect("device lost");
             best = best.min(start.elapsed().as_secs_f64());
         }
         let mut enc = d.create_command_encoder(&Default::default());
         enc.copy_buffer_to_buffer(&out, 0, &read, 0, size);
         self.queue.submit([enc.finish()]);
         read.map_async(wgpu::MapMode::Read, .., |r| r.expect("map the output"));
-        d.poll(wgpu::PollType::wait_indefinitely()).expect("device lost");
+        d.poll(wgpu::PollType::wait_indefinitely())
+            .expect("device lost");
         let view = read.get_mapped_range(..).expect("a mapped output");
         let samples = bytemuck::cast_slice(&view).to_vec();
         (samples, best)
@@ -146,7 +150,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     // Validate on the CPU first: the shader trusts what `Blob::parse` checks.
     let n = Blob::parse(bytes.as_bytes())?.conditional()?.len();
-    let source = [nuld_runtime::shader::WGSL, include_str!("shader_sample.wgsl")].concat();
+    let source = [
+        nuld_runtime::shader::WGSL,
+        include_str!("shader_sample.wgsl"),
+    ]
+    .concat();
     let gpu = Gpu::new().ok_or("no GPU adapter (on Linux, install mesa-vulkan-drivers)")?;
     let pixels = 4;
     let samples = pixels * n;
@@ -155,7 +163,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (out, _) = gpu.run(&pipeline, bytes.as_bytes(), None, samples as u64, groups, 1);
     println!("adapter: {}", gpu.adapter);
     for (e, s) in out.iter().enumerate() {
-        println!("pixel {} index {}: direction {:?}, weight {}", e as u32 / n, e as u32 % n, &s[..3], s[3]);
+        println!(
+            "pixel {} index {}: direction {:?}, weight {}",
+            e as u32 / n,
+            e as u32 % n,
+            &s[..3],
+            s[3]
+        );
     }
     Ok(())
 }

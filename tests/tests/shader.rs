@@ -53,7 +53,9 @@ impl Kernel {
         let count = p.sample_count().expect("a small range") as u64;
         let uniform = Some(bytemuck::bytes_of(p));
         let groups = p.workgroups();
-        self.gpu.run(&self.pipeline, blob, uniform, count, groups, 1).0
+        self.gpu
+            .run(&self.pipeline, blob, uniform, count, groups, 1)
+            .0
     }
 }
 
@@ -231,8 +233,14 @@ fn check_conditional(kernel: &Kernel, bytes: &[u8], label: &str) {
          brdf views table {worst_view:.2e}, network {worst_view_network:.2e}",
         info.n, info.hidden, info.activation
     );
-    assert!(worst_table <= TABLE_TOLERANCE, "{label} table: {worst_table}");
-    assert!(worst_network <= NETWORK_TOLERANCE, "{label} network: {worst_network}");
+    assert!(
+        worst_table <= TABLE_TOLERANCE,
+        "{label} table: {worst_table}"
+    );
+    assert!(
+        worst_network <= NETWORK_TOLERANCE,
+        "{label} network: {worst_network}"
+    );
     assert!(worst_view <= TABLE_TOLERANCE, "{label} views: {worst_view}");
     assert!(
         worst_view_network <= NETWORK_TOLERANCE,
@@ -284,4 +292,38 @@ fn shader_random_samplers_of_every_shape_match_the_runtime() {
         let bytes = parts.to_blob(&META).unwrap();
         check_conditional(kernel, bytes.as_slice(), &format!("random {s}"));
     }
+}
+
+/// The README's shader (tests/examples/shader_sample.wgsl, run by the host code of
+/// tests/examples/shader_sample.rs) gives the runtime's `sample_brdf` samples. Its
+/// view is normalized by the driver's `normalize`, a few ulps from glam's, which the
+/// table interpolation carries through: within 1e-5.
+#[test]
+fn shader_readme_example_gives_the_runtime_samples() {
+    let Some(kernel) = kernel() else { return };
+    let bytes = nuld_runtime::doc_example_conditional_blob();
+    let cs = Blob::parse(&bytes.0).unwrap().conditional().unwrap();
+    let source = [
+        nuld_runtime::shader::WGSL,
+        include_str!("../examples/shader_sample.wgsl"),
+    ]
+    .concat();
+    let pipeline = kernel.gpu.pipeline(&source, "main");
+    let count = 5 * cs.len();
+    let (out, _) = kernel.gpu.run(
+        &pipeline,
+        &bytes.0,
+        None,
+        count as u64,
+        [count.div_ceil(64), 1, 1],
+        1,
+    );
+    let wo = Vec3::new(0.3, 0.4, 0.866).normalize();
+    let mut worst = 0.0f32;
+    for (e, got) in out.iter().enumerate() {
+        let (pixel, i) = (e as u32 / cs.len(), e as u32 % cs.len());
+        worst = worst.max(gap(got, cs.sample_brdf(wo, 0.4, pixel, i)));
+    }
+    println!("shader README example: max |gpu - cpu| {worst:.2e} (tolerance 1e-5)");
+    assert!(worst <= 1e-5, "{worst}");
 }

@@ -41,14 +41,20 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_HEADER_LEN", HEADER_LEN as u64),
         ("NULD_SECTION_ENTRY_LEN", SECTION_ENTRY_LEN as u64),
         ("NULD_SECTION_TAG", offset_of!(SectionEntry, tag) as u64),
-        ("NULD_SECTION_OFFSET", offset_of!(SectionEntry, offset) as u64),
+        (
+            "NULD_SECTION_OFFSET",
+            offset_of!(SectionEntry, offset) as u64,
+        ),
         ("NULD_MAX_SECTIONS", MAX_SECTIONS as u64),
         ("NULD_KIND_POINT_SET_2D", BlobKind::PointSet2D as u64),
         ("NULD_KIND_DIRECTION_SET", BlobKind::DirectionSet as u64),
         ("NULD_KIND_CONDITIONAL", BlobKind::Conditional as u64),
         ("NULD_TAG_POINT_SET_INFO", SectionTag::PointSetInfo as u64),
         ("NULD_TAG_POINTS", SectionTag::Points as u64),
-        ("NULD_TAG_CONDITIONAL_INFO", SectionTag::ConditionalInfo as u64),
+        (
+            "NULD_TAG_CONDITIONAL_INFO",
+            SectionTag::ConditionalInfo as u64,
+        ),
         ("NULD_TAG_NETWORK_PARAMS", SectionTag::NetworkParams as u64),
         ("NULD_TAG_POINT_TABLE", SectionTag::PointTable as u64),
         ("NULD_TAG_WEIGHT_TABLE", SectionTag::WeightTable as u64),
@@ -69,8 +75,14 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
             "NULD_INFO_INSTANCES",
             offset_of!(ConditionalInfo, instances) as u64,
         ),
-        ("NULD_INFO_DOMAIN", offset_of!(ConditionalInfo, domain) as u64),
-        ("NULD_INFO_TARGET", offset_of!(ConditionalInfo, target) as u64),
+        (
+            "NULD_INFO_DOMAIN",
+            offset_of!(ConditionalInfo, domain) as u64,
+        ),
+        (
+            "NULD_INFO_TARGET",
+            offset_of!(ConditionalInfo, target) as u64,
+        ),
         ("NULD_INFO_GRID", offset_of!(ConditionalInfo, grid) as u64),
         (
             "NULD_INFO_WEIGHT_GRID",
@@ -84,7 +96,10 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
             "NULD_INFO_COND_MAX",
             offset_of!(ConditionalInfo, cond_max) as u64,
         ),
-        ("NULD_INFO_HIDDEN", offset_of!(ConditionalInfo, hidden) as u64),
+        (
+            "NULD_INFO_HIDDEN",
+            offset_of!(ConditionalInfo, hidden) as u64,
+        ),
         (
             "NULD_INFO_ACTIVATION",
             offset_of!(ConditionalInfo, activation) as u64,
@@ -102,10 +117,7 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_ACTIVATION_SILU", Activation::Silu as u64),
         ("NULD_FRAC_PI_4", f(core::f32::consts::FRAC_PI_4)),
         ("NULD_FRAC_PI_2", f(core::f32::consts::FRAC_PI_2)),
-        (
-            "NULD_DEGREES_PER_RADIAN",
-            f(180.0 / core::f32::consts::PI),
-        ),
+        ("NULD_DEGREES_PER_RADIAN", f(180.0 / core::f32::consts::PI)),
         ("NULD_UNORM16_SCALE", f(1.0 / UNORM16_CELLS as f32)),
         ("NULD_INSTANCE_UNIT", f((1.0f64 / 16_777_216.0) as f32)),
         // libm's acosf (FreeBSD e_acosf.c), its literals and hex comments.
@@ -123,11 +135,11 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
 /// Struct member offsets and sizes the shader's structs must share with Rust.
 fn rust_structs() -> Vec<(&'static str, u64)> {
     vec![
+        ("NuldConditionalInfo", size_of::<ConditionalInfo>() as u64),
         (
-            "NuldConditionalInfo",
-            size_of::<ConditionalInfo>() as u64,
+            "NuldConditionalInfo.n",
+            offset_of!(ConditionalInfo, n) as u64,
         ),
-        ("NuldConditionalInfo.n", offset_of!(ConditionalInfo, n) as u64),
         (
             "NuldConditionalInfo.instances",
             offset_of!(ConditionalInfo, instances) as u64,
@@ -316,9 +328,6 @@ mod tests {
             .iter()
             .find(|(_, t)| t.name.as_deref() == Some("NuldKernelParams"))
             .unwrap();
-        assert_eq!(
-            layouter[params_ty].size as usize,
-            size_of::<KernelParams>()
-        );
+        assert_eq!(layouter[params_ty].size as usize, size_of::<KernelParams>());
     }
 }

@@ -205,7 +205,10 @@ pub fn translate(lang: Lang) -> Result<Translation, ShaderError> {
             .map_err(|e| backend(one_line(&e)))?;
             let mut frontend = naga::front::glsl::Frontend::default();
             let back = frontend
-                .parse(&naga::front::glsl::Options::from(ShaderStage::Compute), &text)
+                .parse(
+                    &naga::front::glsl::Options::from(ShaderStage::Compute),
+                    &text,
+                )
                 .map_err(|e| parse_back(e.emit_to_string(&text).replace('\n', " ")))?;
             (text.into_bytes(), Some(back))
         }
@@ -295,6 +298,19 @@ mod tests {
                 "{name}"
             );
         }
+    }
+
+    /// The README's example shader (tests/examples/shader_sample.wgsl) after the
+    /// library is a valid module: what a user copies compiles.
+    #[test]
+    fn shader_readme_example_validates() {
+        let src = [
+            nuld_runtime::shader::WGSL,
+            include_str!("../../../tests/examples/shader_sample.wgsl"),
+        ]
+        .concat();
+        let module = naga::front::wgsl::parse_str(&src).unwrap();
+        validate(&module, "the README example").unwrap();
     }
 
     #[test]
