@@ -593,3 +593,44 @@ fn sample_prints_what_the_runtime_serves_and_rejects_bad_input() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `build-tool shader` writes each language's kernel to `--out` (the same bytes
+/// the library translates), prints it to stdout without `--out`, and fails with one
+/// line and no file for an unwritable path or an unknown language.
+#[test]
+fn shader_writes_each_language_or_fails_cleanly() {
+    use nuld_build_tool::shader::{translate, Lang};
+    let dir = scratch("shader");
+    for lang in Lang::ALL {
+        let path = dir.join(format!("kernel.{}", lang.name()));
+        let o = build_tool()
+            .args(["shader", "--lang", lang.name(), "--out"])
+            .arg(&path)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let written = std::fs::read(&path).unwrap();
+        assert_eq!(written, translate(lang).unwrap().bytes, "{}", lang.name());
+    }
+    let o = build_tool()
+        .args(["shader", "--lang", "glsl"])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    assert!(o.stdout.starts_with(b"#version 450"));
+    let missing = dir.join("no/such/dir/kernel.wgsl");
+    let err = failure(&["shader", "--lang", "wgsl"], &missing);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(!missing.exists());
+    let o = build_tool()
+        .args(["shader", "--lang", "cuda"])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), Lang::ALL.len(), "{names:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
