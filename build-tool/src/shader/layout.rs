@@ -123,13 +123,21 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         // libm's acosf (FreeBSD e_acosf.c), its literals and hex comments.
         ("NULD_ACOS_PIO2_HI", 0x3fc9_0fda),
         ("NULD_ACOS_PIO2_LO", 0x33a2_2168),
-        ("NULD_ACOS_P_S0", f(1.666_658_669_7e-1)),
-        ("NULD_ACOS_P_S1", f(-4.274_342_209_1e-2)),
-        ("NULD_ACOS_P_S2", f(-8.656_363_003_0e-3)),
-        ("NULD_ACOS_Q_S1", f(-7.066_296_339_0e-1)),
+        // The coefficients as libm writes them, parsed as Rust parses its `f32`
+        // literals (correctly rounded).
+        ("NULD_ACOS_P_S0", libm_literal("1.6666586697e-01")),
+        ("NULD_ACOS_P_S1", libm_literal("-4.2743422091e-02")),
+        ("NULD_ACOS_P_S2", libm_literal("-8.6563630030e-03")),
+        ("NULD_ACOS_Q_S1", libm_literal("-7.0662963390e-01")),
         ("NULD_F16_SUBNORMAL", f(f16_decode_finite(1))),
         ("NULD_WORKGROUP_SIZE", KERNEL_WORKGROUP_SIZE as u64),
     ]
+}
+
+/// The bits of an `f32` literal of libm's source (a NaN's bits if it does not parse, which
+/// no shader constant equals).
+fn libm_literal(text: &str) -> u64 {
+    text.parse::<f32>().unwrap_or(f32::NAN).to_bits() as u64
 }
 
 /// Struct member offsets and sizes the shader's structs must share with Rust.

@@ -178,7 +178,7 @@ pub fn translate(lang: Lang) -> Result<Translation, ShaderError> {
             let binding_map = module
                 .global_variables
                 .iter()
-                .filter_map(|(_, v)| v.binding.clone())
+                .filter_map(|(_, v)| v.binding)
                 .filter_map(|b| u8::try_from(b.binding).ok().map(|slot| (b, slot)))
                 .collect();
             let options = glsl::Options {
