@@ -45,3 +45,31 @@ pub fn conditional_parts(
     nuld_build_tool::runtime_speed::random_parts(n, hidden, activation, instances, grid, seed)
         .expect("a valid fixture shape")
 }
+
+/// A BRDF sampler briefly trained (40 + 40 steps of a 16-point, [16, 16] network:
+/// enough to leave the initialization, a few seconds) and distilled into `instances`
+/// stored instances on a `grid` point table and a `weight_grid` weight table.
+pub fn distilled_parts(
+    instances: u32,
+    grid: [u32; 2],
+    weight_grid: [u32; 2],
+) -> nuld_build_tool::conditional::blob::ConditionalParts {
+    use nuld_build_tool::train::{TrainConfig, Trainer};
+    let config = TrainConfig {
+        n: 16,
+        hidden: vec![16, 16],
+        steps: 40,
+        pretrain_steps: 40,
+        conditions_per_step: 4,
+        instances_per_condition: 2,
+        pool_conditions: 8,
+        pool_caps: 128,
+        caps_per_step: 64,
+        ..TrainConfig::default()
+    };
+    let mut trainer = Trainer::new(config, None);
+    while !trainer.done() {
+        trainer.step();
+    }
+    nuld_build_tool::conditional::distill::distill(&trainer.params(), instances, grid, weight_grid)
+}

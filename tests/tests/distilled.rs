@@ -3,13 +3,11 @@
 //! independent quadrature.
 
 use glam::Vec2;
-use nuld_build_tool::conditional::distill::distill;
 use nuld_build_tool::sphere::brdf_albedo::directional_albedo;
-use nuld_build_tool::train::{TrainConfig, Trainer};
 use nuld_core::brdf::BrdfModel;
 use nuld_core::quantize::UNORM16_MAX_ERROR;
 use nuld_runtime::{Blob, ConditionalSampler};
-use nuld_tests::META;
+use nuld_tests::{distilled_parts, META};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -17,26 +15,9 @@ const GRID: [u32; 2] = [5, 6];
 const WEIGHT_GRID: [u32; 2] = [10, 9];
 const INSTANCES: u32 = 3;
 
-/// Trains a small network for a few steps (enough to leave the initialization)
-/// and hands the runtime's view of its distilled blob to `f`.
+/// Hands the runtime's view of a briefly trained, distilled blob to `f`.
 fn with_distilled(f: impl FnOnce(ConditionalSampler<'_>)) {
-    let config = TrainConfig {
-        n: 16,
-        hidden: vec![16, 16],
-        steps: 40,
-        pretrain_steps: 40,
-        conditions_per_step: 4,
-        instances_per_condition: 2,
-        pool_conditions: 8,
-        pool_caps: 128,
-        caps_per_step: 64,
-        ..TrainConfig::default()
-    };
-    let mut trainer = Trainer::new(config, None);
-    while !trainer.done() {
-        trainer.step();
-    }
-    let parts = distill(&trainer.params(), INSTANCES, GRID, WEIGHT_GRID);
+    let parts = distilled_parts(INSTANCES, GRID, WEIGHT_GRID);
     let bytes = parts.to_blob(&META).unwrap();
     f(Blob::parse(bytes.as_slice())
         .unwrap()

@@ -24,14 +24,12 @@
 #[path = "../examples/shader_sample.rs"]
 mod shader_sample;
 
-use nuld_build_tool::conditional::distill::distill;
-use nuld_build_tool::train::{TrainConfig, Trainer};
 use nuld_core::blob::Domain;
 use nuld_core::network::Activation;
 use nuld_runtime::glam::{Vec2, Vec3};
 use nuld_runtime::shader::{kernel_wgsl, KernelMode, KernelParams, KERNEL_ENTRY_POINT};
 use nuld_runtime::{Blob, ConditionalSampler, Sample};
-use nuld_tests::{conditional_parts, sobol_blob, META};
+use nuld_tests::{conditional_parts, distilled_parts, sobol_blob, META};
 use shader_sample::Gpu;
 use std::sync::OnceLock;
 
@@ -251,23 +249,8 @@ fn check_conditional(kernel: &Kernel, bytes: &[u8], label: &str) {
 #[test]
 fn shader_distilled_brdf_sampler_matches_the_runtime() {
     let Some(kernel) = kernel() else { return };
-    let config = TrainConfig {
-        n: 16,
-        hidden: vec![16, 16],
-        steps: 40,
-        pretrain_steps: 40,
-        conditions_per_step: 4,
-        instances_per_condition: 2,
-        pool_conditions: 8,
-        pool_caps: 128,
-        caps_per_step: 64,
-        ..TrainConfig::default()
-    };
-    let mut trainer = Trainer::new(config, None);
-    while !trainer.done() {
-        trainer.step();
-    }
-    let parts = distill(&trainer.params(), 3, [5, 6], [10, 9]);
+    // The fixture of tests/distilled.rs: 3 instances, a 5 x 6 point grid.
+    let parts = distilled_parts(3, [5, 6], [10, 9]);
     let bytes = parts.to_blob(&META).unwrap();
     check_conditional(kernel, bytes.as_slice(), "distilled");
 }
