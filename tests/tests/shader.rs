@@ -4,9 +4,10 @@
 //! and a random-content sampler with the shapes training does not use (SiLU, three
 //! layers, a lattice generator whose products overflow 32 bits).
 //!
-//! On a machine without an adapter the tests print why and pass, except under CI
-//! (the `CI` environment variable set), where they fail: CI installs lavapipe, the
-//! CPU Vulkan driver (`apt-get install mesa-vulkan-drivers libvulkan1`).
+//! On a machine without an adapter the tests print why (on stderr, shown with
+//! `--nocapture`) and pass, except under CI (the `CI` environment variable set),
+//! where they fail: CI installs lavapipe, the CPU Vulkan driver
+//! (`apt-get install mesa-vulkan-drivers libvulkan1`).
 //!
 //! Tolerances, in absolute terms on unit-vector components and weights:
 //! * 2D point sets: exact;
