@@ -13,7 +13,7 @@ use crate::sphere::{BrdfTarget, DirectionDensity};
 use anyhow::{anyhow, Result};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::{Domain, Metadata};
-use nuld_core::conditional::{ConditionalInfo, ConditionalTarget};
+use nuld_core::conditional::{ConditionalInfo, ConditionalTarget, PointWarp};
 use nuld_core::network::Activation;
 use nuld_runtime::glam::{Vec2, Vec3};
 use nuld_runtime::Blob;
@@ -25,14 +25,17 @@ use std::time::Instant;
 /// `[0°, 89°]`) with random contents: `n` points, `instances` stored instances, a
 /// `grid` point table of random codes, a 7 x 9 weight table of weights in
 /// `[0.5, 1.6)`, and a network of the given hidden widths (1 to 3) with f16
-/// parameters uniform in `[-0.6, 0.6]`. Deterministic for a seed. Fails if the
-/// counts describe no valid network.
+/// parameters uniform in `[-0.6, 0.6]`, with the given point warp (for
+/// [`PointWarp::BrdfMixture`] a second weight-grid table of lobe probabilities
+/// uniform in `[0.02, 0.98)`). Deterministic for a seed. Fails if the counts
+/// describe no valid network.
 pub fn random_parts(
     n: u32,
     hidden: &[u32],
     activation: Activation,
     instances: u32,
     grid: [u32; 2],
+    warp: PointWarp,
     seed: u64,
 ) -> Result<ConditionalParts> {
     let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
@@ -55,7 +58,8 @@ pub fn random_parts(
         // Odd: coprime to every power of two, so the lattice's second coordinate
         // is a permutation for such n.
         lattice_generator: (n / 3) | 1,
-        reserved: [0; 3],
+        warp: warp as u32,
+        reserved: [0; 2],
     };
     let shape = info
         .shape()
@@ -67,8 +71,15 @@ pub fn random_parts(
         .point_table_len()
         .ok_or_else(|| anyhow!("point table size overflows"))?;
     let table = (0..table_len).map(|_| rng.random()).collect();
-    let weights = (0..info.weight_table_len())
-        .map(|_| rng.random_range(0.5f32..1.6))
+    let nodes = info.weight_table_len();
+    let weights = (0..nodes * info.weight_tables())
+        .map(|e| {
+            if e < nodes {
+                rng.random_range(0.5f32..1.6)
+            } else {
+                rng.random_range(0.02f32..0.98)
+            }
+        })
         .collect();
     Ok(ConditionalParts {
         info,
@@ -146,7 +157,7 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
         seed: 0,
     };
     let blob = |hidden: &[u32], act| -> Result<AlignedBytes> {
-        random_parts(n, hidden, act, 16, [10, 9], 2)?.to_blob(&meta)
+        random_parts(n, hidden, act, 16, [10, 9], PointWarp::BrdfMixture, 2)?.to_blob(&meta)
     };
     let (relu, silu) = (
         blob(&[32, 32], Activation::Relu)?,

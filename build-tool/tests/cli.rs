@@ -467,7 +467,8 @@ fn conditional_blob(path: &Path) {
         hidden: [5, 0, 0],
         activation: 1,
         lattice_generator: 5,
-        reserved: [0; 3],
+        warp: 0,
+        reserved: [0; 2],
     };
     let params = (0..info.shape().unwrap().param_len())
         .map(|j| f16_encode(((j * 37 % 101) as f32 - 50.0) / 60.0))

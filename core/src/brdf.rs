@@ -308,8 +308,15 @@ pub fn burley_parts(wo: DVec3, wi: DVec3, roughness: f64) -> BrdfParts<f64> {
 /// `(sin theta_o, 0, cos theta_o)`, with `theta_o_deg` clamped by
 /// [`clamp_theta_o_deg`].
 pub fn view_direction(theta_o_deg: f64) -> DVec3 {
-    let t = clamp_theta_o_deg(theta_o_deg).to_radians();
-    DVec3::new(libm::sin(t), 0.0, libm::cos(t))
+    DVec3::from_array(view_direction_real(theta_o_deg))
+}
+
+/// [`view_direction`] in any [`Real`] (the runtime's `f32` twin):
+/// `(sin t, 0, cos t)`, `t` the clamped angle times `pi / 180`.
+#[inline]
+pub fn view_direction_real<T: Real>(theta_o_deg: T) -> [T; 3] {
+    let t = clamp_theta_o_deg(theta_o_deg) * T::of(core::f64::consts::PI / 180.0);
+    [t.sin(), T::ZERO, t.cos()]
 }
 
 #[cfg(test)]

@@ -19,6 +19,7 @@
 //! network's condition input is that normalized point.
 
 use crate::network::{Activation, Shape, MAX_HIDDEN_LAYERS};
+use crate::real::Real;
 use bytemuck::{Pod, Zeroable};
 
 /// What a conditional blob's condition means.
@@ -36,6 +37,38 @@ impl ConditionalTarget {
     pub fn from_code(code: u32) -> Option<Self> {
         match code {
             1 => Some(Self::GltfBrdf),
+            _ => None,
+        }
+    }
+}
+
+/// How a conditional sampler turns the network's point of the unit square into a
+/// direction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum PointWarp {
+    /// The domain's equal-area map (`crate::sphere`) of the network's square
+    /// point: the network alone shapes the set.
+    EqualArea = 0,
+    /// The network's point is a point of the *primary sample space* of the
+    /// renderer's mixture warp ([`crate::warp::brdf_mixture_real`]): its outputs
+    /// are a residual added to the logit of the instance's shifted lattice point
+    /// ([`crate::network::Shape::lattice_residual`]), and the direction is the
+    /// mixture warp of the result for the condition's view, `alpha = roughness^2`
+    /// and lobe probability `p_s` (a second table after the weights). A strong
+    /// prior (paper §4's "correction in primary sample space to a cheap standard
+    /// warp"): at zero residual the set is the renderer's warp of a randomly
+    /// shifted lattice, so the network only learns a smooth correction, and
+    /// instances differ by construction. glTF BRDF blobs only.
+    BrdfMixture = 1,
+}
+
+impl PointWarp {
+    /// The warp with this code, if any.
+    pub fn from_code(code: u32) -> Option<Self> {
+        match code {
+            0 => Some(Self::EqualArea),
+            1 => Some(Self::BrdfMixture),
             _ => None,
         }
     }
@@ -68,8 +101,10 @@ pub struct ConditionalInfo {
     pub activation: u32,
     /// The rank-1 lattice generator of the network's input.
     pub lattice_generator: u32,
+    /// A [`PointWarp`] code.
+    pub warp: u32,
     /// Reserved, zero.
-    pub reserved: [u32; 3],
+    pub reserved: [u32; 2],
 }
 
 /// Size of [`ConditionalInfo`] in bytes.
@@ -194,7 +229,14 @@ impl ConditionalInfo {
             return None;
         }
         let act = Activation::from_code(self.activation)?;
+        let residual = PointWarp::from_code(self.warp)? == PointWarp::BrdfMixture;
         Shape::new(self.n, &self.hidden[..layers], act, self.lattice_generator)
+            .map(|s| s.with_lattice_residual(residual))
+    }
+
+    /// The info's [`PointWarp`], if its code is known.
+    pub fn point_warp(&self) -> Option<PointWarp> {
+        PointWarp::from_code(self.warp)
     }
 
     /// Number of `u32` entries of the point table:
@@ -206,9 +248,19 @@ impl ConditionalInfo {
             .checked_mul(self.n as u64)
     }
 
-    /// Number of `f32` entries of the weight table: `weight_grid[0] weight_grid[1]`.
+    /// Number of `f32` entries of one table on the weight grid:
+    /// `weight_grid[0] weight_grid[1]`.
     pub fn weight_table_len(&self) -> u64 {
         self.weight_grid[0] as u64 * self.weight_grid[1] as u64
+    }
+
+    /// Number of tables in the weight section: the weights, then for
+    /// [`PointWarp::BrdfMixture`] the lobe probabilities `p_s`.
+    pub fn weight_tables(&self) -> u64 {
+        match self.point_warp() {
+            Some(PointWarp::BrdfMixture) => 2,
+            _ => 1,
+        }
     }
 
     /// Index of `(node, instance, index)` in the point table: layout
@@ -225,6 +277,17 @@ fn node_condition(info: &ConditionalInfo, nodes: [u32; 2], j: [u32; 2]) -> [f64;
         let steps = (nodes[a].max(2) - 1) as f64;
         lo + (j[a] as f64 / steps) * (hi - lo)
     })
+}
+
+/// The direction of a [`PointWarp::BrdfMixture`] sampler's primary point `u` at the
+/// condition `(roughness, theta_o in degrees)` (each clamped into its range) with
+/// lobe probability `p_s`: [`crate::warp::brdf_mixture_real`] for the view
+/// [`crate::brdf::view_direction_real`] and `alpha = roughness^2`
+/// ([`crate::brdf::alpha`]).
+#[inline]
+pub fn brdf_mixture_direction<T: Real>(cond: [T; 2], p_s: T, u: [T; 2]) -> [T; 3] {
+    let wo = crate::brdf::view_direction_real(cond[1]);
+    crate::warp::brdf_mixture_real(wo, crate::brdf::alpha(cond[0]), p_s, u)
 }
 
 /// Packs a square point's u16 unorm codes as one table entry: `x | y << 16`.
@@ -256,7 +319,8 @@ mod tests {
             hidden: [8, 8, 0],
             activation: 0,
             lattice_generator: 3,
-            reserved: [0; 3],
+            warp: 0,
+            reserved: [0; 2],
         }
     }
 

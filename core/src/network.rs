@@ -26,6 +26,10 @@
 //! * `sigmoid` maps the two outputs onto the open unit square; `M` is the domain's
 //!   equal-area map (for BRDF samplers the hemisphere map of
 //!   [`crate::sphere::square_to_hemisphere`]).
+//! * With a [lattice residual](Shape::lattice_residual) the outputs are a residual
+//!   on the logit of the shifted lattice point, `o_a + ln(p_a / (1 - p_a))`, so that a
+//!   zero output leaves `p` where it is; the caller's map is then a warp of primary
+//!   sample space (`crate::conditional::PointWarp::BrdfMixture`).
 //!
 //! Parameters are one flat array in this order ([`Shape::param_len`]):
 //!
@@ -123,6 +127,26 @@ pub struct Shape {
     layers: u32,
     activation: Activation,
     lattice_generator: u32,
+    lattice_residual: bool,
+}
+
+/// Distance of the clamped shifted lattice point from `0` and `1` in
+/// [`lattice_logit`]: `2^-20`, exact in `f32`, so `logit` stays within `+-13.9`.
+pub const LATTICE_LOGIT_EPS: f64 = 1.0 / 1_048_576.0;
+
+/// `ln(p_a / (1 - p_a))` of the shifted lattice point read back from the input
+/// features (`p_a = (input[7 + a] + 1) / 2`, clamped into
+/// `[LATTICE_LOGIT_EPS, 1 - LATTICE_LOGIT_EPS]`): the residual base of a
+/// [`Shape::lattice_residual`] network.
+#[inline]
+pub fn lattice_logit<T: Real>(input: &[T; INPUTS]) -> [T; 2] {
+    let eps = T::of(LATTICE_LOGIT_EPS);
+    core::array::from_fn(|a| {
+        let p = ((input[CONDITION_FEATURES + 2 + a] + T::ONE) * T::of(0.5))
+            .max(eps)
+            .min(T::ONE - eps);
+        (p / (T::ONE - p)).ln()
+    })
 }
 
 impl Shape {
@@ -152,7 +176,22 @@ impl Shape {
             layers: hidden.len() as u32,
             activation,
             lattice_generator,
+            lattice_residual: false,
         })
+    }
+
+    /// The shape with the outputs a residual on [`lattice_logit`] (`true`) or plain
+    /// (`false`, what [`Shape::new`] makes).
+    pub fn with_lattice_residual(self, lattice_residual: bool) -> Self {
+        Self {
+            lattice_residual,
+            ..self
+        }
+    }
+
+    /// Whether the outputs are `o + lattice_logit(input)` (module docs).
+    pub fn lattice_residual(&self) -> bool {
+        self.lattice_residual
     }
 
     /// Points per set `n` (the number of per-index rows of `E`).
@@ -335,7 +374,8 @@ impl<W> Network<W> {
 
     /// The forward pass, in this order of operations (which readers in other
     /// languages reproduce): per unit `acc = b[o]`, then `acc += E[i][o]` in the
-    /// first hidden layer, then `acc += W[o][k] x[k]` for `k` ascending.
+    /// first hidden layer, then `acc += dot(W[o], x)` ([`dot`]); with a lattice
+    /// residual, each output then `+= lattice_logit(input)[o]`.
     /// `record(layer, unit, pre_activation)` sees every hidden pre-activation.
     #[inline(always)]
     fn run<T: Real>(
@@ -372,6 +412,12 @@ impl<W> Network<W> {
         let mut out = [T::ZERO; OUTPUTS];
         let bias = off + OUTPUTS * fan_in;
         layer(w, off, bias, None, &a[..fan_in], &mut out, |_, z| z);
+        if shape.lattice_residual {
+            let base = lattice_logit(input);
+            for (o, b) in out.iter_mut().zip(base) {
+                *o = *o + b;
+            }
+        }
         out
     }
 }

@@ -120,8 +120,18 @@ pub fn disk_to_square(d: DVec2) -> DVec2 {
 /// assert!((d - DVec3::new(0.5, 0.0, 0.75f64.sqrt())).length() < 1e-15);
 /// ```
 pub fn square_to_cosine_hemisphere(u: DVec2) -> DVec3 {
-    let d = square_to_disk(u);
-    DVec3::new(d.x, d.y, safe_sqrt(1.0 - d.length_squared()))
+    DVec3::from_array(square_to_cosine_hemisphere_real(u.to_array()))
+}
+
+/// [`square_to_cosine_hemisphere`] in any [`Real`]: the one formula, which the
+/// runtime evaluates in `f32`.
+#[inline]
+pub fn square_to_cosine_hemisphere_real<T: Real>(u: [T; 2]) -> [T; 3] {
+    let (x, y) = match concentric_polar(u) {
+        None => (T::ZERO, T::ZERO),
+        Some((r, theta)) => (r * theta.cos(), r * theta.sin()),
+    };
+    [x, y, (T::ONE - (x * x + y * y)).max(T::ZERO).sqrt()]
 }
 
 /// Density per steradian of [`square_to_cosine_hemisphere`]: `max(z, 0) / pi` for a
@@ -168,17 +178,72 @@ fn vndf_frame(wo: DVec3, alpha: f64) -> (DVec3, DVec3, DVec3) {
 /// assert!((h - DVec3::new(0.0, 0.6, 0.8)).length() < 1e-15);
 /// ```
 pub fn sample_ggx_vndf(wo: DVec3, alpha: f64, u: DVec2) -> DVec3 {
-    let (vh, t1, t2) = vndf_frame(wo, alpha);
-    let r = libm::sqrt(u.x.clamp(0.0, 1.0));
-    let phi = 2.0 * PI * u.y;
-    let p1 = r * libm::cos(phi);
-    let mut p2 = r * libm::sin(phi);
+    DVec3::from_array(sample_ggx_vndf_real(wo.to_array(), alpha, u.to_array()))
+}
+
+/// `x / |x|` (NaN for a zero vector), as `glam`'s `normalize`.
+#[inline]
+fn normalize_real<T: Real>(x: [T; 3]) -> [T; 3] {
+    let inv = T::ONE / (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+    x.map(|c| c * inv)
+}
+
+/// [`sample_ggx_vndf`] in any [`Real`]: the one formula, which the runtime
+/// evaluates in `f32` (`u.x` NaN counts as 0).
+#[inline]
+pub fn sample_ggx_vndf_real<T: Real>(wo: [T; 3], alpha: T, u: [T; 2]) -> [T; 3] {
+    let (zero, one, half) = (T::ZERO, T::ONE, T::of(0.5));
+    let safe_sqrt = |x: T| x.max(zero).sqrt();
+    // The stretched view direction and its frame (Heitz 2018, Listing 1).
+    let vh = normalize_real([alpha * wo[0], alpha * wo[1], wo[2]]);
+    let lensq = vh[0] * vh[0] + vh[1] * vh[1];
+    let t1 = if lensq > zero {
+        let len = lensq.sqrt();
+        [zero - vh[1] / len, vh[0] / len, zero]
+    } else {
+        [one, zero, zero]
+    };
+    let t2 = [
+        vh[1] * t1[2] - t1[1] * vh[2],
+        vh[2] * t1[0] - t1[2] * vh[0],
+        vh[0] * t1[1] - t1[0] * vh[1],
+    ];
+    let r = u[0].max(zero).min(one).sqrt();
+    let phi = T::of(2.0) * T::PI * u[1];
+    let p1 = r * phi.cos();
+    let mut p2 = r * phi.sin();
     // Squash the disk's lower half onto the part of the projected hemisphere that
     // the stretched view direction sees (Heitz 2018, §4.2).
-    let s = 0.5 * (1.0 + vh.z);
-    p2 = (1.0 - s) * safe_sqrt(1.0 - p1 * p1) + s * p2;
-    let nh = p1 * t1 + p2 * t2 + safe_sqrt(1.0 - p1 * p1 - p2 * p2) * vh;
-    DVec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(0.0)).normalize()
+    let s = half * (one + vh[2]);
+    p2 = (one - s) * safe_sqrt(one - p1 * p1) + s * p2;
+    let q = safe_sqrt(one - p1 * p1 - p2 * p2);
+    let nh: [T; 3] = core::array::from_fn(|c| p1 * t1[c] + p2 * t2[c] + q * vh[c]);
+    normalize_real([alpha * nh[0], alpha * nh[1], nh[2].max(zero)])
+}
+
+/// The renderer's mixture warp for a BRDF with a GGX lobe and a diffuse lobe
+/// (the incumbent of paper §4's comparison, and the prior of the conditional
+/// sampler's [`crate::conditional::PointWarp::BrdfMixture`]): `u.x < p_s` picks
+/// [`sample_ggx_vndf_real`] reflected about the normal (`wi = 2 (wo.h) h - wo`,
+/// `u.x / p_s` as its first coordinate), otherwise
+/// [`square_to_cosine_hemisphere_real`] of `((u.x - p_s) / (1 - p_s), u.y)`; a
+/// direction below the horizon is mirrored (`z -> |z|`). `wo` is the unit view
+/// direction (`z > 0`), `alpha = roughness^2 > 0`, `p_s` in `[0, 1]` the lobe
+/// probability (the specular share of the albedo), `u` in `[0,1]^2` (`u.x` clamped,
+/// NaN as 0). A unit vector with `z >= 0`.
+#[inline]
+pub fn brdf_mixture_real<T: Real>(wo: [T; 3], alpha: T, p_s: T, u: [T; 2]) -> [T; 3] {
+    let (zero, one) = (T::ZERO, T::ONE);
+    let ux = u[0].max(zero).min(one);
+    let wi = if ux < p_s {
+        let h = sample_ggx_vndf_real(wo, alpha, [(ux / p_s).min(one), u[1]]);
+        let d = T::of(2.0) * (wo[0] * h[0] + wo[1] * h[1] + wo[2] * h[2]);
+        core::array::from_fn(|c| d * h[c] - wo[c])
+    } else {
+        let r = ((ux - p_s) / (one - p_s)).max(zero).min(one);
+        square_to_cosine_hemisphere_real([r, u[1]])
+    };
+    normalize_real([wi[0], wi[1], wi[2].abs()])
 }
 
 /// Density per steradian of [`sample_ggx_vndf`]'s normals: the distribution of

@@ -9,7 +9,8 @@
 use glam::{Vec2, Vec3};
 use nuld_core::blob::{BlobError, Domain, Layout, SectionTag};
 use nuld_core::conditional::{
-    unpack_point, ConditionalInfo, ConditionalTarget, GridCell, CONDITIONAL_INFO_LEN,
+    brdf_mixture_direction, unpack_point, ConditionalInfo, ConditionalTarget, GridCell, PointWarp,
+    CONDITIONAL_INFO_LEN,
 };
 use nuld_core::network::{input_features, Activation, F16Params, Network, Shape};
 use nuld_core::quantize::{f16_is_finite, unorm16_decode};
@@ -41,6 +42,7 @@ pub struct ConditionalSampler<'a> {
     info: ConditionalInfo,
     shape: Shape,
     domain: Domain,
+    warp: PointWarp,
     params: &'a [u16],
     table: &'a [u32],
     weights: &'a [f32],
@@ -88,9 +90,18 @@ impl<'a> ConditionalSampler<'a> {
             Some(d @ (Domain::Sphere | Domain::Hemisphere)) => d,
             _ => return Err(BlobError::ConditionalDomain(info.domain)),
         };
-        if ConditionalTarget::from_code(info.target).is_none() {
+        let Some(target) = ConditionalTarget::from_code(info.target) else {
             return Err(BlobError::UnknownConditionalTarget(info.target));
-        }
+        };
+        let warp = match info.point_warp() {
+            Some(PointWarp::BrdfMixture)
+                if !(target == ConditionalTarget::GltfBrdf && domain == Domain::Hemisphere) =>
+            {
+                return Err(BlobError::UnknownPointWarp(info.warp))
+            }
+            Some(w) => w,
+            None => return Err(BlobError::UnknownPointWarp(info.warp)),
+        };
         for axis in 0..2 {
             let nodes = info.grid[axis];
             if nodes < 2 {
@@ -119,7 +130,7 @@ impl<'a> ConditionalSampler<'a> {
             return Err(BlobError::UnknownActivation(info.activation));
         }
         let shape = info.shape().ok_or(BlobError::NetworkWidths(info.hidden))?;
-        if info.reserved != [0; 3] {
+        if info.reserved != [0; 2] {
             return Err(BlobError::ConditionalReserved(info.reserved));
         }
 
@@ -157,7 +168,7 @@ impl<'a> ConditionalSampler<'a> {
         if entry.elem_size != 4 {
             return Err(BlobError::WeightElementSize(entry.elem_size));
         }
-        let expected = info.weight_table_len();
+        let expected = info.weight_table_len() * info.weight_tables();
         let got = bytes.len() as u64 / 4;
         if got != expected {
             return Err(BlobError::WeightTableLength { expected, got });
@@ -167,6 +178,7 @@ impl<'a> ConditionalSampler<'a> {
             info,
             shape,
             domain,
+            warp,
             params,
             table,
             weights,
@@ -235,9 +247,27 @@ impl<'a> ConditionalSampler<'a> {
     /// `info().normalize(cond)`. Finite and `>= 0`. O(1), never panics.
     #[inline]
     pub fn weight(&self, cond: Vec2) -> f32 {
+        self.weight_grid_lerp(cond, 0)
+    }
+
+    /// Table `table` of the weight section (0: weights, 1: lobe probabilities)
+    /// interpolated bilinearly at `cond`, clamped like [`Self::weight`].
+    #[inline]
+    fn weight_grid_lerp(&self, cond: Vec2, table: usize) -> f32 {
         let cell = GridCell::locate(self.info.normalize(cond.to_array()), self.info.weight_grid);
-        let w = |dx, dy| self.weights.get(cell.node(dx, dy)).copied().unwrap_or(0.0);
+        let base = table * self.info.weight_table_len() as usize;
+        let w = |dx, dy| {
+            let at = base + cell.node(dx, dy);
+            self.weights.get(at).copied().unwrap_or(0.0)
+        };
         cell.lerp(w(0, 0), w(1, 0), w(0, 1), w(1, 1))
+    }
+
+    /// The lobe probability `p_s` of a [`PointWarp::BrdfMixture`] sampler at
+    /// `cond`: the second table of the weight section, interpolated as the weights.
+    #[inline]
+    pub fn lobe_probability(&self, cond: Vec2) -> f32 {
+        self.weight_grid_lerp(cond, 1)
     }
 
     /// Table mode's point of the unit square for index `i` (mod `n`) of instance
@@ -361,8 +391,18 @@ impl<'a> ConditionalSampler<'a> {
 
     #[inline]
     fn mapped(&self, p: Vec2, cond: Vec2) -> Sample {
+        let direction = match self.warp {
+            PointWarp::EqualArea => self.domain.to_direction_real(p.to_array()),
+            PointWarp::BrdfMixture => {
+                // The clamped condition in blob units, as the tables see it.
+                let u = self.info.normalize(cond.to_array());
+                let (lo, hi) = (self.info.cond_min, self.info.cond_max);
+                let c = [0, 1].map(|a| lo[a] + u[a] * (hi[a] - lo[a]));
+                brdf_mixture_direction(c, self.lobe_probability(cond), p.to_array())
+            }
+        };
         Sample {
-            direction: Vec3::from_array(self.domain.to_direction_real(p.to_array())),
+            direction: Vec3::from_array(direction),
             weight: self.weight(cond),
         }
     }
@@ -448,7 +488,8 @@ mod tests {
             hidden: [4, 3, 0],
             activation: Activation::Silu as u32,
             lattice_generator: 2,
-            reserved: [0; 3],
+            warp: 0,
+            reserved: [0; 2],
         };
         let len = info.shape().unwrap().param_len();
         let params = (0..len as u32)
@@ -686,7 +727,7 @@ mod tests {
     fn each_validation_failure_has_its_error() {
         assert_eq!(with(|_| {}), Ok(()));
         type Change = fn(&mut Parts);
-        let cases: [(Change, BlobError); 22] = [
+        let cases: [(Change, BlobError); 24] = [
             (|p| p.info.n = 0, BlobError::ConditionalNoPoints),
             (|p| p.info.instances = 0, BlobError::ConditionalNoInstances),
             (|p| p.info.domain = 0, BlobError::ConditionalDomain(0)),
@@ -741,8 +782,16 @@ mod tests {
                 BlobError::NetworkWidths([129, 3, 0]),
             ),
             (
-                |p| p.info.reserved[2] = 1,
-                BlobError::ConditionalReserved([0, 0, 1]),
+                |p| p.info.reserved[1] = 1,
+                BlobError::ConditionalReserved([0, 1]),
+            ),
+            (|p| p.info.warp = 7, BlobError::UnknownPointWarp(7)),
+            (
+                |p| {
+                    p.info.warp = 1;
+                    p.info.domain = 1;
+                },
+                BlobError::UnknownPointWarp(1),
             ),
             (
                 |p| {

@@ -283,7 +283,8 @@ pub fn doc_example_conditional_blob() -> Aligned<[u8; 400]> {
         hidden: [1, 0, 0],
         activation: 0,
         lattice_generator: 1,
-        reserved: [0; 3],
+        warp: 0,
+        reserved: [0; 2],
     };
     // 2 x 1 embedding, 1 x 11 + 1 first layer, 2 x 1 + 2 output: 18 parameters.
     let params: [u16; 18] =

@@ -270,7 +270,8 @@ mod tests {
         let shape = config.train.shape().unwrap();
         assert_eq!(len(SectionTag::NetworkParams), 2 * shape.param_len());
         assert_eq!(len(SectionTag::PointTable), 4 * 2 * 3 * 3 * 8);
-        assert_eq!(len(SectionTag::WeightTable), 4 * 8);
+        // The weights, then the mixture warp's lobe probabilities.
+        assert_eq!(len(SectionTag::WeightTable), 4 * 8 * 2);
         for f in ["report.json", "loss.png", "sets.png", "checkpoint.bin"] {
             assert!(dir.join(f).is_file(), "{f}");
         }

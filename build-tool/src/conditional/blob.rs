@@ -17,7 +17,9 @@ pub struct ConditionalParts {
     pub params: Vec<u16>,
     /// The point table: `x | y << 16` u16 unorm codes, `[node][instance][index]`.
     pub table: Vec<u32>,
-    /// The weight table, one `f32` per weight-grid node, axis 0 fastest.
+    /// The weight table, one `f32` per weight-grid node, axis 0 fastest; for
+    /// [`nuld_core::conditional::PointWarp::BrdfMixture`] followed by the lobe
+    /// probabilities on the same nodes.
     pub weights: Vec<f32>,
 }
 
@@ -43,11 +45,12 @@ impl ConditionalParts {
                 info.point_table_len()
             );
         }
-        if self.weights.len() as u64 != info.weight_table_len() {
+        let weight_len = info.weight_table_len() * info.weight_tables();
+        if self.weights.len() as u64 != weight_len {
             bail!(
                 "weight table has {} entries, the grid calls for {}",
                 self.weights.len(),
-                info.weight_table_len()
+                weight_len
             );
         }
         let meta_bytes = postcard::to_allocvec(meta).context("cannot encode metadata")?;

@@ -6,15 +6,16 @@
 //!   network's square point evaluated in `f64` on the *f16-rounded* parameters
 //!   (exactly what ships), as u16 unorm codes ([`unorm16_encode`], [`pack_point`]);
 //! * **weight table**: the glTF directional albedo `A` at every weight-grid node
-//!   ([`directional_albedo`]).
+//!   ([`directional_albedo`]), followed for a [`PointWarp::BrdfMixture`] sampler by
+//!   the lobe probability `p_s = A_spec / A` at the same nodes ([`lobe_probability`]).
 
 use super::ConditionalParts;
 use crate::network::Params;
-use crate::sphere::brdf_albedo::directional_albedo;
+use crate::sphere::brdf_albedo::{directional_albedo, lobe_probability};
 use crate::train::pool::{COND_MAX, COND_MIN};
 use nuld_core::blob::Domain;
 use nuld_core::brdf::BrdfModel;
-use nuld_core::conditional::{pack_point, ConditionalInfo, ConditionalTarget};
+use nuld_core::conditional::{pack_point, ConditionalInfo, ConditionalTarget, PointWarp};
 use nuld_core::network::MAX_HIDDEN_LAYERS;
 use nuld_core::quantize::unorm16_encode;
 use rayon::prelude::*;
@@ -43,7 +44,12 @@ pub fn brdf_info(
         hidden,
         activation: shape.activation() as u32,
         lattice_generator: shape.lattice_generator(),
-        reserved: [0; 3],
+        warp: if shape.lattice_residual() {
+            PointWarp::BrdfMixture
+        } else {
+            PointWarp::EqualArea
+        } as u32,
+        reserved: [0; 2],
     }
 }
 
@@ -78,12 +84,17 @@ pub fn distill(
         })
         .collect();
     let weight_nodes = (weight_grid[0] * weight_grid[1]) as usize;
-    let weights: Vec<f32> = (0..weight_nodes)
+    let tables = info.weight_tables() as usize;
+    let weights: Vec<f32> = (0..weight_nodes * tables)
         .into_par_iter()
-        .map(|node| {
-            let j = [node as u32 % weight_grid[0], node as u32 / weight_grid[0]];
-            let c = info.weight_grid_condition(j);
-            directional_albedo(BrdfModel::Gltf, c[0], c[1]).total() as f32
+        .map(|entry| {
+            let node = (entry % weight_nodes) as u32;
+            let c = info.weight_grid_condition([node % weight_grid[0], node / weight_grid[0]]);
+            if entry < weight_nodes {
+                directional_albedo(BrdfModel::Gltf, c[0], c[1]).total() as f32
+            } else {
+                lobe_probability(BrdfModel::Gltf, c[0], c[1]) as f32
+            }
         })
         .collect();
     ConditionalParts {

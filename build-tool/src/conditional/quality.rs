@@ -14,11 +14,14 @@
 use crate::baselines::seeded_owen_sobol;
 use crate::eval::conditional::diversity;
 use crate::network::Params;
+use crate::sphere::brdf_albedo::lobe_probability;
 use crate::sphere::metrics::{CapRadius, MeasuredCaps};
 use crate::sphere::{BrdfTarget, DirectionDensity};
 use crate::train::pool::normalized;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
+use nuld_core::brdf::BrdfModel;
+use nuld_core::conditional::brdf_mixture_direction;
 use nuld_core::network::input_features;
 use nuld_core::sphere::square_to_hemisphere;
 use rayon::prelude::*;
@@ -93,12 +96,17 @@ pub struct Quality {
 /// The directions of instance `k` at `cond` (network mode, `params` as given).
 pub fn instance_directions(params: &Params, cond: [f64; 2], k: u32) -> Vec<DVec3> {
     let unit = normalized(cond);
+    let p_s = lobe_probability(BrdfModel::Gltf, cond[0], cond[1]);
     (0..params.shape.n())
         .map(|i| {
             let s = params
                 .network()
                 .square_point(i, input_features(&params.shape, unit, k, i));
-            square_to_hemisphere(DVec2::new(s[0], s[1]))
+            if params.shape.lattice_residual() {
+                DVec3::from_array(brdf_mixture_direction(cond, p_s, s))
+            } else {
+                square_to_hemisphere(DVec2::new(s[0], s[1]))
+            }
         })
         .collect()
 }

@@ -36,7 +36,7 @@ use nuld_core::brdf::{
     alpha, view_direction, BrdfModel, F0, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS,
 };
 use nuld_core::warp::{
-    cosine_hemisphere_pdf, ggx_vndf_reflected_pdf, sample_ggx_vndf_reflected,
+    brdf_mixture_real, cosine_hemisphere_pdf, ggx_vndf_reflected_pdf, sample_ggx_vndf_reflected,
     square_to_cosine_hemisphere,
 };
 use rand::{Rng, RngCore};
@@ -285,19 +285,18 @@ impl DirectionDensity for BrdfTarget {
         self.model.cosine_weighted(self.wo, w, self.roughness) / self.albedo()
     }
 
-    /// The baseline warp: `u.x < A_spec / A` picks the VNDF lobe (`u.x` rescaled),
-    /// else the cosine lobe; `u.y` and the rescaled `u.x` drive the lobe's warp. A
-    /// VNDF direction below the horizon is mirrored (`z -> -z`).
+    /// The baseline warp, [`brdf_mixture_real`] with `p_s = A_spec / A`:
+    /// `u.x < p_s` picks the VNDF lobe (`u.x` rescaled), else the cosine lobe; `u.y`
+    /// and the rescaled `u.x` drive the lobe's warp. A VNDF direction below the
+    /// horizon is mirrored (`z -> -z`).
     fn sample(&self, u: DVec2) -> DVec3 {
         let ps = self.specular_albedo / self.albedo();
-        let ux = u.x.clamp(0.0, 1.0);
-        let wi = if ux < ps {
-            self.vndf_direction(DVec2::new((ux / ps).min(1.0), u.y))
-        } else {
-            let r = ((ux - ps) / (1.0 - ps)).clamp(0.0, 1.0);
-            square_to_cosine_hemisphere(DVec2::new(r, u.y))
-        };
-        DVec3::new(wi.x, wi.y, wi.z.abs()).normalize()
+        DVec3::from_array(brdf_mixture_real(
+            self.wo.to_array(),
+            self.alpha,
+            ps,
+            u.to_array(),
+        ))
     }
 
     /// Density of [`BrdfTarget::sample`]: with `p_s = A_spec / A` the VNDF lobe

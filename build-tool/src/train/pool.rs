@@ -13,13 +13,16 @@
 use crate::baselines::seeded_owen_sobol;
 use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use crate::discrepancy::GradientPath;
+use crate::optimize::directions::map_jacobian;
 use crate::optimize::directions::{epoch_caps, local_factor};
 use crate::seeding::derive_seed;
 use crate::sphere::{BrdfTarget, DirectionDensity};
 use glam::{DVec2, DVec3};
+use nuld_core::blob::Domain;
 use nuld_core::brdf::{view_direction, BrdfModel, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
+use nuld_core::conditional::brdf_mixture_direction;
 use nuld_core::network::{instance_offset, shifted_lattice_point, Shape};
-use nuld_core::sphere::hemisphere_to_square;
+use nuld_core::sphere::{hemisphere_to_square, square_to_hemisphere};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -63,6 +66,12 @@ pub struct PoolCondition {
     /// Cap loss of `N` Owen-Sobol points through the renderer's warp on the first
     /// window of caps: the scale against which the trainer ranks conditions.
     pub baseline_loss: f64,
+    /// The specular share `p_s = A_spec / A` of the albedo, the mixture warp's lobe
+    /// probability.
+    pub lobe_probability: f64,
+    /// Whether the network's points are primary points of the mixture warp
+    /// ([`Shape::lattice_residual`]) rather than points of the equal-area square.
+    pub mixture_prior: bool,
 }
 
 impl PoolCondition {
@@ -76,23 +85,60 @@ impl PoolCondition {
     pub fn local_factor(&self, x: DVec3) -> f64 {
         local_factor(HEMISPHERE_AREA, self.pdf(x))
     }
+
+    /// The direction of the network's point `p` and its derivatives along `p.x`
+    /// and `p.y`: the mixture warp ([`brdf_mixture_direction`], derivatives by
+    /// central differences of step `1e-6`, zeroed where they straddle the lobe
+    /// boundary, a jump that no gradient can follow) or the hemisphere map (exact
+    /// Jacobian).
+    pub fn direction(&self, p: DVec2) -> (DVec3, DVec3, DVec3) {
+        if !self.mixture_prior {
+            let (jx, jy) = map_jacobian(Domain::Hemisphere, p);
+            return (square_to_hemisphere(p), jx, jy);
+        }
+        let warp = |u: DVec2| {
+            DVec3::from_array(brdf_mixture_direction(
+                self.cond,
+                self.lobe_probability,
+                u.to_array(),
+            ))
+        };
+        const H: f64 = 1e-6;
+        let diff = |e: DVec2| {
+            let j = (warp(p + H * e) - warp(p - H * e)) / (2.0 * H);
+            // A smooth warp moves a direction by at most ~1/alpha per unit of p.
+            if j.is_finite() && j.length() < 1e3 {
+                j
+            } else {
+                DVec3::ZERO
+            }
+        };
+        (warp(p), diff(DVec2::X), diff(DVec2::Y))
+    }
 }
 
 /// Instances with pretraining targets per pool condition.
 pub const PRETRAIN_INSTANCES: u32 = 8;
 
 /// The warp's square points for the shifted lattices of the first
-/// [`PRETRAIN_INSTANCES`] instances: the renderer's mixture warp
-/// ([`BrdfTarget::sample`]) of each shifted lattice point, which the network reads
-/// as an input, so the start is a warped randomly shifted lattice.
+/// [`PRETRAIN_INSTANCES`] instances, so the start is a warped randomly shifted
+/// lattice: with a [lattice residual](Shape::lattice_residual) the shifted lattice
+/// point itself (a zero residual; the mixture warp follows), otherwise the
+/// square point of the renderer's mixture warp ([`BrdfTarget::sample`]) of it.
 fn warp_targets(target: &BrdfTarget, shape: &Shape) -> Vec<DVec2> {
     let (shape_n, g) = (shape.n(), shape.lattice_generator());
+    let residual = shape.lattice_residual();
     (0..PRETRAIN_INSTANCES)
         .flat_map(|k| {
             let z = instance_offset::<f64>(k);
             (0..shape_n).map(move |i| {
                 let u = shifted_lattice_point(i, shape_n, g, z);
-                hemisphere_to_square(target.sample(DVec2::new(u[0], u[1])))
+                let u = DVec2::new(u[0], u[1]);
+                if residual {
+                    u
+                } else {
+                    hemisphere_to_square(target.sample(u))
+                }
             })
         })
         .collect()
@@ -159,6 +205,11 @@ fn condition(
         measures,
         warp_targets: warp_targets(&target, shape),
         baseline_loss: 0.0,
+        lobe_probability: {
+            let (diffuse, specular) = target.albedo_parts();
+            specular / (diffuse + specular)
+        },
+        mixture_prior: shape.lattice_residual(),
     };
     let w = window.min(pc.caps.len());
     let pts: Vec<DVec3> = seeded_owen_sobol(n, seed)
