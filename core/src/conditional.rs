@@ -18,6 +18,8 @@
 //! `cond_min`), then normalized to `[0,1]^2` ([`ConditionalInfo::normalize`]); the
 //! network's condition input is that normalized point.
 
+use crate::blob::{SectionSpec, SectionTag};
+use crate::domain::Domain;
 use crate::network::{Activation, Shape, MAX_HIDDEN_LAYERS};
 use crate::real::Real;
 use bytemuck::{Pod, Zeroable};
@@ -70,6 +72,31 @@ impl PointWarp {
             0 => Some(Self::EqualArea),
             1 => Some(Self::BrdfMixture),
             _ => None,
+        }
+    }
+
+    /// The warp a network of `shape` is trained for: [`BrdfMixture`](Self::BrdfMixture)
+    /// for a [lattice residual](Shape::lattice_residual), else
+    /// [`EqualArea`](Self::EqualArea).
+    pub fn of_shape(shape: &Shape) -> Self {
+        if shape.lattice_residual() {
+            Self::BrdfMixture
+        } else {
+            Self::EqualArea
+        }
+    }
+
+    /// The direction of a sampler's point `p` (the network's output, or the table's
+    /// interpolation of it): [`EqualArea`](Self::EqualArea) maps it with
+    /// `domain`'s equal-area map; [`BrdfMixture`](Self::BrdfMixture) warps it with
+    /// [`brdf_mixture_direction`] at the condition `cond = (roughness, theta_o in
+    /// degrees)` and lobe probability `p_s`. A warp ignores the arguments it does not
+    /// use. Unit vectors; never panics.
+    #[inline]
+    pub fn direction<T: Real>(self, domain: Domain, cond: [T; 2], p_s: T, p: [T; 2]) -> [T; 3] {
+        match self {
+            Self::EqualArea => domain.to_direction_real(p),
+            Self::BrdfMixture => brdf_mixture_direction(cond, p_s, p),
         }
     }
 }
@@ -288,6 +315,41 @@ fn node_condition(info: &ConditionalInfo, nodes: [u32; 2], j: [u32; 2]) -> [f64;
 pub fn brdf_mixture_direction<T: Real>(cond: [T; 2], p_s: T, u: [T; 2]) -> [T; 3] {
     let wo = crate::brdf::view_direction_real(cond[1]);
     crate::warp::brdf_mixture_real(wo, crate::brdf::alpha(cond[0]), p_s, u)
+}
+
+/// The four sections of a conditional blob (kind 3) in the order `core/FORMAT.md`
+/// lists them, ready for [`crate::blob::write`]: the info record, the f16
+/// parameters, the point table and the weight section (weights, then for
+/// [`PointWarp::BrdfMixture`] the lobe probabilities). Checks no length: a reader
+/// validates them.
+pub fn sections<'s>(
+    info: &'s ConditionalInfo,
+    params: &'s [u16],
+    table: &'s [u32],
+    weights: &'s [f32],
+) -> [SectionSpec<'s>; 4] {
+    [
+        SectionSpec {
+            tag: SectionTag::ConditionalInfo,
+            elem_size: CONDITIONAL_INFO_LEN as u32,
+            bytes: bytemuck::bytes_of(info),
+        },
+        SectionSpec {
+            tag: SectionTag::NetworkParams,
+            elem_size: 2,
+            bytes: bytemuck::cast_slice(params),
+        },
+        SectionSpec {
+            tag: SectionTag::PointTable,
+            elem_size: 4,
+            bytes: bytemuck::cast_slice(table),
+        },
+        SectionSpec {
+            tag: SectionTag::WeightTable,
+            elem_size: 4,
+            bytes: bytemuck::cast_slice(weights),
+        },
+    ]
 }
 
 /// Packs a square point's u16 unorm codes as one table entry: `x | y << 16`.

@@ -446,7 +446,8 @@ mod tests {
     extern crate std;
     use super::*;
     use crate::Blob;
-    use nuld_core::blob::{encoded_len, write, BlobKind, SectionSpec};
+    use nuld_core::blob::{encoded_len, write, BlobKind};
+    use nuld_core::conditional::sections;
     use nuld_core::quantize::f16_encode;
     use std::vec::Vec;
 
@@ -521,28 +522,7 @@ mod tests {
     }
 
     fn encode(p: &Parts) -> Bytes {
-        let sections = [
-            SectionSpec {
-                tag: SectionTag::ConditionalInfo,
-                elem_size: CONDITIONAL_INFO_LEN as u32,
-                bytes: bytemuck::bytes_of(&p.info),
-            },
-            SectionSpec {
-                tag: SectionTag::NetworkParams,
-                elem_size: 2,
-                bytes: bytemuck::cast_slice(&p.params),
-            },
-            SectionSpec {
-                tag: SectionTag::PointTable,
-                elem_size: 4,
-                bytes: bytemuck::cast_slice(&p.table),
-            },
-            SectionSpec {
-                tag: SectionTag::WeightTable,
-                elem_size: 4,
-                bytes: bytemuck::cast_slice(&p.weights),
-            },
-        ];
+        let sections = sections(&p.info, &p.params, &p.table, &p.weights);
         let meta = [0u8, 0, 0];
         let len = encoded_len(&meta, &sections);
         let mut buf = std::vec![0u128; len.div_ceil(16)];

@@ -3,8 +3,8 @@
 
 use crate::pointset::AlignedBytes;
 use anyhow::{bail, Context, Result};
-use nuld_core::blob::{encoded_len, write, BlobKind, Metadata, SectionSpec, SectionTag};
-use nuld_core::conditional::{ConditionalInfo, CONDITIONAL_INFO_LEN};
+use nuld_core::blob::{encoded_len, write, BlobKind, Metadata};
+use nuld_core::conditional::{sections, ConditionalInfo};
 use std::path::Path;
 
 /// Everything a conditional blob holds besides its metadata (layouts in
@@ -54,28 +54,7 @@ impl ConditionalParts {
             );
         }
         let meta_bytes = postcard::to_allocvec(meta).context("cannot encode metadata")?;
-        let sections = [
-            SectionSpec {
-                tag: SectionTag::ConditionalInfo,
-                elem_size: CONDITIONAL_INFO_LEN as u32,
-                bytes: bytemuck::bytes_of(info),
-            },
-            SectionSpec {
-                tag: SectionTag::NetworkParams,
-                elem_size: 2,
-                bytes: bytemuck::cast_slice(&self.params),
-            },
-            SectionSpec {
-                tag: SectionTag::PointTable,
-                elem_size: 4,
-                bytes: bytemuck::cast_slice(&self.table),
-            },
-            SectionSpec {
-                tag: SectionTag::WeightTable,
-                elem_size: 4,
-                bytes: bytemuck::cast_slice(&self.weights),
-            },
-        ];
+        let sections = sections(info, &self.params, &self.table, &self.weights);
         let mut out = AlignedBytes::zeroed(encoded_len(&meta_bytes, &sections));
         write(
             out.as_mut_slice(),

@@ -44,11 +44,7 @@ pub fn brdf_info(
         hidden,
         activation: shape.activation() as u32,
         lattice_generator: shape.lattice_generator(),
-        warp: if shape.lattice_residual() {
-            PointWarp::BrdfMixture
-        } else {
-            PointWarp::EqualArea
-        } as u32,
+        warp: PointWarp::of_shape(&shape) as u32,
         reserved: [0; 2],
     }
 }

@@ -14,16 +14,13 @@
 use crate::baselines::seeded_owen_sobol;
 use crate::eval::conditional::diversity;
 use crate::network::Params;
-use crate::sphere::brdf_albedo::lobe_probability;
 use crate::sphere::metrics::{CapRadius, MeasuredCaps};
 use crate::sphere::{BrdfTarget, DirectionDensity};
 use crate::train::pool::normalized;
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 use nuld_core::blob::Domain;
-use nuld_core::brdf::BrdfModel;
-use nuld_core::conditional::brdf_mixture_direction;
+use nuld_core::conditional::PointWarp;
 use nuld_core::network::input_features;
-use nuld_core::sphere::square_to_hemisphere;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -93,20 +90,18 @@ pub struct Quality {
     pub mean_nn_ratio: f64,
 }
 
-/// The directions of instance `k` at `cond` (network mode, `params` as given).
-pub fn instance_directions(params: &Params, cond: [f64; 2], k: u32) -> Vec<DVec3> {
+/// The directions of instance `k` at `cond` (network mode, `params` as given),
+/// `p_s` the condition's lobe probability (used by the mixture warp,
+/// [`PointWarp::direction`]).
+pub fn instance_directions(params: &Params, cond: [f64; 2], p_s: f64, k: u32) -> Vec<DVec3> {
     let unit = normalized(cond);
-    let p_s = lobe_probability(BrdfModel::Gltf, cond[0], cond[1]);
+    let warp = PointWarp::of_shape(&params.shape);
     (0..params.shape.n())
         .map(|i| {
             let s = params
                 .network()
                 .square_point(i, input_features(&params.shape, unit, k, i));
-            if params.shape.lattice_residual() {
-                DVec3::from_array(brdf_mixture_direction(cond, p_s, s))
-            } else {
-                square_to_hemisphere(DVec2::new(s[0], s[1]))
-            }
+            DVec3::from_array(warp.direction(Domain::Hemisphere, cond, p_s, s))
         })
         .collect()
 }
@@ -131,7 +126,7 @@ pub fn evaluate(params: &Params, config: &QualityConfig) -> Quality {
             let d = |pts: &[DVec3]| caps.l2_squared(pts, CapRadius::ThetaUniform).0.sqrt();
             let sets: Vec<Vec<DVec3>> = (0..config.union_instances.max(config.instances).max(2))
                 .into_par_iter()
-                .map(|k| instance_directions(&shipped, cond, k))
+                .map(|k| instance_directions(&shipped, cond, target.lobe_probability(), k))
                 .collect();
             let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len() as f64;
             let ours = mean(

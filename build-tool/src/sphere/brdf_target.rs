@@ -204,6 +204,12 @@ impl BrdfTarget {
         self.diffuse_albedo + self.specular_albedo
     }
 
+    /// The lobe probability `p_s = A_spec / A` of the mixture warp
+    /// ([`BrdfTarget::sample`]), as [`crate::sphere::brdf_albedo::lobe_probability`].
+    pub fn lobe_probability(&self) -> f64 {
+        self.specular_albedo / self.albedo()
+    }
+
     /// The diffuse and specular parts of [`BrdfTarget::albedo`].
     pub fn albedo_parts(&self) -> (f64, f64) {
         (self.diffuse_albedo, self.specular_albedo)
@@ -290,7 +296,7 @@ impl DirectionDensity for BrdfTarget {
     /// and the rescaled `u.x` drive the lobe's warp. A VNDF direction below the
     /// horizon is mirrored (`z -> -z`).
     fn sample(&self, u: DVec2) -> DVec3 {
-        let ps = self.specular_albedo / self.albedo();
+        let ps = self.lobe_probability();
         DVec3::from_array(brdf_mixture_real(
             self.wo.to_array(),
             self.alpha,
@@ -308,7 +314,7 @@ impl DirectionDensity for BrdfTarget {
         if w.z < 0.0 {
             return 0.0;
         }
-        let ps = self.specular_albedo / self.albedo();
+        let ps = self.lobe_probability();
         let mirror = DVec3::new(w.x, w.y, -w.z);
         ps * (self.pdf_vndf(w) + self.pdf_vndf(mirror)) + (1.0 - ps) * cosine_hemisphere_pdf(w)
     }

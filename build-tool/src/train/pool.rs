@@ -20,9 +20,9 @@ use crate::sphere::{BrdfTarget, DirectionDensity};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
 use nuld_core::brdf::{view_direction, BrdfModel, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
-use nuld_core::conditional::brdf_mixture_direction;
+use nuld_core::conditional::PointWarp;
 use nuld_core::network::{instance_offset, shifted_lattice_point, Shape};
-use nuld_core::sphere::{hemisphere_to_square, square_to_hemisphere};
+use nuld_core::sphere::hemisphere_to_square;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -69,9 +69,8 @@ pub struct PoolCondition {
     /// The specular share `p_s = A_spec / A` of the albedo, the mixture warp's lobe
     /// probability.
     pub lobe_probability: f64,
-    /// Whether the network's points are primary points of the mixture warp
-    /// ([`Shape::lattice_residual`]) rather than points of the equal-area square.
-    pub mixture_prior: bool,
+    /// How the network's points become directions ([`PointWarp::of_shape`]).
+    pub warp: PointWarp,
 }
 
 impl PoolCondition {
@@ -86,23 +85,23 @@ impl PoolCondition {
         local_factor(HEMISPHERE_AREA, self.pdf(x))
     }
 
-    /// The direction of the network's point `p` and its derivatives along `p.x`
-    /// and `p.y`: the mixture warp ([`brdf_mixture_direction`], derivatives by
-    /// central differences of step `1e-6`, zeroed where they straddle the lobe
-    /// boundary, a jump that no gradient can follow) or the hemisphere map (exact
-    /// Jacobian).
+    /// The direction of the network's point `p` ([`PointWarp::direction`]) and its
+    /// derivatives along `p.x` and `p.y`: for the mixture warp by central
+    /// differences of step `1e-6`, zeroed where they straddle the lobe boundary (a
+    /// jump that no gradient can follow); for the hemisphere map exact.
     pub fn direction(&self, p: DVec2) -> (DVec3, DVec3, DVec3) {
-        if !self.mixture_prior {
-            let (jx, jy) = map_jacobian(Domain::Hemisphere, p);
-            return (square_to_hemisphere(p), jx, jy);
-        }
         let warp = |u: DVec2| {
-            DVec3::from_array(brdf_mixture_direction(
+            DVec3::from_array(self.warp.direction(
+                Domain::Hemisphere,
                 self.cond,
                 self.lobe_probability,
                 u.to_array(),
             ))
         };
+        if self.warp == PointWarp::EqualArea {
+            let (jx, jy) = map_jacobian(Domain::Hemisphere, p);
+            return (warp(p), jx, jy);
+        }
         const H: f64 = 1e-6;
         let diff = |e: DVec2| {
             let j = (warp(p + H * e) - warp(p - H * e)) / (2.0 * H);
@@ -205,11 +204,8 @@ fn condition(
         measures,
         warp_targets: warp_targets(&target, shape),
         baseline_loss: 0.0,
-        lobe_probability: {
-            let (diffuse, specular) = target.albedo_parts();
-            specular / (diffuse + specular)
-        },
-        mixture_prior: shape.lattice_residual(),
+        lobe_probability: target.lobe_probability(),
+        warp: PointWarp::of_shape(shape),
     };
     let w = window.min(pc.caps.len());
     let pts: Vec<DVec3> = seeded_owen_sobol(n, seed)
