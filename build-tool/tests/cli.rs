@@ -582,3 +582,35 @@ fn sample_prints_what_the_runtime_serves_and_rejects_bad_input() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `eval conditional --blob` reads a blob file (16-byte aligned, as `Blob::parse`
+/// demands) and judges its table and network modes through the runtime: the
+/// report's first rows are those two samplers, with finite ratios.
+#[test]
+fn eval_conditional_judges_a_blob_file() {
+    let dir = scratch("eval-blob");
+    let file = dir.join("brdf.nuld");
+    conditional_blob(&file);
+    let out = dir.join("eval");
+    let table = stdout_of(
+        build_tool()
+            .args(["eval", "conditional", "--quick", "--blob"])
+            .arg(&file)
+            .arg("--out")
+            .arg(&out),
+    );
+    assert!(
+        table.contains("| table |") && table.contains("| network |"),
+        "{table}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("conditional.json")).unwrap()).unwrap();
+    assert_eq!(json["n"], 6);
+    for (row, name) in ["table", "network"].iter().enumerate() {
+        let s = &json["summary"][row];
+        assert_eq!(s["sampler"], *name);
+        let r = s["mean_ratio_exact"].as_f64().unwrap();
+        assert!(r.is_finite() && r > 0.0, "{name}: {r}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
