@@ -7,14 +7,16 @@
 //!   (exactly what ships), as u16 unorm codes ([`unorm16_encode`], [`pack_point`]);
 //! * **weight table**: the glTF directional albedo `A` at every weight-grid node
 //!   ([`directional_albedo`]), followed for a [`PointWarp::BrdfMixture`] sampler by
-//!   the lobe probability `p_s = A_spec / A` at the same nodes ([`lobe_probability`]).
+//!   the lobe probability `p_s = A_spec / A` at the same nodes (what
+//!   [`crate::sphere::brdf_albedo::lobe_probability`] computes, from the same
+//!   quadrature).
 
 use super::ConditionalParts;
 use crate::network::Params;
-use crate::sphere::brdf_albedo::{directional_albedo, lobe_probability};
+use crate::sphere::brdf_albedo::directional_albedo;
 use crate::train::pool::{COND_MAX, COND_MIN};
 use nuld_core::blob::Domain;
-use nuld_core::brdf::BrdfModel;
+use nuld_core::brdf::{BrdfModel, BrdfParts};
 use nuld_core::conditional::{pack_point, ConditionalInfo, ConditionalTarget, PointWarp};
 use nuld_core::network::MAX_HIDDEN_LAYERS;
 use nuld_core::quantize::unorm16_encode;
@@ -73,26 +75,25 @@ pub fn distill(
             let shipped = &shipped;
             (0..instances).flat_map(move |k| {
                 (0..n).map(move |i| {
-                    let p = shipped.trace(unit, k, i).square_point();
+                    let p = shipped.square_point(unit, k, i);
                     pack_point(unorm16_encode(p[0]), unorm16_encode(p[1]))
                 })
             })
         })
         .collect();
-    let weight_nodes = (weight_grid[0] * weight_grid[1]) as usize;
-    let tables = info.weight_tables() as usize;
-    let weights: Vec<f32> = (0..weight_nodes * tables)
+    let weight_nodes = weight_grid[0] * weight_grid[1];
+    // One quadrature per node gives both tables: `A` and `p_s = A_spec / A`.
+    let albedos: Vec<BrdfParts<f64>> = (0..weight_nodes)
         .into_par_iter()
-        .map(|entry| {
-            let node = (entry % weight_nodes) as u32;
+        .map(|node| {
             let c = info.weight_grid_condition([node % weight_grid[0], node / weight_grid[0]]);
-            if entry < weight_nodes {
-                directional_albedo(BrdfModel::Gltf, c[0], c[1]).total() as f32
-            } else {
-                lobe_probability(BrdfModel::Gltf, c[0], c[1]) as f32
-            }
+            directional_albedo(BrdfModel::Gltf, c[0], c[1])
         })
         .collect();
+    let mut weights: Vec<f32> = albedos.iter().map(|a| a.total() as f32).collect();
+    if info.weight_tables() > 1 {
+        weights.extend(albedos.iter().map(|a| (a.specular / a.total()) as f32));
+    }
     ConditionalParts {
         info,
         params: params.to_f16_bits(),

@@ -20,7 +20,6 @@ use crate::train::pool::normalized;
 use glam::DVec3;
 use nuld_core::blob::Domain;
 use nuld_core::conditional::PointWarp;
-use nuld_core::network::input_features;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -98,9 +97,7 @@ pub fn instance_directions(params: &Params, cond: [f64; 2], p_s: f64, k: u32) ->
     let warp = PointWarp::of_shape(&params.shape);
     (0..params.shape.n())
         .map(|i| {
-            let s = params
-                .network()
-                .square_point(i, input_features(&params.shape, unit, k, i));
+            let s = params.square_point(unit, k, i);
             DVec3::from_array(warp.direction(Domain::Hemisphere, cond, p_s, s))
         })
         .collect()
