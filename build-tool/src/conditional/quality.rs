@@ -11,7 +11,7 @@
 //!   of the next instance over the mean nearest-neighbour angle within a set
 //!   (independent Owen-Sobol sets: about 0.65; identical sets: 0).
 
-use crate::baselines::seeded_owen_sobol;
+use crate::baselines::warped_owen_sobol_directions;
 use crate::eval::conditional::diversity;
 use crate::network::Params;
 use crate::sphere::metrics::{CapRadius, MeasuredCaps};
@@ -136,11 +136,11 @@ pub fn evaluate(params: &Params, config: &QualityConfig) -> Quality {
                 (0..config.instances as u64)
                     .into_par_iter()
                     .map(|s| {
-                        let pts: Vec<DVec3> = seeded_owen_sobol(n, config.seed ^ (s + 1))
-                            .into_iter()
-                            .map(|u| target.sample(u))
-                            .collect();
-                        d(&pts)
+                        d(&warped_owen_sobol_directions(
+                            &target,
+                            n,
+                            config.seed ^ (s + 1),
+                        ))
                     })
                     .collect(),
             );

@@ -10,7 +10,7 @@
 //! of `M` of each one's caps. The caps are measured with a `2^14`-point rule
 //! ([`BrdfTarget::coarse`], [`POOL_RULE_POINTS`]): the pool is paid once, nothing per step.
 
-use crate::baselines::seeded_owen_sobol;
+use crate::baselines::warped_owen_sobol_directions;
 use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use crate::discrepancy::GradientPath;
 use crate::optimize::directions::map_jacobian;
@@ -208,10 +208,7 @@ fn condition(
         warp: PointWarp::of_shape(shape),
     };
     let w = window.min(pc.caps.len());
-    let pts: Vec<DVec3> = seeded_owen_sobol(n, seed)
-        .into_iter()
-        .map(|u| target.sample(u))
-        .collect();
+    let pts = warped_owen_sobol_directions(&target, n, seed);
     let local: Vec<f64> = pts.iter().map(|&x| pc.local_factor(x)).collect();
     let mut g = vec![DVec3::ZERO; n];
     let baseline_loss = cap_loss_and_gradient(
