@@ -14,24 +14,23 @@
 use super::ConditionalParts;
 use crate::network::Params;
 use crate::sphere::brdf_albedo::directional_albedo;
-use crate::train::pool::{COND_MAX, COND_MIN};
 use nuld_core::blob::Domain;
-use nuld_core::brdf::{BrdfModel, BrdfParts};
+use nuld_core::brdf::{BrdfModel, BrdfParts, CONDITION_MAX, CONDITION_MIN};
 use nuld_core::conditional::{pack_point, ConditionalInfo, ConditionalTarget, PointWarp};
-use nuld_core::network::MAX_HIDDEN_LAYERS;
+use nuld_core::network::{Shape, MAX_HIDDEN_LAYERS};
 use nuld_core::quantize::unorm16_encode;
 use rayon::prelude::*;
 
-/// The info record of a glTF BRDF sampler with `params`' architecture, `instances`
-/// stored instances, and the given point and weight grids (nodes per axis, each
-/// `>= 2`).
+/// The info record of a glTF BRDF sampler over the condition range
+/// ([`CONDITION_MIN`] to [`CONDITION_MAX`]) with a network of `shape` (its point
+/// warp [`PointWarp::of_shape`]), `instances` stored instances, and the given point
+/// and weight grids (nodes per axis, each `>= 2`).
 pub fn brdf_info(
-    params: &Params,
+    shape: &Shape,
     instances: u32,
     grid: [u32; 2],
     weight_grid: [u32; 2],
 ) -> ConditionalInfo {
-    let shape = params.shape;
     let mut hidden = [0u32; MAX_HIDDEN_LAYERS];
     hidden[..shape.hidden().len()].copy_from_slice(shape.hidden());
     ConditionalInfo {
@@ -41,12 +40,12 @@ pub fn brdf_info(
         target: ConditionalTarget::GltfBrdf as u32,
         grid,
         weight_grid,
-        cond_min: COND_MIN.map(|x| x as f32),
-        cond_max: COND_MAX.map(|x| x as f32),
+        cond_min: CONDITION_MIN.map(|x| x as f32),
+        cond_max: CONDITION_MAX.map(|x| x as f32),
         hidden,
         activation: shape.activation() as u32,
         lattice_generator: shape.lattice_generator(),
-        warp: PointWarp::of_shape(&shape) as u32,
+        warp: PointWarp::of_shape(shape) as u32,
         reserved: [0; 2],
     }
 }
@@ -59,7 +58,7 @@ pub fn distill(
     grid: [u32; 2],
     weight_grid: [u32; 2],
 ) -> ConditionalParts {
-    let info = brdf_info(params, instances, grid, weight_grid);
+    let info = brdf_info(&params.shape, instances, grid, weight_grid);
     let shipped = params.rounded_to_f16();
     let n = info.n;
     let nodes = (grid[0] * grid[1]) as usize;
@@ -106,7 +105,7 @@ pub fn distill(
 mod tests {
     use super::*;
     use nuld_core::conditional::unpack_point;
-    use nuld_core::network::{Activation, Shape};
+    use nuld_core::network::Activation;
     use nuld_core::quantize::{f16_decode, unorm16_decode_f64};
 
     #[test]

@@ -19,6 +19,7 @@ use crate::sphere::{BrdfTarget, DirectionDensity};
 use crate::train::pool::normalized;
 use glam::DVec3;
 use nuld_core::blob::Domain;
+use nuld_core::brdf::{CONDITION_MAX, CONDITION_MIN};
 use nuld_core::conditional::PointWarp;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -43,10 +44,12 @@ impl QualityConfig {
     /// (off any point-table grid with an odd node count... and most even ones),
     /// 8 instances, unions of 64, 4096 caps.
     pub fn held_out(k: usize, seed: u64) -> Self {
-        let at = |j: usize, lo: f64, hi: f64| lo + (j as f64 + 0.5) / k as f64 * (hi - lo);
-        let conditions = (0..k * k)
-            .map(|j| [at(j % k, 0.1, 1.0), at(j / k, 0.0, 89.0)])
-            .collect();
+        // Cell centre `j` of axis `a` of the condition range.
+        let at = |j: usize, a: usize| {
+            let (lo, hi) = (CONDITION_MIN[a], CONDITION_MAX[a]);
+            lo + (j as f64 + 0.5) / k as f64 * (hi - lo)
+        };
+        let conditions = (0..k * k).map(|j| [at(j % k, 0), at(j / k, 1)]).collect();
         Self {
             conditions,
             instances: 8,

@@ -19,7 +19,7 @@ use crate::seeding::derive_seed;
 use crate::sphere::{BrdfTarget, DirectionDensity};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
-use nuld_core::brdf::{view_direction, BrdfModel, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
+use nuld_core::brdf::{view_direction, BrdfModel, CONDITION_MAX, CONDITION_MIN};
 use nuld_core::conditional::PointWarp;
 use nuld_core::network::{instance_offset, shifted_lattice_point, Shape};
 use nuld_core::sphere::hemisphere_to_square;
@@ -33,15 +33,10 @@ pub const POOL_RULE_POINTS: usize = 1 << 14;
 /// Solid angle of the hemisphere.
 pub const HEMISPHERE_AREA: f64 = 2.0 * PI;
 
-/// The condition range of a BRDF sampler: `(roughness, theta_o in degrees)` from
-/// `COND_MIN` to `COND_MAX`.
-pub const COND_MIN: [f64; 2] = [MIN_ROUGHNESS, 0.0];
-/// Upper end of the condition range.
-pub const COND_MAX: [f64; 2] = [MAX_ROUGHNESS, MAX_THETA_O_DEG];
-
-/// The normalized condition in `[0,1]^2` of `(roughness, theta_o_deg)`.
+/// The normalized condition in `[0,1]^2` of `(roughness, theta_o_deg)`: its place
+/// between [`CONDITION_MIN`] and [`CONDITION_MAX`].
 pub fn normalized(cond: [f64; 2]) -> [f64; 2] {
-    core::array::from_fn(|a| (cond[a] - COND_MIN[a]) / (COND_MAX[a] - COND_MIN[a]))
+    core::array::from_fn(|a| (cond[a] - CONDITION_MIN[a]) / (CONDITION_MAX[a] - CONDITION_MIN[a]))
 }
 
 /// One training condition: what a step needs to score a set for it.
@@ -161,8 +156,9 @@ impl ConditionPool {
                     sobol_burley::sample(p as u32, 0, scramble) as f64,
                     sobol_burley::sample(p as u32, 1, scramble) as f64,
                 ];
-                let cond: [f64; 2] =
-                    core::array::from_fn(|a| COND_MIN[a] + u[a] * (COND_MAX[a] - COND_MIN[a]));
+                let cond: [f64; 2] = core::array::from_fn(|a| {
+                    CONDITION_MIN[a] + u[a] * (CONDITION_MAX[a] - CONDITION_MIN[a])
+                });
                 condition(cond, caps, window, shape, derive_seed(seed, p as u64))
             })
             .collect();
