@@ -251,11 +251,7 @@ fn run(
 ) -> Vec<DVec2> {
     let domain = density.domain();
     let mut params = initial_square_points(density, n, config.seed);
-    let area_of_domain = if domain == Domain::Hemisphere {
-        2.0
-    } else {
-        4.0
-    } * std::f64::consts::PI;
+    let area_of_domain = domain.area();
     let spacing = (area_of_domain / n as f64).sqrt();
     // Square units per radian: the equal-area map scales areas by 1/area_of_domain.
     let square_per_radian = 1.0 / area_of_domain.sqrt();

@@ -24,14 +24,10 @@ use nuld_core::conditional::PointWarp;
 use nuld_core::network::{instance_offset, shifted_lattice_point, Shape};
 use nuld_core::sphere::hemisphere_to_square;
 use rayon::prelude::*;
-use std::f64::consts::PI;
 
 /// Points of the rule that measures a pool condition's caps: `2^14`, 1/16 of a
 /// [`BrdfTarget::new`]'s, so that building the pool costs seconds, not minutes.
 pub const POOL_RULE_POINTS: usize = 1 << 14;
-
-/// Solid angle of the hemisphere.
-pub const HEMISPHERE_AREA: f64 = 2.0 * PI;
 
 /// The normalized condition in `[0,1]^2` of `(roughness, theta_o_deg)`: its place
 /// between [`CONDITION_MIN`] and [`CONDITION_MAX`].
@@ -77,7 +73,7 @@ impl PoolCondition {
     /// Local sharpness factor `sqrt(2 pi q(x))`, clamped (direction optimizer's
     /// local units).
     pub fn local_factor(&self, x: DVec3) -> f64 {
-        local_factor(HEMISPHERE_AREA, self.pdf(x))
+        local_factor(Domain::Hemisphere.area(), self.pdf(x))
     }
 
     /// The direction of the network's point `p` ([`PointWarp::direction`]) and its
