@@ -309,10 +309,7 @@ impl Trainer {
             self.state.adam_t,
         );
         adam.step(&mut self.state.params, &grad, lr);
-        let (m, v, at) = adam.state();
-        self.state.adam_m = m.to_vec();
-        self.state.adam_v = v.to_vec();
-        self.state.adam_t = at;
+        (self.state.adam_m, self.state.adam_v, self.state.adam_t) = adam.into_state();
         self.state.losses.push(loss);
         self.state.step += 1;
         StepReport {
