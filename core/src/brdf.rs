@@ -55,6 +55,14 @@ pub const MAX_ROUGHNESS: f64 = 1.0;
 /// values are lowered to it.
 pub const MAX_THETA_O_DEG: f64 = 89.0;
 
+/// Lower corner of the condition range `(roughness, theta_o in degrees)`:
+/// `(MIN_ROUGHNESS, 0)`.
+pub const CONDITION_MIN: [f64; 2] = [MIN_ROUGHNESS, 0.0];
+
+/// Upper corner of the condition range `(roughness, theta_o in degrees)`:
+/// `(MAX_ROUGHNESS, MAX_THETA_O_DEG)`.
+pub const CONDITION_MAX: [f64; 2] = [MAX_ROUGHNESS, MAX_THETA_O_DEG];
+
 /// Which BRDF a `brdf:` target or a bake uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum BrdfModel {

@@ -96,6 +96,26 @@ impl Domain {
             Self::Sphere | Self::Square => sphere_to_square(d),
         }
     }
+
+    /// The domain's area: `4 pi` steradians for the sphere, `2 pi` for the
+    /// hemisphere, 1 for the unit square. The uniform point spacing of `n` points is
+    /// `sqrt(area / n)`; the equal-area maps scale areas by `area` (square to
+    /// directions). `O(1)`, never panics.
+    ///
+    /// ```
+    /// # use nuld_core::domain::Domain;
+    /// use core::f64::consts::PI;
+    /// assert_eq!(Domain::Sphere.area(), 4.0 * PI);
+    /// assert_eq!(Domain::Hemisphere.area(), 2.0 * PI);
+    /// ```
+    #[inline]
+    pub fn area(self) -> f64 {
+        match self {
+            Self::Square => 1.0,
+            Self::Sphere => 4.0 * core::f64::consts::PI,
+            Self::Hemisphere => 2.0 * core::f64::consts::PI,
+        }
+    }
 }
 
 #[cfg(test)]

@@ -12,18 +12,8 @@
 //! dL/da_(l-1) = W_l^T dL/dz_l
 //! ```
 
-use crate::optimize::directions::map_jacobian;
-use glam::{DVec2, DVec3};
-use nuld_core::blob::Domain;
+use glam::DVec2;
 use nuld_core::network::{sigmoid, Shape, Trace, INPUTS, MAX_WIDTH, OUTPUTS};
-
-/// `dL/dp` of the hemisphere's square point `p` from `dL/dx` of its direction
-/// `x = M(p)` (ambient gradient `g`): `(J_x . g, J_y . g)` with the map's Jacobian
-/// columns by central differences.
-pub fn hemisphere_square_gradient(p: DVec2, g: DVec3) -> DVec2 {
-    let (jx, jy) = map_jacobian(Domain::Hemisphere, p);
-    DVec2::new(jx.dot(g), jy.dot(g))
-}
 
 /// `dL/do` of the outputs before the sigmoid from `dL/dp` of the square point
 /// `p = sigmoid(o)`: `dL/dp p (1 - p)` per coordinate.
@@ -124,6 +114,9 @@ pub fn backward(
 mod tests {
     use super::*;
     use crate::network::Params;
+    use crate::optimize::directions::map_jacobian;
+    use glam::DVec3;
+    use nuld_core::blob::Domain;
     use nuld_core::network::Activation;
     use nuld_core::sphere::square_to_hemisphere;
 
@@ -177,7 +170,10 @@ mod tests {
                 let s = t.square_point();
                 let sq = DVec2::new(s[0], s[1]);
                 let g3 = loss_of(square_to_hemisphere(sq)).1;
-                let d_out = output_gradient(&t, hemisphere_square_gradient(sq, g3));
+                // dL/dp = (J_x . g, J_y . g), the map's Jacobian columns by central
+                // differences.
+                let (jx, jy) = map_jacobian(Domain::Hemisphere, sq);
+                let d_out = output_gradient(&t, DVec2::new(jx.dot(g3), jy.dot(g3)));
                 backward(&shape, &p.values, &t, i, d_out, &mut grad);
             }
             let h = 1e-6;

@@ -57,6 +57,14 @@ impl Params {
             .forward(i, input_features(&self.shape, c, k, i))
     }
 
+    /// The point of the unit square of index `i`, instance `k`, normalized condition
+    /// `c`: [`Network::square_point`], the same bits as
+    /// `self.trace(c, k, i).square_point()` without recording a [`Trace`].
+    pub fn square_point(&self, c: [f64; 2], k: u32, i: u32) -> [f64; 2] {
+        self.network()
+            .square_point(i, input_features(&self.shape, c, k, i))
+    }
+
     /// The parameters as f16 bits (round to nearest even through `f32`).
     pub fn to_f16_bits(&self) -> Vec<u16> {
         self.values.iter().map(|&x| f16_encode(x as f32)).collect()

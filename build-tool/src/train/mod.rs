@@ -37,8 +37,8 @@ use crate::optimize::adam::Adam;
 use crate::optimize::epoch_schedule;
 use crate::seeding::rng;
 use glam::{DVec2, DVec3};
+use nuld_core::blob::Domain;
 use nuld_core::network::{Activation, Shape};
-use pool::HEMISPHERE_AREA;
 use rand::Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -309,10 +309,7 @@ impl Trainer {
             self.state.adam_t,
         );
         adam.step(&mut self.state.params, &grad, lr);
-        let (m, v, at) = adam.state();
-        self.state.adam_m = m.to_vec();
-        self.state.adam_v = v.to_vec();
-        self.state.adam_t = at;
+        (self.state.adam_m, self.state.adam_v, self.state.adam_t) = adam.into_state();
         self.state.losses.push(loss);
         self.state.step += 1;
         StepReport {
@@ -384,7 +381,7 @@ fn condition_step(
         }
     }
     let local: Vec<f64> = dirs.iter().map(|&x| pc.local_factor(x)).collect();
-    let spacing = |points: usize| (HEMISPHERE_AREA / points as f64).sqrt();
+    let spacing = |points: usize| (Domain::Hemisphere.area() / points as f64).sqrt();
     let mut grad3 = vec![DVec3::ZERO; s * n];
     let mut g = vec![DVec3::ZERO; s * n];
     let mut set_loss = 0.0;

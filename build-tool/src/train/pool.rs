@@ -10,7 +10,7 @@
 //! of `M` of each one's caps. The caps are measured with a `2^14`-point rule
 //! ([`BrdfTarget::coarse`], [`POOL_RULE_POINTS`]): the pool is paid once, nothing per step.
 
-use crate::baselines::seeded_owen_sobol;
+use crate::baselines::warped_owen_sobol_directions;
 use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use crate::discrepancy::GradientPath;
 use crate::optimize::directions::map_jacobian;
@@ -19,29 +19,20 @@ use crate::seeding::derive_seed;
 use crate::sphere::{BrdfTarget, DirectionDensity};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
-use nuld_core::brdf::{view_direction, BrdfModel, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
+use nuld_core::brdf::{view_direction, BrdfModel, CONDITION_MAX, CONDITION_MIN};
 use nuld_core::conditional::PointWarp;
 use nuld_core::network::{instance_offset, shifted_lattice_point, Shape};
 use nuld_core::sphere::hemisphere_to_square;
 use rayon::prelude::*;
-use std::f64::consts::PI;
 
 /// Points of the rule that measures a pool condition's caps: `2^14`, 1/16 of a
 /// [`BrdfTarget::new`]'s, so that building the pool costs seconds, not minutes.
 pub const POOL_RULE_POINTS: usize = 1 << 14;
 
-/// Solid angle of the hemisphere.
-pub const HEMISPHERE_AREA: f64 = 2.0 * PI;
-
-/// The condition range of a BRDF sampler: `(roughness, theta_o in degrees)` from
-/// `COND_MIN` to `COND_MAX`.
-pub const COND_MIN: [f64; 2] = [MIN_ROUGHNESS, 0.0];
-/// Upper end of the condition range.
-pub const COND_MAX: [f64; 2] = [MAX_ROUGHNESS, MAX_THETA_O_DEG];
-
-/// The normalized condition in `[0,1]^2` of `(roughness, theta_o_deg)`.
+/// The normalized condition in `[0,1]^2` of `(roughness, theta_o_deg)`: its place
+/// between [`CONDITION_MIN`] and [`CONDITION_MAX`].
 pub fn normalized(cond: [f64; 2]) -> [f64; 2] {
-    core::array::from_fn(|a| (cond[a] - COND_MIN[a]) / (COND_MAX[a] - COND_MIN[a]))
+    core::array::from_fn(|a| (cond[a] - CONDITION_MIN[a]) / (CONDITION_MAX[a] - CONDITION_MIN[a]))
 }
 
 /// One training condition: what a step needs to score a set for it.
@@ -82,7 +73,7 @@ impl PoolCondition {
     /// Local sharpness factor `sqrt(2 pi q(x))`, clamped (direction optimizer's
     /// local units).
     pub fn local_factor(&self, x: DVec3) -> f64 {
-        local_factor(HEMISPHERE_AREA, self.pdf(x))
+        local_factor(Domain::Hemisphere.area(), self.pdf(x))
     }
 
     /// The direction of the network's point `p` ([`PointWarp::direction`]) and its
@@ -161,8 +152,9 @@ impl ConditionPool {
                     sobol_burley::sample(p as u32, 0, scramble) as f64,
                     sobol_burley::sample(p as u32, 1, scramble) as f64,
                 ];
-                let cond: [f64; 2] =
-                    core::array::from_fn(|a| COND_MIN[a] + u[a] * (COND_MAX[a] - COND_MIN[a]));
+                let cond: [f64; 2] = core::array::from_fn(|a| {
+                    CONDITION_MIN[a] + u[a] * (CONDITION_MAX[a] - CONDITION_MIN[a])
+                });
                 condition(cond, caps, window, shape, derive_seed(seed, p as u64))
             })
             .collect();
@@ -208,10 +200,7 @@ fn condition(
         warp: PointWarp::of_shape(shape),
     };
     let w = window.min(pc.caps.len());
-    let pts: Vec<DVec3> = seeded_owen_sobol(n, seed)
-        .into_iter()
-        .map(|u| target.sample(u))
-        .collect();
+    let pts = warped_owen_sobol_directions(&target, n, seed);
     let local: Vec<f64> = pts.iter().map(|&x| pc.local_factor(x)).collect();
     let mut g = vec![DVec3::ZERO; n];
     let baseline_loss = cap_loss_and_gradient(
