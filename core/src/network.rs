@@ -214,23 +214,46 @@ impl Shape {
         self.lattice_generator
     }
 
-    /// Number of parameters: `n h1 + sum over layers (out in + out)` with the input
-    /// layer of width [`INPUTS`] and the output layer of width [`OUTPUTS`].
+    /// Number of parameters: `n h1 +` [`Shape::multiply_adds`].
     pub fn param_len(&self) -> usize {
-        let hidden = self.hidden();
-        let mut len = self.n as usize * hidden[0] as usize;
-        let mut fan_in = INPUTS;
-        for &h in hidden {
-            len += h as usize * (fan_in + 1);
-            fan_in = h as usize;
-        }
-        len + OUTPUTS * (fan_in + 1)
+        self.first_layer_offset() + self.multiply_adds()
     }
 
     /// Multiply-adds of one forward pass (the run-time cost of a network sample,
-    /// besides the activations and the map).
+    /// besides the activations and the map): `sum over layers (out in + out)` with
+    /// the input layer of width [`INPUTS`] and the output layer of width
+    /// [`OUTPUTS`], i.e. the parameters after `E`. Independent of `n`, so it cannot
+    /// overflow however large `n` is.
     pub fn multiply_adds(&self) -> usize {
-        self.param_len() - self.n as usize * self.hidden[0] as usize
+        self.spans(0)
+            .last()
+            .map_or(0, |last| last.bias + last.width)
+    }
+
+    /// The dense layers in the order of the parameter array: the hidden layers,
+    /// first first, then the output layer of width [`OUTPUTS`]; the first has fan-in
+    /// [`INPUTS`], each next one the previous width. Offsets are into the whole
+    /// array (after `E`, from [`Shape::first_layer_offset`]).
+    pub fn layers(&self) -> impl Iterator<Item = LayerSpan> {
+        self.spans(self.first_layer_offset())
+    }
+
+    /// [`Shape::layers`] with the first layer's weights at `start`.
+    fn spans(&self, start: usize) -> impl Iterator<Item = LayerSpan> {
+        let (hidden, layers) = (self.hidden, self.layers as usize);
+        let widths = (0..layers).map(move |l| hidden[l] as usize);
+        let (mut weights, mut fan_in) = (start, INPUTS);
+        widths.chain(core::iter::once(OUTPUTS)).map(move |width| {
+            let span = LayerSpan {
+                weights,
+                bias: weights + width * fan_in,
+                fan_in,
+                width,
+            };
+            weights = span.bias + width;
+            fan_in = width;
+            span
+        })
     }
 
     /// Offset of the per-index row `E[i mod n]` in the parameter array.
@@ -243,6 +266,21 @@ impl Shape {
     pub fn first_layer_offset(&self) -> usize {
         self.n as usize * self.hidden[0] as usize
     }
+}
+
+/// Where one dense layer lies in the flat parameter array ([`Shape::layers`]): its
+/// `width x fan_in` weights row-major by output unit from `weights`, then its
+/// `width` biases from `bias = weights + width fan_in`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LayerSpan {
+    /// Offset of the first weight (row 0 of `W`).
+    pub weights: usize,
+    /// Offset of the first bias.
+    pub bias: usize,
+    /// Inputs per unit (the length of a row of `W`).
+    pub fan_in: usize,
+    /// Units (rows of `W`, biases).
+    pub width: usize,
 }
 
 /// The values a forward pass went through, which a backward pass needs: the
@@ -394,24 +432,30 @@ impl<W> Network<W> {
         let mut a = [T::ZERO; MAX_WIDTH];
         let mut b = [T::ZERO; MAX_WIDTH];
         a[..INPUTS].copy_from_slice(input);
-        let mut fan_in = INPUTS;
-        let mut off = shape.first_layer_offset();
         let embedding = shape.embedding_offset(i);
-        for (l, &h) in shape.hidden().iter().enumerate() {
-            let h = h as usize;
-            let bias = off + h * fan_in;
-            let first = (l == 0).then_some(embedding);
-            layer(w, off, bias, first, &a[..fan_in], &mut b[..h], |o, z| {
-                record(l, o, z);
-                act.apply(z)
-            });
-            core::mem::swap(&mut a, &mut b);
-            off = bias + h;
-            fan_in = h;
-        }
+        let hidden = shape.layers as usize;
         let mut out = [T::ZERO; OUTPUTS];
-        let bias = off + OUTPUTS * fan_in;
-        layer(w, off, bias, None, &a[..fan_in], &mut out, |_, z| z);
+        for (l, span) in shape.layers().enumerate() {
+            let (x, width) = (&a[..span.fan_in], span.width);
+            if l < hidden {
+                let first = (l == 0).then_some(embedding);
+                layer(
+                    w,
+                    span.weights,
+                    span.bias,
+                    first,
+                    x,
+                    &mut b[..width],
+                    |o, z| {
+                        record(l, o, z);
+                        act.apply(z)
+                    },
+                );
+                core::mem::swap(&mut a, &mut b);
+            } else {
+                layer(w, span.weights, span.bias, None, x, &mut out, |_, z| z);
+            }
+        }
         if shape.lattice_residual {
             let base = lattice_logit(input);
             for (o, b) in out.iter_mut().zip(base) {
@@ -587,6 +631,15 @@ mod tests {
         // E 4x3, W1 3x11 + 3, W2 2x3 + 2, Wo 2x2 + 2.
         assert_eq!(s.param_len(), 12 + 36 + 8 + 6);
         assert_eq!(s.multiply_adds(), 36 + 8 + 6);
+        let span = |weights, fan_in, width| LayerSpan {
+            weights,
+            bias: weights + width * fan_in,
+            fan_in,
+            width,
+        };
+        let want = [span(12, 11, 3), span(48, 3, 2), span(56, 2, 2)];
+        // E 4x3, then W1/b1 at 12/45, W2/b2 at 48/54, Wo/bo at 56/60.
+        assert!(s.layers().eq(want));
         assert!(Shape::new(0, &[3], Activation::Relu, 1).is_none());
         assert!(Shape::new(4, &[], Activation::Relu, 1).is_none());
         assert!(Shape::new(4, &[129], Activation::Relu, 1).is_none());

@@ -139,12 +139,10 @@ impl<'a> ConditionalSampler<'a> {
             return Err(BlobError::ParamElementSize(entry.elem_size));
         }
         // Counted in u64: `Shape::param_len` multiplies `n h1` in `usize`, which a
-        // hostile `n` could overflow on a 32-bit target. The other parameters do not
-        // depend on `n`, so a one-point shape counts them.
+        // hostile `n` could overflow on a 32-bit target; `multiply_adds` does not
+        // depend on `n`.
         let h1 = shape.hidden().first().copied().unwrap_or(0) as u64;
-        let rest = Shape::new(1, shape.hidden(), shape.activation(), 0)
-            .map_or(0, |s| s.multiply_adds() as u64);
-        let expected = info.n as u64 * h1 + rest;
+        let expected = info.n as u64 * h1 + shape.multiply_adds() as u64;
         let got = bytes.len() as u64 / 2;
         if got != expected {
             return Err(BlobError::ParamsLength { expected, got });
