@@ -307,11 +307,34 @@ impl<T: Real> Trace<T> {
 /// Read access to a network's flat parameter array as `T`: an `f64` slice in the
 /// trainer, f16 bits decoded to `f32` in the runtime ([`F16Params`]). Reads past
 /// the end give 0 (never a panic).
-pub trait Parameters<T> {
+pub trait Parameters<T: Real> {
     /// Parameter `j`.
     fn get(&self, j: usize) -> T;
     /// Parameters `start..start + out.len()` into `out`.
     fn read(&self, start: usize, out: &mut [T]);
+    /// `dot(row, x)` ([`dot`]) of the row `params[start..start + len]`,
+    /// `len = min(x.len(), scratch.len())`: one unit of a dense layer. The default
+    /// [`Parameters::read`]s the row into `scratch` first (what decoding storage
+    /// needs; the caller owns the buffer so that a layer clears it once, not per
+    /// unit); storage that holds `T` dots the row in place, with the same bits.
+    #[inline(always)]
+    fn row_dot(&self, start: usize, x: &[T], scratch: &mut [T]) -> T {
+        read_dot(self, start, x, scratch)
+    }
+}
+
+/// [`Parameters::row_dot`] through a copy of the row in `scratch`.
+#[inline(always)]
+fn read_dot<T: Real, W: Parameters<T> + ?Sized>(
+    w: &W,
+    start: usize,
+    x: &[T],
+    scratch: &mut [T],
+) -> T {
+    let len = x.len().min(scratch.len());
+    let row = &mut scratch[..len];
+    w.read(start, row);
+    dot(row, x)
 }
 
 impl<T: Real> Parameters<T> for &[T] {
@@ -329,6 +352,19 @@ impl<T: Real> Parameters<T> for &[T] {
             None => out.iter_mut().enumerate().for_each(|(k, o)| {
                 *o = Parameters::get(self, start.saturating_add(k));
             }),
+        }
+    }
+    /// The row dotted where it lies (the trainer's hot path: no copy); a row that
+    /// runs past the end goes through [`Parameters::read`] (missing entries 0).
+    #[inline(always)]
+    fn row_dot(&self, start: usize, x: &[T], scratch: &mut [T]) -> T {
+        let len = x.len().min(scratch.len());
+        match start
+            .checked_add(len)
+            .and_then(|end| <[T]>::get(self, start..end))
+        {
+            Some(row) => dot(row, &x[..len]),
+            None => read_dot(self, start, x, scratch),
         }
     }
 }
@@ -507,15 +543,13 @@ fn layer<T: Real>(
 ) {
     let fan_in = x.len().min(MAX_WIDTH);
     let x = &x[..fan_in];
-    let mut row = [T::ZERO; MAX_WIDTH];
-    let row = &mut row[..fan_in];
+    let mut scratch = [T::ZERO; MAX_WIDTH];
     for (o, slot) in out.iter_mut().enumerate() {
         let mut acc = w.get(bias + o);
         if let Some(e) = extra {
             acc = acc + w.get(e + o);
         }
-        w.read(off + o * fan_in, row);
-        *slot = finish(o, acc + dot(row, x));
+        *slot = finish(o, acc + w.row_dot(off + o * fan_in, x, &mut scratch));
     }
 }
 
