@@ -9,8 +9,7 @@
 use glam::{Vec2, Vec3};
 use nuld_core::blob::{BlobError, Domain, Layout, SectionTag};
 use nuld_core::conditional::{
-    brdf_mixture_direction, unpack_point, ConditionalInfo, ConditionalTarget, GridCell, PointWarp,
-    CONDITIONAL_INFO_LEN,
+    unpack_point, ConditionalInfo, ConditionalTarget, GridCell, PointWarp, CONDITIONAL_INFO_LEN,
 };
 use nuld_core::network::{input_features, Activation, F16Params, Network, Shape};
 use nuld_core::quantize::{f16_is_finite, unorm16_decode};
@@ -245,14 +244,25 @@ impl<'a> ConditionalSampler<'a> {
     /// `info().normalize(cond)`. Finite and `>= 0`. O(1), never panics.
     #[inline]
     pub fn weight(&self, cond: Vec2) -> f32 {
-        self.weight_grid_lerp(cond, 0)
+        self.weight_table_lerp(&self.weight_cell(cond), 0)
+    }
+
+    /// The weight-grid cell of `cond` (blob units, clamped like [`Self::weight`]).
+    #[inline]
+    fn weight_cell(&self, cond: Vec2) -> GridCell {
+        self.weight_cell_at(self.info.normalize(cond.to_array()))
+    }
+
+    /// The weight-grid cell of the normalized condition `u`.
+    #[inline]
+    fn weight_cell_at(&self, u: [f32; 2]) -> GridCell {
+        GridCell::locate(u, self.info.weight_grid)
     }
 
     /// Table `table` of the weight section (0: weights, 1: lobe probabilities)
-    /// interpolated bilinearly at `cond`, clamped like [`Self::weight`].
+    /// interpolated bilinearly in `cell`.
     #[inline]
-    fn weight_grid_lerp(&self, cond: Vec2, table: usize) -> f32 {
-        let cell = GridCell::locate(self.info.normalize(cond.to_array()), self.info.weight_grid);
+    fn weight_table_lerp(&self, cell: &GridCell, table: usize) -> f32 {
         let base = table * self.info.weight_table_len() as usize;
         let w = |dx, dy| {
             let at = base + cell.node(dx, dy);
@@ -265,7 +275,7 @@ impl<'a> ConditionalSampler<'a> {
     /// `cond`: the second table of the weight section, interpolated as the weights.
     #[inline]
     pub fn lobe_probability(&self, cond: Vec2) -> f32 {
-        self.weight_grid_lerp(cond, 1)
+        self.weight_table_lerp(&self.weight_cell(cond), 1)
     }
 
     /// Table mode's point of the unit square for index `i` (mod `n`) of instance
@@ -276,8 +286,13 @@ impl<'a> ConditionalSampler<'a> {
     /// ([`GridCell::lerp`]), x and y separately. In `(0,1)^2`. O(1), never panics.
     #[inline]
     pub fn square_point(&self, cond: Vec2, instance: u32, i: u32) -> Vec2 {
+        self.square_point_at(self.info.normalize(cond.to_array()), instance, i)
+    }
+
+    /// [`Self::square_point`] at the normalized condition `u`.
+    #[inline]
+    fn square_point_at(&self, u: [f32; 2], instance: u32, i: u32) -> Vec2 {
         let info = &self.info;
-        let u = info.normalize(cond.to_array());
         let cell = GridCell::locate(u, info.grid);
         let k = instance.checked_rem(info.instances).unwrap_or(0);
         let j = i.checked_rem(info.n).unwrap_or(0);
@@ -306,7 +321,12 @@ impl<'a> ConditionalSampler<'a> {
     /// then `sigmoid` per output. In `[0,1]^2`. `O(multiply_adds)`, never panics.
     #[inline]
     pub fn network_square_point(&self, cond: Vec2, instance: u32, i: u32) -> Vec2 {
-        let u = self.info.normalize(cond.to_array());
+        self.network_square_point_at(self.info.normalize(cond.to_array()), instance, i)
+    }
+
+    /// [`Self::network_square_point`] at the normalized condition `u`.
+    #[inline]
+    fn network_square_point_at(&self, u: [f32; 2], instance: u32, i: u32) -> Vec2 {
         let input = input_features::<f32>(&self.shape, u, instance, i);
         let params = self.params;
         let net = Network {
@@ -336,7 +356,8 @@ impl<'a> ConditionalSampler<'a> {
     /// ```
     #[inline]
     pub fn sample(&self, cond: Vec2, instance: u32, i: u32) -> Sample {
-        self.mapped(self.square_point(cond, instance, i), cond)
+        let u = self.info.normalize(cond.to_array());
+        self.mapped(self.square_point_at(u, instance, i), u)
     }
 
     /// Network mode: as [`Self::sample`] with [`Self::network_square_point`]; every
@@ -344,7 +365,8 @@ impl<'a> ConditionalSampler<'a> {
     /// `O(multiply_adds)`, never panics.
     #[inline]
     pub fn sample_network(&self, cond: Vec2, instance: u32, i: u32) -> Sample {
-        self.mapped(self.network_square_point(cond, instance, i), cond)
+        let u = self.info.normalize(cond.to_array());
+        self.mapped(self.network_square_point_at(u, instance, i), u)
     }
 
     /// Table mode for a BRDF sampler ([`ConditionalTarget::GltfBrdf`]) at any view:
@@ -387,21 +409,27 @@ impl<'a> ConditionalSampler<'a> {
         rotate(self.sample_network(cond, instance, i), azimuth)
     }
 
+    /// The sample of point `p` at the normalized condition `u`: the direction of
+    /// [`PointWarp::direction`], the weight of [`Self::weight`]; one weight-grid
+    /// cell serves the weight and the lobe probability.
     #[inline]
-    fn mapped(&self, p: Vec2, cond: Vec2) -> Sample {
-        let direction = match self.warp {
-            PointWarp::EqualArea => self.domain.to_direction_real(p.to_array()),
+    fn mapped(&self, p: Vec2, u: [f32; 2]) -> Sample {
+        let cell = self.weight_cell_at(u);
+        // Only the mixture warp reads the condition and `p_s`; the equal-area map
+        // skips their lookups.
+        let (cond, p_s) = match self.warp {
+            PointWarp::EqualArea => ([0.0; 2], 0.0),
             PointWarp::BrdfMixture => {
                 // The clamped condition in blob units, as the tables see it.
-                let u = self.info.normalize(cond.to_array());
                 let (lo, hi) = (self.info.cond_min, self.info.cond_max);
                 let c = [0, 1].map(|a| lo[a] + u[a] * (hi[a] - lo[a]));
-                brdf_mixture_direction(c, self.lobe_probability(cond), p.to_array())
+                (c, self.weight_table_lerp(&cell, 1))
             }
         };
+        let direction = self.warp.direction(self.domain, cond, p_s, p.to_array());
         Sample {
             direction: Vec3::from_array(direction),
-            weight: self.weight(cond),
+            weight: self.weight_table_lerp(&cell, 0),
         }
     }
 }
