@@ -101,18 +101,21 @@ impl<'a> ConditionalSampler<'a> {
             Some(w) => w,
             None => return Err(BlobError::UnknownPointWarp(info.warp)),
         };
-        for axis in 0..2 {
-            let nodes = info.grid[axis];
-            if nodes < 2 {
-                let axis = axis as u32;
-                return Err(BlobError::ConditionalGrid { axis, nodes });
-            }
-        }
-        for axis in 0..2 {
-            let nodes = info.weight_grid[axis];
-            if nodes < 2 {
-                let axis = axis as u32;
-                return Err(BlobError::ConditionalWeightGrid { axis, nodes });
+        type GridError = fn(u32, u32) -> BlobError;
+        let grids: [([u32; 2], GridError); 2] = [
+            (info.grid, |axis, nodes| BlobError::ConditionalGrid {
+                axis,
+                nodes,
+            }),
+            (info.weight_grid, |axis, nodes| {
+                BlobError::ConditionalWeightGrid { axis, nodes }
+            }),
+        ];
+        for (grid, error) in grids {
+            for (axis, &nodes) in (0u32..).zip(&grid) {
+                if nodes < 2 {
+                    return Err(error(axis, nodes));
+                }
             }
         }
         for axis in 0..2 {
@@ -133,44 +136,36 @@ impl<'a> ConditionalSampler<'a> {
             return Err(BlobError::ConditionalReserved(info.reserved));
         }
 
-        let (entry, bytes) = layout.section(SectionTag::NetworkParams)?;
-        if entry.elem_size != 2 {
-            return Err(BlobError::ParamElementSize(entry.elem_size));
-        }
-        // Counted in u64: `Shape::param_len` multiplies `n h1` in `usize`, which a
-        // hostile `n` could overflow on a 32-bit target; `multiply_adds` does not
-        // depend on `n`.
-        let h1 = shape.hidden().first().copied().unwrap_or(0) as u64;
-        let expected = info.n as u64 * h1 + shape.multiply_adds() as u64;
-        let got = bytes.len() as u64 / 2;
-        if got != expected {
-            return Err(BlobError::ParamsLength { expected, got });
-        }
-        let params: &[u16] = bytemuck::try_cast_slice(bytes).map_err(|_| BlobError::Misaligned)?;
-
-        let (entry, bytes) = layout.section(SectionTag::PointTable)?;
-        if entry.elem_size != 4 {
-            return Err(BlobError::PointTableElementSize(entry.elem_size));
-        }
-        let expected = info
-            .point_table_len()
-            .ok_or(BlobError::PointTableCountOverflow)?;
-        let got = bytes.len() as u64 / 4;
-        if got != expected {
-            return Err(BlobError::PointTableLength { expected, got });
-        }
-        let table: &[u32] = bytemuck::try_cast_slice(bytes).map_err(|_| BlobError::Misaligned)?;
-
-        let (entry, bytes) = layout.section(SectionTag::WeightTable)?;
-        if entry.elem_size != 4 {
-            return Err(BlobError::WeightElementSize(entry.elem_size));
-        }
-        let expected = info.weight_table_len() * info.weight_tables();
-        let got = bytes.len() as u64 / 4;
-        if got != expected {
-            return Err(BlobError::WeightTableLength { expected, got });
-        }
-        let weights: &[f32] = bytemuck::try_cast_slice(bytes).map_err(|_| BlobError::Misaligned)?;
+        let params: &[u16] = typed_section(
+            layout,
+            SectionTag::NetworkParams,
+            BlobError::ParamElementSize,
+            || {
+                // Counted in u64: `Shape::param_len` multiplies `n h1` in `usize`,
+                // which a hostile `n` could overflow on a 32-bit target;
+                // `multiply_adds` does not depend on `n`.
+                let h1 = shape.hidden().first().copied().unwrap_or(0) as u64;
+                Ok(info.n as u64 * h1 + shape.multiply_adds() as u64)
+            },
+            |expected, got| BlobError::ParamsLength { expected, got },
+        )?;
+        let table: &[u32] = typed_section(
+            layout,
+            SectionTag::PointTable,
+            BlobError::PointTableElementSize,
+            || {
+                info.point_table_len()
+                    .ok_or(BlobError::PointTableCountOverflow)
+            },
+            |expected, got| BlobError::PointTableLength { expected, got },
+        )?;
+        let weights: &[f32] = typed_section(
+            layout,
+            SectionTag::WeightTable,
+            BlobError::WeightElementSize,
+            || Ok(info.weight_table_len() * info.weight_tables()),
+            |expected, got| BlobError::WeightTableLength { expected, got },
+        )?;
         Ok(Self {
             info,
             shape,
@@ -432,6 +427,30 @@ impl<'a> ConditionalSampler<'a> {
             weight: self.weight_table_lerp(&cell, 0),
         }
     }
+}
+
+/// Section `tag` of `layout` as a slice of `T`, checked in this order: the section
+/// exists; its `elem_size` is `size_of::<T>()` (else `bad_size(elem_size)`); it holds
+/// exactly `expected()?` elements (else `bad_length(expected, got)`); it is aligned
+/// for `T` (else [`BlobError::Misaligned`]).
+fn typed_section<'a, T: bytemuck::Pod>(
+    layout: &Layout<'a>,
+    tag: SectionTag,
+    bad_size: fn(u32) -> BlobError,
+    expected: impl FnOnce() -> Result<u64, BlobError>,
+    bad_length: fn(u64, u64) -> BlobError,
+) -> Result<&'a [T], BlobError> {
+    let (entry, bytes) = layout.section(tag)?;
+    let size = core::mem::size_of::<T>();
+    if entry.elem_size as usize != size {
+        return Err(bad_size(entry.elem_size));
+    }
+    let expected = expected()?;
+    let got = (bytes.len() / size) as u64;
+    if got != expected {
+        return Err(bad_length(expected, got));
+    }
+    bytemuck::try_cast_slice(bytes).map_err(|_| BlobError::Misaligned)
 }
 
 /// The condition `(roughness, theta_o in degrees)` of a view `wo` and its azimuth
