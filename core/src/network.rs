@@ -680,13 +680,44 @@ mod tests {
         assert!(Shape::new(4, &[1, 1, 1, 1], Activation::Relu, 1).is_none());
     }
 
+    /// The parameters of the tests' [`shape`] networks (62 of them).
+    fn test_params() -> [f64; 62] {
+        core::array::from_fn(|j| ((j * 37 % 23) as f64 - 11.0) / 9.0)
+    }
+
+    /// The network of [`shape`] written out as explicit matrix products for row 2 of
+    /// `E`: the two hidden pre-activations and the outputs.
+    fn explicit_forward(
+        p: &[f64; 62],
+        act: Activation,
+        x: &[f64; INPUTS],
+    ) -> ([f64; 3], [f64; 2], [f64; 2]) {
+        let (e, w1, b1) = (&p[6..9], &p[12..45], &p[45..48]);
+        let h1: [f64; 3] = core::array::from_fn(|o| {
+            b1[o] + e[o] + (0..INPUTS).map(|k| w1[o * INPUTS + k] * x[k]).sum::<f64>()
+        });
+        let (w2, b2) = (&p[48..54], &p[54..56]);
+        let a1 = h1.map(|z| act.apply(z));
+        let h2: [f64; 2] =
+            core::array::from_fn(|o| b2[o] + (0..3).map(|k| w2[o * 3 + k] * a1[k]).sum::<f64>());
+        let a2 = h2.map(|z| act.apply(z));
+        let (wo, bo) = (&p[56..60], &p[60..62]);
+        let out: [f64; 2] =
+            core::array::from_fn(|o| bo[o] + (0..2).map(|k| wo[o * 2 + k] * a2[k]).sum::<f64>());
+        (h1, h2, out)
+    }
+
+    fn close(a: &[f64], b: &[f64], tol: f64) -> bool {
+        a.iter().zip(b).all(|(x, y)| (x - y).abs() < tol)
+    }
+
     /// The forward pass against the same network written out as explicit matrix
     /// products.
     #[test]
     fn forward_equals_explicit_matrix_products() {
         for act in [Activation::Relu, Activation::Silu] {
             let s = shape(act);
-            let p: [f64; 62] = core::array::from_fn(|j| ((j * 37 % 23) as f64 - 11.0) / 9.0);
+            let p = test_params();
             let net = Network {
                 shape: s,
                 params: &p[..],
@@ -699,24 +730,43 @@ mod tests {
                 t.output,
                 "evaluate and forward agree bit for bit"
             );
-            let (e, w1, b1) = (&p[6..9], &p[12..45], &p[45..48]);
-            let h1: [f64; 3] = core::array::from_fn(|o| {
-                b1[o] + e[o] + (0..INPUTS).map(|k| w1[o * INPUTS + k] * x[k]).sum::<f64>()
-            });
-            let (w2, b2) = (&p[48..54], &p[54..56]);
-            let a1 = h1.map(|z| act.apply(z));
-            let h2: [f64; 2] = core::array::from_fn(|o| {
-                b2[o] + (0..3).map(|k| w2[o * 3 + k] * a1[k]).sum::<f64>()
-            });
-            let a2 = h2.map(|z| act.apply(z));
-            let (wo, bo) = (&p[56..60], &p[60..62]);
-            let out: [f64; 2] = core::array::from_fn(|o| {
-                bo[o] + (0..2).map(|k| wo[o * 2 + k] * a2[k]).sum::<f64>()
-            });
-            let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-14);
-            assert!(close(&t.pre[0][..3], &h1));
-            assert!(close(&t.pre[1][..2], &h2));
-            assert!(close(&t.output, &out));
+            let (h1, h2, out) = explicit_forward(&p, act, &x);
+            assert!(close(&t.pre[0][..3], &h1, 1e-14));
+            assert!(close(&t.pre[1][..2], &h2, 1e-14));
+            assert!(close(&t.output, &out, 1e-14));
+        }
+    }
+
+    /// With a lattice residual the outputs are the explicit matrix products plus
+    /// `ln(p / (1 - p))` of the shifted lattice point `p`, taken from
+    /// [`shifted_lattice_point`] (not read back from the features); with all-zero
+    /// parameters the square point is `p` itself.
+    #[test]
+    fn lattice_residual_adds_the_logit_of_the_shifted_lattice_point() {
+        for act in [Activation::Relu, Activation::Silu] {
+            let s = shape(act).with_lattice_residual(true);
+            let (c, k, i) = ([0.3, 0.7], 5, 6); // i wraps to row 2 of E
+            let x = input_features::<f64>(&s, c, k, i);
+            let z = instance_offset::<f64>(k);
+            let p = shifted_lattice_point(i, s.n(), s.lattice_generator(), z);
+            // Away from the clamp at LATTICE_LOGIT_EPS, where the logit is exact.
+            assert!(p.iter().all(|&q| (0.01..0.99).contains(&q)), "{p:?}");
+            let logit = p.map(|q| Real::ln(q / (1.0 - q)));
+            let params = test_params();
+            let net = Network {
+                shape: s,
+                params: &params[..],
+            };
+            let (_, _, out) = explicit_forward(&params, act, &x);
+            let want = [out[0] + logit[0], out[1] + logit[1]];
+            let got = net.evaluate(i, x);
+            assert!(close(&got, &want, 1e-12), "{got:?} vs {want:?}");
+            let zero = [0.0; 62];
+            let net = Network {
+                shape: s,
+                params: &zero[..],
+            };
+            assert!(close(&net.square_point(i, x), &p, 1e-12));
         }
     }
 
