@@ -95,9 +95,11 @@ pub fn square_to_disk(u: DVec2) -> DVec2 {
     DVec2::from_array(square_to_disk_real(u.to_array()))
 }
 
-/// [`square_to_disk`] in any [`Real`]: `r (cos theta, sin theta)` of
-/// [`concentric_polar`], the origin at the square's centre. The one formula, which
-/// [`square_to_cosine_hemisphere_real`] lifts and the runtime evaluates in `f32`.
+/// [`square_to_disk`] in any [`Real`]: with `a = 2 u.x - 1`, `b = 2 u.y - 1`,
+/// `r (cos theta, sin theta)` for `(r, theta) = (a, pi/4 (b / a))` if `|a| > |b|`,
+/// else `(b, pi/2 - pi/4 (a / b))`; the origin at the square's centre. The one
+/// formula, which [`square_to_cosine_hemisphere_real`] lifts and the runtime
+/// evaluates in `f32`.
 #[inline]
 pub fn square_to_disk_real<T: Real>(u: [T; 2]) -> [T; 2] {
     match concentric_polar(u) {
