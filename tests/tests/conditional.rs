@@ -9,6 +9,7 @@ use nuld_core::blob::Domain;
 use nuld_core::conditional::{brdf_mixture_direction, PointWarp};
 use nuld_core::network::{input_features, Activation, Network};
 use nuld_core::quantize::f16_decode;
+use nuld_core::real::Real;
 use nuld_core::sphere::square_to_hemisphere_real;
 use nuld_runtime::{Blob, ConditionalSampler};
 use nuld_tests::{conditional_parts, META};
@@ -28,10 +29,37 @@ fn fixtures() -> Vec<ConditionalParts> {
     .collect()
 }
 
-/// The clamped condition in blob units, `lo + u (hi - lo)` of the normalized one.
-fn clamped_f32(parts: &ConditionalParts, u: [f32; 2]) -> [f32; 2] {
+/// The blob's condition range `(cond_min[a], cond_max[a])` of axis `a` in `T`.
+fn range<T: Real>(parts: &ConditionalParts, a: usize) -> (T, T) {
     let info = &parts.info;
-    std::array::from_fn(|a| info.cond_min[a] + u[a] * (info.cond_max[a] - info.cond_min[a]))
+    (
+        T::of(info.cond_min[a].into()),
+        T::of(info.cond_max[a].into()),
+    )
+}
+
+/// The clamped condition in blob units, `lo + u (hi - lo)` of the normalized one,
+/// in `T`.
+fn clamped<T: Real>(parts: &ConditionalParts, u: [T; 2]) -> [T; 2] {
+    std::array::from_fn(|a| {
+        let (lo, hi) = range::<T>(parts, a);
+        lo + u[a] * (hi - lo)
+    })
+}
+
+/// The normalized condition in `T`, as documented: clamp into the range (NaN to
+/// the lower end), then `(c - lo) / (hi - lo)`.
+fn normalize<T: Real>(parts: &ConditionalParts, c: Vec2) -> [T; 2] {
+    let c = c.to_array();
+    std::array::from_fn(|a| {
+        let (lo, hi) = range::<T>(parts, a);
+        let x = if c[a].is_nan() {
+            lo
+        } else {
+            T::of(c[a].into()).max(lo).min(hi)
+        };
+        (x - lo) / (hi - lo)
+    })
 }
 
 /// A condition drawn over the blob's range and a little beyond (to exercise the
@@ -49,22 +77,6 @@ fn with_sampler(parts: &ConditionalParts, f: impl FnOnce(ConditionalSampler<'_>)
     let blob = Blob::parse(bytes.as_slice()).unwrap();
     assert_eq!(blob.metadata(), META);
     f(blob.conditional().unwrap());
-}
-
-/// The normalized condition in `f64`: clamp into the range (NaN to the lower end),
-/// then `(c - lo) / (hi - lo)`.
-fn normalize_f64(parts: &ConditionalParts, c: Vec2) -> [f64; 2] {
-    let info = &parts.info;
-    let c = c.to_array();
-    std::array::from_fn(|a| {
-        let (lo, hi) = (info.cond_min[a] as f64, info.cond_max[a] as f64);
-        let x = if c[a].is_nan() {
-            lo
-        } else {
-            (c[a] as f64).clamp(lo, hi)
-        };
-        (x - lo) / (hi - lo)
-    })
 }
 
 /// Network mode equals the tool's `f64` forward pass over the same f16 weights
@@ -89,7 +101,7 @@ fn network_mode_equals_the_tools_f64_evaluation_of_the_f16_weights() {
                 let c = condition(&mut rng);
                 let k: u32 = rng.random();
                 let i = rng.random_range(0..200);
-                let u = normalize_f64(&parts, c);
+                let u = normalize::<f64>(&parts, c);
                 let input = input_features::<f64>(&shape, u, k, i);
                 let p = DVec2::from(tool.forward(i, input).square_point());
                 let got = cs.network_square_point(c, k, i).as_dvec2();
@@ -103,11 +115,7 @@ fn network_mode_equals_the_tools_f64_evaluation_of_the_f16_weights() {
                         if (p.x - p_s).abs() < 1e-4 {
                             continue;
                         }
-                        let info = &parts.info;
-                        let cond: [f64; 2] = std::array::from_fn(|a| {
-                            let (lo, hi) = (info.cond_min[a] as f64, info.cond_max[a] as f64);
-                            lo + u[a] * (hi - lo)
-                        });
+                        let cond = clamped(&parts, u);
                         DVec3::from_array(brdf_mixture_direction(cond, p_s, p.to_array()))
                     }
                 };
@@ -147,22 +155,6 @@ fn bilinear(u: [f32; 2], nodes: [u32; 2], value: impl Fn(usize) -> f32) -> f32 {
     a + (b - a) * t1
 }
 
-/// The normalized condition in `f32`, as documented: clamp (NaN to the lower end),
-/// then `(c - lo) / (hi - lo)`.
-fn normalize_f32(parts: &ConditionalParts, c: Vec2) -> [f32; 2] {
-    let info = &parts.info;
-    let c = c.to_array();
-    std::array::from_fn(|a| {
-        let (lo, hi) = (info.cond_min[a], info.cond_max[a]);
-        let x = if c[a].is_nan() {
-            lo
-        } else {
-            c[a].clamp(lo, hi)
-        };
-        (x - lo) / (hi - lo)
-    })
-}
-
 /// Table lookups equal the reference interpolation of the stored codes bit for
 /// bit, in the square and (through the `f32` hemisphere map) as directions.
 #[test]
@@ -176,7 +168,7 @@ fn table_mode_equals_the_reference_interpolation_bit_for_bit() {
                 let k: u32 = rng.random();
                 let i: u32 = rng.random();
                 let (ks, is) = (k % info.instances, i % info.n);
-                let u = normalize_f32(&parts, c);
+                let u = normalize::<f32>(&parts, c);
                 let coord = |axis: u32| {
                     bilinear(u, info.grid, |node| {
                         let at = (node * info.instances as usize + ks as usize) * info.n as usize
@@ -192,7 +184,7 @@ fn table_mode_equals_the_reference_interpolation_bit_for_bit() {
                     PointWarp::BrdfMixture => {
                         let nodes = info.weight_table_len() as usize;
                         let p_s = bilinear(u, info.weight_grid, |node| parts.weights[nodes + node]);
-                        brdf_mixture_direction(clamped_f32(&parts, u), p_s, p)
+                        brdf_mixture_direction(clamped(&parts, u), p_s, p)
                     }
                 };
                 assert_eq!(cs.sample(c, k, i).direction.to_array(), d);
@@ -211,7 +203,7 @@ fn weights_equal_the_reference_bilinear_interpolation() {
         with_sampler(&parts, |cs| {
             for _ in 0..50_000 {
                 let c = condition(&mut rng);
-                let want = bilinear(normalize_f32(&parts, c), info.weight_grid, |node| {
+                let want = bilinear(normalize::<f32>(&parts, c), info.weight_grid, |node| {
                     parts.weights[node]
                 });
                 let got = cs.weight(c);
@@ -219,7 +211,7 @@ fn weights_equal_the_reference_bilinear_interpolation() {
                 assert_eq!(cs.sample(c, 3, 5).weight, want);
                 assert_eq!(cs.sample_network(c, 3, 5).weight, want);
                 // The same interpolation in f64, from the f64 normalized condition.
-                let u = normalize_f64(&parts, c);
+                let u = normalize::<f64>(&parts, c);
                 let g = info.weight_grid;
                 let (s0, s1) = (u[0] * (g[0] - 1) as f64, u[1] * (g[1] - 1) as f64);
                 let (j0, j1) = (

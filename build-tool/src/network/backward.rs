@@ -1,5 +1,6 @@
-//! The backward pass of [`nuld_core::network::Network::forward`] and of the two
-//! maps after it (the sigmoid onto the square, the hemisphere's equal-area map).
+//! The backward pass of [`nuld_core::network::Network::forward`] and of the
+//! sigmoid onto the square after it (the map from the square to a direction is the
+//! caller's: its Jacobian chains in front of [`output_gradient`]).
 //!
 //! With `a_0` the input, `z_l = W_l a_(l-1) + b_l (+ E[i] for l = 1)`,
 //! `a_l = act(z_l)`, `o = W_o a_L + b_o`, `p = sigmoid(o)`, `x = M(p)`:
@@ -13,7 +14,9 @@
 //! ```
 
 use glam::DVec2;
-use nuld_core::network::{sigmoid, Shape, Trace, INPUTS, MAX_WIDTH, OUTPUTS};
+use nuld_core::network::{
+    sigmoid, LayerSpan, Shape, Trace, INPUTS, MAX_HIDDEN_LAYERS, MAX_WIDTH, OUTPUTS,
+};
 
 /// `dL/do` of the outputs before the sigmoid from `dL/dp` of the square point
 /// `p = sigmoid(o)`: `dL/dp p (1 - p)` per coordinate.
@@ -42,19 +45,11 @@ pub fn backward(
     let act = shape.activation();
     let hidden = shape.hidden();
     let layers = hidden.len();
-    // Offsets of every layer's weights (biases follow them), output layer last.
-    let mut offsets = [0usize; 4];
-    let mut fan_ins = [0usize; 4];
-    let mut off = shape.first_layer_offset();
-    let mut fan_in = INPUTS;
-    for (l, &h) in hidden.iter().enumerate() {
-        offsets[l] = off;
-        fan_ins[l] = fan_in;
-        off += h as usize * (fan_in + 1);
-        fan_in = h as usize;
+    // Every layer's place in the array, output layer last: walked backwards below.
+    let mut spans = [LayerSpan::default(); MAX_HIDDEN_LAYERS + 1];
+    for (slot, span) in spans.iter_mut().zip(shape.layers()) {
+        *slot = span;
     }
-    offsets[layers] = off;
-    fan_ins[layers] = fan_in;
 
     let activation = |l: usize| -> [f64; MAX_WIDTH] {
         let mut a = [0.0; MAX_WIDTH];
@@ -72,7 +67,12 @@ pub fn backward(
     };
 
     // Output layer.
-    let (off, fan_in) = (offsets[layers], fan_ins[layers]);
+    let LayerSpan {
+        weights: off,
+        bias,
+        fan_in,
+        ..
+    } = spans[layers];
     let a = activation(layers);
     let mut delta_a = [0.0; MAX_WIDTH];
     for (o, &d) in d_output.iter().enumerate() {
@@ -81,11 +81,16 @@ pub fn backward(
             grad[row + k] += d * a[k];
             delta_a[k] += params[row + k] * d;
         }
-        grad[off + OUTPUTS * fan_in + o] += d;
+        grad[bias + o] += d;
     }
     // Hidden layers, last first.
     for l in (0..layers).rev() {
-        let (off, fan_in, h) = (offsets[l], fan_ins[l], hidden[l] as usize);
+        let LayerSpan {
+            weights: off,
+            bias,
+            fan_in,
+            width: h,
+        } = spans[l];
         let a = activation(l);
         let mut delta_z = [0.0; MAX_WIDTH];
         for o in 0..h {
@@ -101,7 +106,7 @@ pub fn backward(
                 grad[row + k] += d * a[k];
                 next[k] += params[row + k] * d;
             }
-            grad[off + h * fan_in + o] += d;
+            grad[bias + o] += d;
             if l == 0 {
                 grad[shape.embedding_offset(i) + o] += d;
             }
