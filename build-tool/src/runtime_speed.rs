@@ -8,58 +8,51 @@
 //! are timed on blobs with random contents ([`random_parts`]).
 
 use crate::conditional::blob::ConditionalParts;
+use crate::conditional::distill::brdf_info;
 use crate::pointset::AlignedBytes;
 use crate::sphere::{BrdfTarget, DirectionDensity};
-use anyhow::{anyhow, Result};
+use anyhow::{anyhow, ensure, Result};
 use glam::{DVec2, DVec3};
-use nuld_core::blob::{Domain, Metadata};
-use nuld_core::conditional::{ConditionalInfo, ConditionalTarget};
-use nuld_core::network::Activation;
+use nuld_core::blob::Metadata;
+use nuld_core::brdf::{CONDITION_MAX, CONDITION_MIN};
+use nuld_core::conditional::PointWarp;
+use nuld_core::network::{Activation, Shape, MAX_HIDDEN_LAYERS};
 use nuld_runtime::glam::{Vec2, Vec3};
 use nuld_runtime::Blob;
 use rand::{Rng, SeedableRng};
 use std::hint::black_box;
 use std::time::Instant;
 
-/// A BRDF conditional sampler (hemisphere, roughness `[0.1, 1]` x `theta_o`
-/// `[0°, 89°]`) with random contents: `n` points, `instances` stored instances, a
+/// A BRDF conditional sampler (hemisphere, the condition range of
+/// [`brdf_info`]) with random contents: `n` points, `instances` stored instances, a
 /// `grid` point table of random codes, a 7 x 9 weight table of weights in
 /// `[0.5, 1.6)`, and a network of the given hidden widths (1 to 3) with f16
-/// parameters uniform in `[-0.6, 0.6]`. Deterministic for a seed. Fails if the
-/// counts describe no valid network.
+/// parameters uniform in `[-0.6, 0.6]`, with the given point warp (for
+/// [`PointWarp::BrdfMixture`] a second weight-grid table of lobe probabilities
+/// uniform in `[0.02, 0.98)`). Deterministic for a seed. Fails if the counts
+/// describe no valid network.
 pub fn random_parts(
     n: u32,
     hidden: &[u32],
     activation: Activation,
     instances: u32,
     grid: [u32; 2],
+    warp: PointWarp,
     seed: u64,
 ) -> Result<ConditionalParts> {
     let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
-    let mut widths = [0u32; 3];
-    widths
-        .get_mut(..hidden.len())
-        .ok_or_else(|| anyhow!("{} hidden layers, at most 3", hidden.len()))?
-        .copy_from_slice(hidden);
-    let info = ConditionalInfo {
-        n,
-        instances,
-        domain: Domain::Hemisphere as u32,
-        target: ConditionalTarget::GltfBrdf as u32,
-        grid,
-        weight_grid: [7, 9],
-        cond_min: [0.1, 0.0],
-        cond_max: [1.0, 89.0],
-        hidden: widths,
-        activation: activation as u32,
-        // Odd: coprime to every power of two, so the lattice's second coordinate
-        // is a permutation for such n.
-        lattice_generator: (n / 3) | 1,
-        reserved: [0; 3],
-    };
-    let shape = info
-        .shape()
-        .ok_or_else(|| anyhow!("n {n}, hidden {hidden:?}: no valid network"))?;
+    ensure!(
+        hidden.len() <= MAX_HIDDEN_LAYERS,
+        "{} hidden layers, at most {MAX_HIDDEN_LAYERS}",
+        hidden.len()
+    );
+    // Odd: coprime to every power of two, so the lattice's second coordinate is a
+    // permutation for such n.
+    let lattice_generator = (n / 3) | 1;
+    let shape = Shape::new(n, hidden, activation, lattice_generator)
+        .ok_or_else(|| anyhow!("n {n}, hidden {hidden:?}: no valid network"))?
+        .with_lattice_residual(warp == PointWarp::BrdfMixture);
+    let info = brdf_info(&shape, instances, grid, [7, 9]);
     let params = (0..shape.param_len())
         .map(|_| nuld_core::quantize::f16_encode(rng.random_range(-0.6f32..=0.6)))
         .collect();
@@ -67,8 +60,15 @@ pub fn random_parts(
         .point_table_len()
         .ok_or_else(|| anyhow!("point table size overflows"))?;
     let table = (0..table_len).map(|_| rng.random()).collect();
-    let weights = (0..info.weight_table_len())
-        .map(|_| rng.random_range(0.5f32..1.6))
+    let nodes = info.weight_table_len();
+    let weights = (0..nodes * info.weight_tables())
+        .map(|e| {
+            if e < nodes {
+                rng.random_range(0.5f32..1.6)
+            } else {
+                rng.random_range(0.02f32..0.98)
+            }
+        })
         .collect();
     Ok(ConditionalParts {
         info,
@@ -94,6 +94,11 @@ pub struct RuntimeTimings {
 /// Conditions cycled through by every method: a renderer's shading points each
 /// have their own.
 const CONDITIONS: usize = 64;
+
+/// Points of the cap-measure rule of the incumbent's targets: the bench calls only
+/// their warp, its density and the albedo, none of which reads the rule, so a small
+/// one spares building 64 rules of `2^18` points (seconds) for nothing.
+const INCUMBENT_RULE_POINTS: usize = 1 << 10;
 
 /// Times of each method are the best of this many repeats (the least disturbed by
 /// other work on the machine).
@@ -124,7 +129,11 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
     let n = 64u32;
     let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(1);
     let conds: Vec<Vec2> = (0..CONDITIONS)
-        .map(|_| Vec2::new(rng.random_range(0.1..1.0), rng.random_range(0.0..89.0)))
+        .map(|_| {
+            let r = rng.random_range(CONDITION_MIN[0] as f32..CONDITION_MAX[0] as f32);
+            let t = rng.random_range(CONDITION_MIN[1] as f32..CONDITION_MAX[1] as f32);
+            Vec2::new(r, t)
+        })
         .collect();
     let views: Vec<Vec3> = conds
         .iter()
@@ -138,7 +147,7 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
         .collect();
     let targets = conds
         .iter()
-        .map(|c| BrdfTarget::new(c.x as f64, c.y as f64, Domain::Hemisphere))
+        .map(|c| BrdfTarget::coarse(c.x as f64, c.y as f64, INCUMBENT_RULE_POINTS))
         .collect::<Result<Vec<_>, _>>()?;
     let meta = Metadata {
         generator: "bench",
@@ -146,7 +155,7 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
         seed: 0,
     };
     let blob = |hidden: &[u32], act| -> Result<AlignedBytes> {
-        random_parts(n, hidden, act, 16, [10, 9], 2)?.to_blob(&meta)
+        random_parts(n, hidden, act, 16, [10, 9], PointWarp::BrdfMixture, 2)?.to_blob(&meta)
     };
     let (relu, silu) = (
         blob(&[32, 32], Activation::Relu)?,

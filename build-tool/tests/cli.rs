@@ -22,6 +22,17 @@ fn failure(args: &[&str], out: &Path) -> String {
     String::from_utf8(o.stderr).unwrap()
 }
 
+/// Runs `cmd`, which must succeed (its stderr shown if not); returns its stdout.
+fn stdout_of(cmd: &mut Command) -> String {
+    let out = cmd.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("nuld-cli-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -340,16 +351,7 @@ fn optimize_directions_writes_a_direction_blob() {
 
 #[test]
 fn bench_baselines_times_every_generator_at_every_size() {
-    let out = build_tool()
-        .args(["bench", "--only", "baselines", "--sizes", "16,32"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = stdout_of(build_tool().args(["bench", "--only", "baselines", "--sizes", "16,32"]));
     let names = [
         "random",
         "owen-sobol",
@@ -467,7 +469,8 @@ fn conditional_blob(path: &Path) {
         hidden: [5, 0, 0],
         activation: 1,
         lattice_generator: 5,
-        reserved: [0; 3],
+        warp: 0,
+        reserved: [0; 2],
     };
     let params = (0..info.shape().unwrap().param_len())
         .map(|j| f16_encode(((j * 37 % 101) as f32 - 50.0) / 60.0))
@@ -502,25 +505,14 @@ fn sample_prints_what_the_runtime_serves_and_rejects_bad_input() {
         .conditional()
         .unwrap();
     for (mode, instance) in [("table", "4"), ("network", "123456")] {
-        let out = build_tool()
-            .arg("sample")
-            .arg(&file)
-            .args([
-                "--cond",
-                "0.35,47.5",
-                "--instance",
-                instance,
-                "--mode",
-                mode,
-            ])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let csv = String::from_utf8(out.stdout).unwrap();
+        let csv = stdout_of(build_tool().arg("sample").arg(&file).args([
+            "--cond",
+            "0.35,47.5",
+            "--instance",
+            instance,
+            "--mode",
+            mode,
+        ]));
         let mut lines = csv.lines();
         assert_eq!(lines.next(), Some("index,x,y,z,weight"));
         let rows: Vec<Vec<f32>> = lines
@@ -545,19 +537,16 @@ fn sample_prints_what_the_runtime_serves_and_rejects_bad_input() {
         }
     }
     // The default mode is table mode, the default instance 0.
-    let out = build_tool()
-        .arg("sample")
-        .arg(&file)
-        .args(["--cond", "2,-10"])
-        .output()
-        .unwrap();
-    assert!(out.status.success());
-    let first = String::from_utf8(out.stdout)
-        .unwrap()
-        .lines()
-        .nth(1)
-        .unwrap()
-        .to_string();
+    let first = stdout_of(
+        build_tool()
+            .arg("sample")
+            .arg(&file)
+            .args(["--cond", "2,-10"]),
+    )
+    .lines()
+    .nth(1)
+    .unwrap()
+    .to_string();
     let s = cs.sample(Vec2::new(1.0, 0.0), 0, 0);
     let d = s.direction;
     assert_eq!(first, format!("0,{},{},{},{}", d.x, d.y, d.z, s.weight));
@@ -632,5 +621,37 @@ fn shader_writes_each_language_or_fails_cleanly() {
         .map(|e| e.unwrap().file_name())
         .collect();
     assert_eq!(names.len(), Lang::ALL.len(), "{names:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `eval conditional --blob` reads a blob file (16-byte aligned, as `Blob::parse`
+/// demands) and judges its table and network modes through the runtime: the
+/// report's first rows are those two samplers, with finite ratios.
+#[test]
+fn eval_conditional_judges_a_blob_file() {
+    let dir = scratch("eval-blob");
+    let file = dir.join("brdf.nuld");
+    conditional_blob(&file);
+    let out = dir.join("eval");
+    let table = stdout_of(
+        build_tool()
+            .args(["eval", "conditional", "--quick", "--blob"])
+            .arg(&file)
+            .arg("--out")
+            .arg(&out),
+    );
+    assert!(
+        table.contains("| table |") && table.contains("| network |"),
+        "{table}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("conditional.json")).unwrap()).unwrap();
+    assert_eq!(json["n"], 6);
+    for (row, name) in ["table", "network"].iter().enumerate() {
+        let s = &json["summary"][row];
+        assert_eq!(s["sampler"], *name);
+        let r = s["mean_ratio_exact"].as_f64().unwrap();
+        assert!(r.is_finite() && r > 0.0, "{name}: {r}");
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -349,7 +349,10 @@ pub enum BlobError {
     /// width above [`crate::network::MAX_WIDTH`], or a non-zero width after a zero.
     NetworkWidths([u32; 3]),
     /// A reserved field of the conditional info is not zero.
-    ConditionalReserved([u32; 3]),
+    ConditionalReserved([u32; 2]),
+    /// The conditional info's warp is not a
+    /// [`crate::conditional::PointWarp`] code, or names a warp the target has none of.
+    UnknownPointWarp(u32),
     /// The [`SectionTag::NetworkParams`] elements are not 2 bytes (f16).
     ParamElementSize(u32),
     /// The [`SectionTag::NetworkParams`] section does not hold exactly
@@ -545,6 +548,7 @@ impl core::fmt::Display for BlobError {
             Self::ConditionalReserved(r) => {
                 write!(f, "blob conditional info reserved fields {r:?} are not zero")
             }
+            Self::UnknownPointWarp(w) => write!(f, "blob conditional point warp {w} is unknown"),
             Self::ParamElementSize(s) => write!(
                 f,
                 "blob network parameters have {s}-byte elements, not 2 (f16)"

@@ -55,6 +55,14 @@ pub const MAX_ROUGHNESS: f64 = 1.0;
 /// values are lowered to it.
 pub const MAX_THETA_O_DEG: f64 = 89.0;
 
+/// Lower corner of the condition range `(roughness, theta_o in degrees)`:
+/// `(MIN_ROUGHNESS, 0)`.
+pub const CONDITION_MIN: [f64; 2] = [MIN_ROUGHNESS, 0.0];
+
+/// Upper corner of the condition range `(roughness, theta_o in degrees)`:
+/// `(MAX_ROUGHNESS, MAX_THETA_O_DEG)`.
+pub const CONDITION_MAX: [f64; 2] = [MAX_ROUGHNESS, MAX_THETA_O_DEG];
+
 /// Which BRDF a `brdf:` target or a bake uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum BrdfModel {
@@ -308,8 +316,15 @@ pub fn burley_parts(wo: DVec3, wi: DVec3, roughness: f64) -> BrdfParts<f64> {
 /// `(sin theta_o, 0, cos theta_o)`, with `theta_o_deg` clamped by
 /// [`clamp_theta_o_deg`].
 pub fn view_direction(theta_o_deg: f64) -> DVec3 {
-    let t = clamp_theta_o_deg(theta_o_deg).to_radians();
-    DVec3::new(libm::sin(t), 0.0, libm::cos(t))
+    DVec3::from_array(view_direction_real(theta_o_deg))
+}
+
+/// [`view_direction`] in any [`Real`] (the runtime's `f32` twin):
+/// `(sin t, 0, cos t)`, `t` the clamped angle times `pi / 180`.
+#[inline]
+pub fn view_direction_real<T: Real>(theta_o_deg: T) -> [T; 3] {
+    let t = clamp_theta_o_deg(theta_o_deg) * T::of(core::f64::consts::PI / 180.0);
+    [t.sin(), T::ZERO, t.cos()]
 }
 
 #[cfg(test)]

@@ -18,7 +18,10 @@
 //! `cond_min`), then normalized to `[0,1]^2` ([`ConditionalInfo::normalize`]); the
 //! network's condition input is that normalized point.
 
+use crate::blob::{SectionSpec, SectionTag};
+use crate::domain::Domain;
 use crate::network::{Activation, Shape, MAX_HIDDEN_LAYERS};
+use crate::real::Real;
 use bytemuck::{Pod, Zeroable};
 
 /// What a conditional blob's condition means.
@@ -37,6 +40,63 @@ impl ConditionalTarget {
         match code {
             1 => Some(Self::GltfBrdf),
             _ => None,
+        }
+    }
+}
+
+/// How a conditional sampler turns the network's point of the unit square into a
+/// direction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum PointWarp {
+    /// The domain's equal-area map (`crate::sphere`) of the network's square
+    /// point: the network alone shapes the set.
+    EqualArea = 0,
+    /// The network's point is a point of the *primary sample space* of the
+    /// renderer's mixture warp ([`crate::warp::brdf_mixture_real`]): its outputs
+    /// are a residual added to the logit of the instance's shifted lattice point
+    /// ([`crate::network::Shape::lattice_residual`]), and the direction is the
+    /// mixture warp of the result for the condition's view, `alpha = roughness^2`
+    /// and lobe probability `p_s` (a second table after the weights). A strong
+    /// prior (paper §4's "correction in primary sample space to a cheap standard
+    /// warp"): at zero residual the set is the renderer's warp of a randomly
+    /// shifted lattice, so the network only learns a smooth correction, and
+    /// instances differ by construction. glTF BRDF blobs only.
+    BrdfMixture = 1,
+}
+
+impl PointWarp {
+    /// The warp with this code, if any.
+    pub fn from_code(code: u32) -> Option<Self> {
+        match code {
+            0 => Some(Self::EqualArea),
+            1 => Some(Self::BrdfMixture),
+            _ => None,
+        }
+    }
+
+    /// The warp a network of `shape` is trained for: [`BrdfMixture`](Self::BrdfMixture)
+    /// for a [lattice residual](Shape::lattice_residual), else
+    /// [`EqualArea`](Self::EqualArea).
+    pub fn of_shape(shape: &Shape) -> Self {
+        if shape.lattice_residual() {
+            Self::BrdfMixture
+        } else {
+            Self::EqualArea
+        }
+    }
+
+    /// The direction of a sampler's point `p` (the network's output, or the table's
+    /// interpolation of it): [`EqualArea`](Self::EqualArea) maps it with
+    /// `domain`'s equal-area map; [`BrdfMixture`](Self::BrdfMixture) warps it with
+    /// [`brdf_mixture_direction`] at the condition `cond = (roughness, theta_o in
+    /// degrees)` and lobe probability `p_s`. A warp ignores the arguments it does not
+    /// use. Unit vectors; never panics.
+    #[inline]
+    pub fn direction<T: Real>(self, domain: Domain, cond: [T; 2], p_s: T, p: [T; 2]) -> [T; 3] {
+        match self {
+            Self::EqualArea => domain.to_direction_real(p),
+            Self::BrdfMixture => brdf_mixture_direction(cond, p_s, p),
         }
     }
 }
@@ -68,8 +128,10 @@ pub struct ConditionalInfo {
     pub activation: u32,
     /// The rank-1 lattice generator of the network's input.
     pub lattice_generator: u32,
+    /// A [`PointWarp`] code.
+    pub warp: u32,
     /// Reserved, zero.
-    pub reserved: [u32; 3],
+    pub reserved: [u32; 2],
 }
 
 /// Size of [`ConditionalInfo`] in bytes.
@@ -194,7 +256,14 @@ impl ConditionalInfo {
             return None;
         }
         let act = Activation::from_code(self.activation)?;
+        let residual = PointWarp::from_code(self.warp)? == PointWarp::BrdfMixture;
         Shape::new(self.n, &self.hidden[..layers], act, self.lattice_generator)
+            .map(|s| s.with_lattice_residual(residual))
+    }
+
+    /// The info's [`PointWarp`], if its code is known.
+    pub fn point_warp(&self) -> Option<PointWarp> {
+        PointWarp::from_code(self.warp)
     }
 
     /// Number of `u32` entries of the point table:
@@ -206,9 +275,19 @@ impl ConditionalInfo {
             .checked_mul(self.n as u64)
     }
 
-    /// Number of `f32` entries of the weight table: `weight_grid[0] weight_grid[1]`.
+    /// Number of `f32` entries of one table on the weight grid:
+    /// `weight_grid[0] weight_grid[1]`.
     pub fn weight_table_len(&self) -> u64 {
         self.weight_grid[0] as u64 * self.weight_grid[1] as u64
+    }
+
+    /// Number of tables in the weight section: the weights, then for
+    /// [`PointWarp::BrdfMixture`] the lobe probabilities `p_s`.
+    pub fn weight_tables(&self) -> u64 {
+        match self.point_warp() {
+            Some(PointWarp::BrdfMixture) => 2,
+            _ => 1,
+        }
     }
 
     /// Index of `(node, instance, index)` in the point table: layout
@@ -225,6 +304,52 @@ fn node_condition(info: &ConditionalInfo, nodes: [u32; 2], j: [u32; 2]) -> [f64;
         let steps = (nodes[a].max(2) - 1) as f64;
         lo + (j[a] as f64 / steps) * (hi - lo)
     })
+}
+
+/// The direction of a [`PointWarp::BrdfMixture`] sampler's primary point `u` at the
+/// condition `(roughness, theta_o in degrees)` (each clamped into its range) with
+/// lobe probability `p_s`: [`crate::warp::brdf_mixture_real`] for the view
+/// [`crate::brdf::view_direction_real`] and `alpha = roughness^2`
+/// ([`crate::brdf::alpha`]).
+#[inline]
+pub fn brdf_mixture_direction<T: Real>(cond: [T; 2], p_s: T, u: [T; 2]) -> [T; 3] {
+    let wo = crate::brdf::view_direction_real(cond[1]);
+    crate::warp::brdf_mixture_real(wo, crate::brdf::alpha(cond[0]), p_s, u)
+}
+
+/// The four sections of a conditional blob (kind 3) in the order `core/FORMAT.md`
+/// lists them, ready for [`crate::blob::write`]: the info record, the f16
+/// parameters, the point table and the weight section (weights, then for
+/// [`PointWarp::BrdfMixture`] the lobe probabilities). Checks no length: a reader
+/// validates them.
+pub fn sections<'s>(
+    info: &'s ConditionalInfo,
+    params: &'s [u16],
+    table: &'s [u32],
+    weights: &'s [f32],
+) -> [SectionSpec<'s>; 4] {
+    [
+        SectionSpec {
+            tag: SectionTag::ConditionalInfo,
+            elem_size: CONDITIONAL_INFO_LEN as u32,
+            bytes: bytemuck::bytes_of(info),
+        },
+        SectionSpec {
+            tag: SectionTag::NetworkParams,
+            elem_size: 2,
+            bytes: bytemuck::cast_slice(params),
+        },
+        SectionSpec {
+            tag: SectionTag::PointTable,
+            elem_size: 4,
+            bytes: bytemuck::cast_slice(table),
+        },
+        SectionSpec {
+            tag: SectionTag::WeightTable,
+            elem_size: 4,
+            bytes: bytemuck::cast_slice(weights),
+        },
+    ]
 }
 
 /// Packs a square point's u16 unorm codes as one table entry: `x | y << 16`.
@@ -256,7 +381,8 @@ mod tests {
             hidden: [8, 8, 0],
             activation: 0,
             lattice_generator: 3,
-            reserved: [0; 3],
+            warp: 0,
+            reserved: [0; 2],
         }
     }
 

@@ -26,6 +26,10 @@
 //! * `sigmoid` maps the two outputs onto the open unit square; `M` is the domain's
 //!   equal-area map (for BRDF samplers the hemisphere map of
 //!   [`crate::sphere::square_to_hemisphere`]).
+//! * With a [lattice residual](Shape::lattice_residual) the outputs are a residual
+//!   on the logit of the shifted lattice point, `o_a + ln(p_a / (1 - p_a))`, so that a
+//!   zero output leaves `p` where it is; the caller's map is then a warp of primary
+//!   sample space (`crate::conditional::PointWarp::BrdfMixture`).
 //!
 //! Parameters are one flat array in this order ([`Shape::param_len`]):
 //!
@@ -123,6 +127,26 @@ pub struct Shape {
     layers: u32,
     activation: Activation,
     lattice_generator: u32,
+    lattice_residual: bool,
+}
+
+/// Distance of the clamped shifted lattice point from `0` and `1` in
+/// [`lattice_logit`]: `2^-20`, exact in `f32`, so `logit` stays within `+-13.9`.
+pub const LATTICE_LOGIT_EPS: f64 = 1.0 / 1_048_576.0;
+
+/// `ln(p_a / (1 - p_a))` of the shifted lattice point read back from the input
+/// features (`p_a = (input[7 + a] + 1) / 2`, clamped into
+/// `[LATTICE_LOGIT_EPS, 1 - LATTICE_LOGIT_EPS]`): the residual base of a
+/// [`Shape::lattice_residual`] network.
+#[inline]
+pub fn lattice_logit<T: Real>(input: &[T; INPUTS]) -> [T; 2] {
+    let eps = T::of(LATTICE_LOGIT_EPS);
+    core::array::from_fn(|a| {
+        let p = ((input[CONDITION_FEATURES + 2 + a] + T::ONE) * T::of(0.5))
+            .max(eps)
+            .min(T::ONE - eps);
+        (p / (T::ONE - p)).ln()
+    })
 }
 
 impl Shape {
@@ -152,7 +176,22 @@ impl Shape {
             layers: hidden.len() as u32,
             activation,
             lattice_generator,
+            lattice_residual: false,
         })
+    }
+
+    /// The shape with the outputs a residual on [`lattice_logit`] (`true`) or plain
+    /// (`false`, what [`Shape::new`] makes).
+    pub fn with_lattice_residual(self, lattice_residual: bool) -> Self {
+        Self {
+            lattice_residual,
+            ..self
+        }
+    }
+
+    /// Whether the outputs are `o + lattice_logit(input)` (module docs).
+    pub fn lattice_residual(&self) -> bool {
+        self.lattice_residual
     }
 
     /// Points per set `n` (the number of per-index rows of `E`).
@@ -175,23 +214,46 @@ impl Shape {
         self.lattice_generator
     }
 
-    /// Number of parameters: `n h1 + sum over layers (out in + out)` with the input
-    /// layer of width [`INPUTS`] and the output layer of width [`OUTPUTS`].
+    /// Number of parameters: `n h1 +` [`Shape::multiply_adds`].
     pub fn param_len(&self) -> usize {
-        let hidden = self.hidden();
-        let mut len = self.n as usize * hidden[0] as usize;
-        let mut fan_in = INPUTS;
-        for &h in hidden {
-            len += h as usize * (fan_in + 1);
-            fan_in = h as usize;
-        }
-        len + OUTPUTS * (fan_in + 1)
+        self.first_layer_offset() + self.multiply_adds()
     }
 
     /// Multiply-adds of one forward pass (the run-time cost of a network sample,
-    /// besides the activations and the map).
+    /// besides the activations and the map): `sum over layers (out in + out)` with
+    /// the input layer of width [`INPUTS`] and the output layer of width
+    /// [`OUTPUTS`], i.e. the parameters after `E`. Independent of `n`, so it cannot
+    /// overflow however large `n` is.
     pub fn multiply_adds(&self) -> usize {
-        self.param_len() - self.n as usize * self.hidden[0] as usize
+        self.spans(0)
+            .last()
+            .map_or(0, |last| last.bias + last.width)
+    }
+
+    /// The dense layers in the order of the parameter array: the hidden layers,
+    /// first first, then the output layer of width [`OUTPUTS`]; the first has fan-in
+    /// [`INPUTS`], each next one the previous width. Offsets are into the whole
+    /// array (after `E`, from [`Shape::first_layer_offset`]).
+    pub fn layers(&self) -> impl Iterator<Item = LayerSpan> {
+        self.spans(self.first_layer_offset())
+    }
+
+    /// [`Shape::layers`] with the first layer's weights at `start`.
+    fn spans(&self, start: usize) -> impl Iterator<Item = LayerSpan> {
+        let (hidden, layers) = (self.hidden, self.layers as usize);
+        let widths = (0..layers).map(move |l| hidden[l] as usize);
+        let (mut weights, mut fan_in) = (start, INPUTS);
+        widths.chain(core::iter::once(OUTPUTS)).map(move |width| {
+            let span = LayerSpan {
+                weights,
+                bias: weights + width * fan_in,
+                fan_in,
+                width,
+            };
+            weights = span.bias + width;
+            fan_in = width;
+            span
+        })
     }
 
     /// Offset of the per-index row `E[i mod n]` in the parameter array.
@@ -204,6 +266,21 @@ impl Shape {
     pub fn first_layer_offset(&self) -> usize {
         self.n as usize * self.hidden[0] as usize
     }
+}
+
+/// Where one dense layer lies in the flat parameter array ([`Shape::layers`]): its
+/// `width x fan_in` weights row-major by output unit from `weights`, then its
+/// `width` biases from `bias = weights + width fan_in`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LayerSpan {
+    /// Offset of the first weight (row 0 of `W`).
+    pub weights: usize,
+    /// Offset of the first bias.
+    pub bias: usize,
+    /// Inputs per unit (the length of a row of `W`).
+    pub fan_in: usize,
+    /// Units (rows of `W`, biases).
+    pub width: usize,
 }
 
 /// The values a forward pass went through, which a backward pass needs: the
@@ -230,11 +307,34 @@ impl<T: Real> Trace<T> {
 /// Read access to a network's flat parameter array as `T`: an `f64` slice in the
 /// trainer, f16 bits decoded to `f32` in the runtime ([`F16Params`]). Reads past
 /// the end give 0 (never a panic).
-pub trait Parameters<T> {
+pub trait Parameters<T: Real> {
     /// Parameter `j`.
     fn get(&self, j: usize) -> T;
     /// Parameters `start..start + out.len()` into `out`.
     fn read(&self, start: usize, out: &mut [T]);
+    /// `dot(row, x)` ([`dot`]) of the row `params[start..start + len]`,
+    /// `len = min(x.len(), scratch.len())`: one unit of a dense layer. The default
+    /// [`Parameters::read`]s the row into `scratch` first (what decoding storage
+    /// needs; the caller owns the buffer so that a layer clears it once, not per
+    /// unit); storage that holds `T` dots the row in place, with the same bits.
+    #[inline(always)]
+    fn row_dot(&self, start: usize, x: &[T], scratch: &mut [T]) -> T {
+        read_dot(self, start, x, scratch)
+    }
+}
+
+/// [`Parameters::row_dot`] through a copy of the row in `scratch`.
+#[inline(always)]
+fn read_dot<T: Real, W: Parameters<T> + ?Sized>(
+    w: &W,
+    start: usize,
+    x: &[T],
+    scratch: &mut [T],
+) -> T {
+    let len = x.len().min(scratch.len());
+    let row = &mut scratch[..len];
+    w.read(start, row);
+    dot(row, x)
 }
 
 impl<T: Real> Parameters<T> for &[T] {
@@ -252,6 +352,19 @@ impl<T: Real> Parameters<T> for &[T] {
             None => out.iter_mut().enumerate().for_each(|(k, o)| {
                 *o = Parameters::get(self, start.saturating_add(k));
             }),
+        }
+    }
+    /// The row dotted where it lies (the trainer's hot path: no copy); a row that
+    /// runs past the end goes through [`Parameters::read`] (missing entries 0).
+    #[inline(always)]
+    fn row_dot(&self, start: usize, x: &[T], scratch: &mut [T]) -> T {
+        let len = x.len().min(scratch.len());
+        match start
+            .checked_add(len)
+            .and_then(|end| <[T]>::get(self, start..end))
+        {
+            Some(row) => dot(row, &x[..len]),
+            None => read_dot(self, start, x, scratch),
         }
     }
 }
@@ -335,7 +448,8 @@ impl<W> Network<W> {
 
     /// The forward pass, in this order of operations (which readers in other
     /// languages reproduce): per unit `acc = b[o]`, then `acc += E[i][o]` in the
-    /// first hidden layer, then `acc += W[o][k] x[k]` for `k` ascending.
+    /// first hidden layer, then `acc += dot(W[o], x)` ([`dot`]); with a lattice
+    /// residual, each output then `+= lattice_logit(input)[o]`.
     /// `record(layer, unit, pre_activation)` sees every hidden pre-activation.
     #[inline(always)]
     fn run<T: Real>(
@@ -354,24 +468,36 @@ impl<W> Network<W> {
         let mut a = [T::ZERO; MAX_WIDTH];
         let mut b = [T::ZERO; MAX_WIDTH];
         a[..INPUTS].copy_from_slice(input);
-        let mut fan_in = INPUTS;
-        let mut off = shape.first_layer_offset();
         let embedding = shape.embedding_offset(i);
-        for (l, &h) in shape.hidden().iter().enumerate() {
-            let h = h as usize;
-            let bias = off + h * fan_in;
-            let first = (l == 0).then_some(embedding);
-            layer(w, off, bias, first, &a[..fan_in], &mut b[..h], |o, z| {
-                record(l, o, z);
-                act.apply(z)
-            });
-            core::mem::swap(&mut a, &mut b);
-            off = bias + h;
-            fan_in = h;
-        }
+        let hidden = shape.layers as usize;
         let mut out = [T::ZERO; OUTPUTS];
-        let bias = off + OUTPUTS * fan_in;
-        layer(w, off, bias, None, &a[..fan_in], &mut out, |_, z| z);
+        for (l, span) in shape.layers().enumerate() {
+            let (x, width) = (&a[..span.fan_in], span.width);
+            if l < hidden {
+                let first = (l == 0).then_some(embedding);
+                layer(
+                    w,
+                    span.weights,
+                    span.bias,
+                    first,
+                    x,
+                    &mut b[..width],
+                    |o, z| {
+                        record(l, o, z);
+                        act.apply(z)
+                    },
+                );
+                core::mem::swap(&mut a, &mut b);
+            } else {
+                layer(w, span.weights, span.bias, None, x, &mut out, |_, z| z);
+            }
+        }
+        if shape.lattice_residual {
+            let base = lattice_logit(input);
+            for (o, b) in out.iter_mut().zip(base) {
+                *o = *o + b;
+            }
+        }
         out
     }
 }
@@ -417,15 +543,13 @@ fn layer<T: Real>(
 ) {
     let fan_in = x.len().min(MAX_WIDTH);
     let x = &x[..fan_in];
-    let mut row = [T::ZERO; MAX_WIDTH];
-    let row = &mut row[..fan_in];
+    let mut scratch = [T::ZERO; MAX_WIDTH];
     for (o, slot) in out.iter_mut().enumerate() {
         let mut acc = w.get(bias + o);
         if let Some(e) = extra {
             acc = acc + w.get(e + o);
         }
-        w.read(off + o * fan_in, row);
-        *slot = finish(o, acc + dot(row, x));
+        *slot = finish(o, acc + w.row_dot(off + o * fan_in, x, &mut scratch));
     }
 }
 
@@ -541,10 +665,50 @@ mod tests {
         // E 4x3, W1 3x11 + 3, W2 2x3 + 2, Wo 2x2 + 2.
         assert_eq!(s.param_len(), 12 + 36 + 8 + 6);
         assert_eq!(s.multiply_adds(), 36 + 8 + 6);
+        let span = |weights, fan_in, width| LayerSpan {
+            weights,
+            bias: weights + width * fan_in,
+            fan_in,
+            width,
+        };
+        let want = [span(12, 11, 3), span(48, 3, 2), span(56, 2, 2)];
+        // E 4x3, then W1/b1 at 12/45, W2/b2 at 48/54, Wo/bo at 56/60.
+        assert!(s.layers().eq(want));
         assert!(Shape::new(0, &[3], Activation::Relu, 1).is_none());
         assert!(Shape::new(4, &[], Activation::Relu, 1).is_none());
         assert!(Shape::new(4, &[129], Activation::Relu, 1).is_none());
         assert!(Shape::new(4, &[1, 1, 1, 1], Activation::Relu, 1).is_none());
+    }
+
+    /// The parameters of the tests' [`shape`] networks (62 of them).
+    fn test_params() -> [f64; 62] {
+        core::array::from_fn(|j| ((j * 37 % 23) as f64 - 11.0) / 9.0)
+    }
+
+    /// The network of [`shape`] written out as explicit matrix products for row 2 of
+    /// `E`: the two hidden pre-activations and the outputs.
+    fn explicit_forward(
+        p: &[f64; 62],
+        act: Activation,
+        x: &[f64; INPUTS],
+    ) -> ([f64; 3], [f64; 2], [f64; 2]) {
+        let (e, w1, b1) = (&p[6..9], &p[12..45], &p[45..48]);
+        let h1: [f64; 3] = core::array::from_fn(|o| {
+            b1[o] + e[o] + (0..INPUTS).map(|k| w1[o * INPUTS + k] * x[k]).sum::<f64>()
+        });
+        let (w2, b2) = (&p[48..54], &p[54..56]);
+        let a1 = h1.map(|z| act.apply(z));
+        let h2: [f64; 2] =
+            core::array::from_fn(|o| b2[o] + (0..3).map(|k| w2[o * 3 + k] * a1[k]).sum::<f64>());
+        let a2 = h2.map(|z| act.apply(z));
+        let (wo, bo) = (&p[56..60], &p[60..62]);
+        let out: [f64; 2] =
+            core::array::from_fn(|o| bo[o] + (0..2).map(|k| wo[o * 2 + k] * a2[k]).sum::<f64>());
+        (h1, h2, out)
+    }
+
+    fn close(a: &[f64], b: &[f64], tol: f64) -> bool {
+        a.iter().zip(b).all(|(x, y)| (x - y).abs() < tol)
     }
 
     /// The forward pass against the same network written out as explicit matrix
@@ -553,7 +717,7 @@ mod tests {
     fn forward_equals_explicit_matrix_products() {
         for act in [Activation::Relu, Activation::Silu] {
             let s = shape(act);
-            let p: [f64; 62] = core::array::from_fn(|j| ((j * 37 % 23) as f64 - 11.0) / 9.0);
+            let p = test_params();
             let net = Network {
                 shape: s,
                 params: &p[..],
@@ -566,24 +730,43 @@ mod tests {
                 t.output,
                 "evaluate and forward agree bit for bit"
             );
-            let (e, w1, b1) = (&p[6..9], &p[12..45], &p[45..48]);
-            let h1: [f64; 3] = core::array::from_fn(|o| {
-                b1[o] + e[o] + (0..INPUTS).map(|k| w1[o * INPUTS + k] * x[k]).sum::<f64>()
-            });
-            let (w2, b2) = (&p[48..54], &p[54..56]);
-            let a1 = h1.map(|z| act.apply(z));
-            let h2: [f64; 2] = core::array::from_fn(|o| {
-                b2[o] + (0..3).map(|k| w2[o * 3 + k] * a1[k]).sum::<f64>()
-            });
-            let a2 = h2.map(|z| act.apply(z));
-            let (wo, bo) = (&p[56..60], &p[60..62]);
-            let out: [f64; 2] = core::array::from_fn(|o| {
-                bo[o] + (0..2).map(|k| wo[o * 2 + k] * a2[k]).sum::<f64>()
-            });
-            let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-14);
-            assert!(close(&t.pre[0][..3], &h1));
-            assert!(close(&t.pre[1][..2], &h2));
-            assert!(close(&t.output, &out));
+            let (h1, h2, out) = explicit_forward(&p, act, &x);
+            assert!(close(&t.pre[0][..3], &h1, 1e-14));
+            assert!(close(&t.pre[1][..2], &h2, 1e-14));
+            assert!(close(&t.output, &out, 1e-14));
+        }
+    }
+
+    /// With a lattice residual the outputs are the explicit matrix products plus
+    /// `ln(p / (1 - p))` of the shifted lattice point `p`, taken from
+    /// [`shifted_lattice_point`] (not read back from the features); with all-zero
+    /// parameters the square point is `p` itself.
+    #[test]
+    fn lattice_residual_adds_the_logit_of_the_shifted_lattice_point() {
+        for act in [Activation::Relu, Activation::Silu] {
+            let s = shape(act).with_lattice_residual(true);
+            let (c, k, i) = ([0.3, 0.7], 5, 6); // i wraps to row 2 of E
+            let x = input_features::<f64>(&s, c, k, i);
+            let z = instance_offset::<f64>(k);
+            let p = shifted_lattice_point(i, s.n(), s.lattice_generator(), z);
+            // Away from the clamp at LATTICE_LOGIT_EPS, where the logit is exact.
+            assert!(p.iter().all(|&q| (0.01..0.99).contains(&q)), "{p:?}");
+            let logit = p.map(|q| Real::ln(q / (1.0 - q)));
+            let params = test_params();
+            let net = Network {
+                shape: s,
+                params: &params[..],
+            };
+            let (_, _, out) = explicit_forward(&params, act, &x);
+            let want = [out[0] + logit[0], out[1] + logit[1]];
+            let got = net.evaluate(i, x);
+            assert!(close(&got, &want, 1e-12), "{got:?} vs {want:?}");
+            let zero = [0.0; 62];
+            let net = Network {
+                shape: s,
+                params: &zero[..],
+            };
+            assert!(close(&net.square_point(i, x), &p, 1e-12));
         }
     }
 

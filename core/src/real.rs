@@ -50,6 +50,8 @@ pub trait Real:
     fn floor(self) -> Self;
     /// `e^self`.
     fn exp(self) -> Self;
+    /// The natural logarithm (NaN for negative arguments, `-inf` at 0).
+    fn ln(self) -> Self;
     /// `self` with the sign bit of `sign` (IEEE 754 `copySign`; `-0.0` and negative
     /// NaNs count as negative).
     fn copysign(self, sign: Self) -> Self;
@@ -104,6 +106,10 @@ impl Real for f64 {
     #[inline]
     fn exp(self) -> Self {
         libm::exp(self)
+    }
+    #[inline]
+    fn ln(self) -> Self {
+        libm::log(self)
     }
     #[inline]
     fn copysign(self, sign: Self) -> Self {
@@ -162,6 +168,10 @@ impl Real for f32 {
     #[inline]
     fn exp(self) -> Self {
         libm::expf(self)
+    }
+    #[inline]
+    fn ln(self) -> Self {
+        libm::logf(self)
     }
     #[inline]
     fn copysign(self, sign: Self) -> Self {

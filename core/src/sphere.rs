@@ -61,7 +61,7 @@ pub fn square_to_sphere_real<T: Real>(p: [T; 2]) -> [T; 3] {
     let z = (T::ONE - r * r).copysign(signed_distance);
     let cos_phi = phi.cos().copysign(u);
     let sin_phi = phi.sin().copysign(v);
-    let s = r * (two - r * r).max(T::ZERO).sqrt();
+    let s = r * safe_sqrt(two - r * r);
     [cos_phi * s, sin_phi * s, z]
 }
 
@@ -164,7 +164,7 @@ pub fn square_to_hemisphere_real<T: Real>(p: [T; 2]) -> [T; 3] {
         return [T::ZERO, T::ZERO, T::ONE];
     };
     let r2 = r * r;
-    let s = r * (T::of(2.0) - r2).max(T::ZERO).sqrt();
+    let s = r * safe_sqrt(T::of(2.0) - r2);
     [s * theta.cos(), s * theta.sin(), T::ONE - r2]
 }
 

@@ -76,6 +76,7 @@ const NULD_INFO_COND_MAX: u32 = 40u;
 const NULD_INFO_HIDDEN: u32 = 48u;
 const NULD_INFO_ACTIVATION: u32 = 60u;
 const NULD_INFO_LATTICE_GENERATOR: u32 = 64u;
+const NULD_INFO_WARP: u32 = 68u;
 
 // `nuld_core::network`: `INPUTS`, `MAX_WIDTH`, `MAX_HIDDEN_LAYERS`, `OUTPUTS`, and
 // the dot product's partial sums (`DOT_LANES`).
@@ -87,6 +88,9 @@ const NULD_DOT_LANES: u32 = 8u;
 // `Activation` codes.
 const NULD_ACTIVATION_RELU: u32 = 0u;
 const NULD_ACTIVATION_SILU: u32 = 1u;
+// `PointWarp` codes (core/src/conditional.rs).
+const NULD_WARP_EQUAL_AREA: u32 = 0u;
+const NULD_WARP_BRDF_MIXTURE: u32 = 1u;
 
 // `f32` constants written as the runtime's `f32` values (a decimal literal would be
 // rounded from the exact value, which is not always the same `f32`).
@@ -95,6 +99,17 @@ const NULD_FRAC_PI_4: f32 = 0.78539818525314331055;
 const NULD_FRAC_PI_2: f32 = 1.57079637050628662109;
 // `DEGREES_PER_RADIAN` of runtime/src/conditional.rs: `180 / PI` divided in f32.
 const NULD_DEGREES_PER_RADIAN: f32 = 57.2957763671875;
+// `f32::consts::PI` and `(pi / 180) as f32` (bits 0x40490fdb, 0x3c8efa35).
+const NULD_PI: f32 = 3.14159274101257324219;
+const NULD_RADIANS_PER_DEGREE: f32 = 0.01745329238474369049;
+// The BRDF condition's clamps (core/src/brdf.rs `MIN_ROUGHNESS`, `MAX_ROUGHNESS`,
+// `MAX_THETA_O_DEG`), as `f32`.
+const NULD_MIN_ROUGHNESS: f32 = 0.10000000149011611938;
+const NULD_MAX_ROUGHNESS: f32 = 1.0;
+const NULD_MAX_THETA_O_DEG: f32 = 89.0;
+// `2^-20`: the clamp of the shifted lattice point before its logit
+// (core/src/network.rs `LATTICE_LOGIT_EPS`).
+const NULD_LATTICE_LOGIT_EPS: f32 = 0.00000095367431640625;
 // `1 / UNORM16_CELLS` (core/src/quantize.rs).
 const NULD_UNORM16_SCALE: f32 = 0.0000152587890625;
 // `2^-24`: the instance offset's unit (core/src/network.rs `instance_offset`).
@@ -180,23 +195,27 @@ fn nuld_square_to_sphere(p: vec2<f32>) -> vec3<f32> {
     return vec3<f32>(cos_phi * s, sin_phi * s, z);
 }
 
-// Rust: `square_to_hemisphere_real` (with `concentric_polar`, core/src/warp.rs):
-// the Shirley-Chiu concentric map lifted to the upper hemisphere, equal-area.
-fn nuld_square_to_hemisphere(p: vec2<f32>) -> vec3<f32> {
+// Rust: `concentric_polar` (core/src/warp.rs): the signed polar form `(r, theta)`
+// of the Shirley-Chiu concentric map, `(0, 0)` at the square's centre (where Rust
+// has `None`; both callers then give Rust's result bit for bit).
+fn nuld_concentric_polar(p: vec2<f32>) -> vec2<f32> {
     let a = 2.0 * p.x - 1.0;
     let b = 2.0 * p.y - 1.0;
     if a == 0.0 && b == 0.0 {
-        return vec3<f32>(0.0, 0.0, 1.0);
+        return vec2<f32>(0.0, 0.0);
     }
-    var r: f32;
-    var theta: f32;
     if abs(a) > abs(b) {
-        r = a;
-        theta = NULD_FRAC_PI_4 * (b / a);
-    } else {
-        r = b;
-        theta = NULD_FRAC_PI_2 - NULD_FRAC_PI_4 * (a / b);
+        return vec2<f32>(a, NULD_FRAC_PI_4 * (b / a));
     }
+    return vec2<f32>(b, NULD_FRAC_PI_2 - NULD_FRAC_PI_4 * (a / b));
+}
+
+// Rust: `square_to_hemisphere_real` (core/src/sphere.rs): the concentric map
+// lifted to the upper hemisphere, equal-area.
+fn nuld_square_to_hemisphere(p: vec2<f32>) -> vec3<f32> {
+    let polar = nuld_concentric_polar(p);
+    let r = polar.x;
+    let theta = polar.y;
     let r2 = r * r;
     let s = r * sqrt(max(2.0 - r2, 0.0));
     return vec3<f32>(s * cos(theta), s * sin(theta), 1.0 - r2);
@@ -209,6 +228,85 @@ fn nuld_to_direction(domain: u32, p: vec2<f32>) -> vec3<f32> {
         return nuld_square_to_hemisphere(p);
     }
     return nuld_square_to_sphere(p);
+}
+
+// ---- The renderer's BRDF mixture warp (core/src/warp.rs, core/src/brdf.rs) -----
+
+// Rust: `f32::max(x, 0).min(1)`: `x` clamped into `[0, 1]`, NaN as 0 (WGSL's
+// `clamp` leaves NaN to the driver).
+fn nuld_clamp01(x: f32) -> f32 {
+    if nuld_is_nan(x) {
+        return 0.0;
+    }
+    return clamp(x, 0.0, 1.0);
+}
+
+// Rust: `normalize_real`: `x * (1 / |x|)`, in its order of operations.
+fn nuld_normalize3(x: vec3<f32>) -> vec3<f32> {
+    let inv = 1.0 / sqrt(x.x * x.x + x.y * x.y + x.z * x.z);
+    return vec3<f32>(x.x * inv, x.y * inv, x.z * inv);
+}
+
+// Rust: `square_to_cosine_hemisphere_real`: the concentric disk point lifted by
+// `z = sqrt(max(1 - (x^2 + y^2), 0))` (Malley's method).
+fn nuld_square_to_cosine_hemisphere(p: vec2<f32>) -> vec3<f32> {
+    let polar = nuld_concentric_polar(p);
+    let x = polar.x * cos(polar.y);
+    let y = polar.x * sin(polar.y);
+    return vec3<f32>(x, y, sqrt(max(1.0 - (x * x + y * y), 0.0)));
+}
+
+// Rust: `sample_ggx_vndf_real` (with `vndf_frame`): GGX visible normals (Heitz
+// 2018, Listing 1) of the unit view `wo`, isotropic `alpha`.
+fn nuld_sample_ggx_vndf(wo: vec3<f32>, alpha: f32, u: vec2<f32>) -> vec3<f32> {
+    let vh = nuld_normalize3(vec3<f32>(alpha * wo.x, alpha * wo.y, wo.z));
+    let lensq = vh.x * vh.x + vh.y * vh.y;
+    var t1 = vec3<f32>(1.0, 0.0, 0.0);
+    if lensq > 0.0 {
+        let len = sqrt(lensq);
+        t1 = vec3<f32>(0.0 - vh.y / len, vh.x / len, 0.0);
+    }
+    let t2 = vec3<f32>(
+        vh.y * t1.z - t1.y * vh.z,
+        vh.z * t1.x - t1.z * vh.x,
+        vh.x * t1.y - t1.x * vh.y,
+    );
+    let r = sqrt(nuld_clamp01(u.x));
+    let phi = 2.0 * NULD_PI * u.y;
+    let p1 = r * cos(phi);
+    var p2 = r * sin(phi);
+    let s = 0.5 * (1.0 + vh.z);
+    p2 = (1.0 - s) * sqrt(max(1.0 - p1 * p1, 0.0)) + s * p2;
+    let q = sqrt(max(1.0 - p1 * p1 - p2 * p2, 0.0));
+    let nh = vec3<f32>(
+        p1 * t1.x + p2 * t2.x + q * vh.x,
+        p1 * t1.y + p2 * t2.y + q * vh.y,
+        p1 * t1.z + p2 * t2.z + q * vh.z,
+    );
+    return nuld_normalize3(vec3<f32>(alpha * nh.x, alpha * nh.y, max(nh.z, 0.0)));
+}
+
+// Rust: `brdf_mixture_direction` (core/src/conditional.rs) and `brdf_mixture_real`
+// (core/src/warp.rs): the point `p` warped by the renderer's mixture at the BRDF
+// condition `c = (roughness, theta_o in degrees)` with lobe probability `p_s`:
+// `p.x < p_s` picks the GGX lobe (visible normals at `(p.x / p_s, p.y)`, reflected),
+// otherwise the cosine lobe at `((p.x - p_s) / (1 - p_s), p.y)`; a direction below
+// the horizon is mirrored. Step 8 of core/FORMAT.md.
+fn nuld_brdf_mixture(c: vec2<f32>, p_s: f32, p: vec2<f32>) -> vec3<f32> {
+    let t = min(max(c.y, 0.0), NULD_MAX_THETA_O_DEG) * NULD_RADIANS_PER_DEGREE;
+    let wo = vec3<f32>(sin(t), 0.0, cos(t));
+    let roughness = min(max(c.x, NULD_MIN_ROUGHNESS), NULD_MAX_ROUGHNESS);
+    let alpha = roughness * roughness;
+    let ux = nuld_clamp01(p.x);
+    var wi: vec3<f32>;
+    if ux < p_s {
+        let h = nuld_sample_ggx_vndf(wo, alpha, vec2<f32>(min(ux / p_s, 1.0), p.y));
+        let d = 2.0 * (wo.x * h.x + wo.y * h.y + wo.z * h.z);
+        wi = vec3<f32>(d * h.x - wo.x, d * h.y - wo.y, d * h.z - wo.z);
+    } else {
+        wi = nuld_square_to_cosine_hemisphere(vec2<f32>(nuld_clamp01((ux - p_s) / (1.0 - p_s)), p.y));
+    }
+    return nuld_normalize3(vec3<f32>(wi.x, wi.y, abs(wi.z)));
 }
 
 // ---- Point and direction sets (kinds 1 and 2; runtime/src/points.rs) ----------
@@ -276,6 +374,7 @@ struct NuldConditionalInfo {
     hidden: vec3<u32>,
     activation: u32,
     lattice_generator: u32,
+    warp: u32,
 }
 
 // Rust: `ConditionalSampler::info` (the info section read from the buffer).
@@ -298,6 +397,7 @@ fn nuld_info() -> NuldConditionalInfo {
     }
     info.activation = nuld_u32(o + NULD_INFO_ACTIVATION);
     info.lattice_generator = nuld_u32(o + NULD_INFO_LATTICE_GENERATOR);
+    info.warp = nuld_u32(o + NULD_INFO_WARP);
     return info;
 }
 
@@ -395,8 +495,14 @@ fn nuld_weight(cond: vec2<f32>) -> f32 {
 
 // `nuld_weight` at the normalized condition `u` of the sampler `cs`.
 fn nuld_weight_of(cs: NuldConditional, u: vec2<f32>) -> f32 {
-    let cell = nuld_locate(u, cs.info.weight_grid);
-    let w = cs.weights;
+    return nuld_weight_table_lerp(cs, nuld_locate(u, cs.info.weight_grid), 0u);
+}
+
+// Rust: `ConditionalSampler::weight_table_lerp`: table `table` of the weight
+// section (0: weights, 1: the mixture warp's lobe probabilities) interpolated in
+// the weight-grid cell `cell`.
+fn nuld_weight_table_lerp(cs: NuldConditional, cell: NuldGridCell, table: u32) -> f32 {
+    let w = cs.weights + 4u * table * cs.info.weight_grid.x * cs.info.weight_grid.y;
     return nuld_lerp(
         cell,
         nuld_f32(w + 4u * nuld_node(cell, 0u, 0u)),
@@ -642,10 +748,19 @@ fn nuld_network_evaluate(cs: NuldConditional, i: u32, input: array<f32, 11>) -> 
         fan_in = h;
     }
     let bias = off + NULD_OUTPUTS * fan_in;
-    return vec2<f32>(
+    var out = vec2<f32>(
         nuld_param(params, bias) + nuld_dot(params, off, &a, fan_in),
         nuld_param(params, bias + 1u) + nuld_dot(params, off + fan_in, &a, fan_in),
     );
+    if info.warp == NULD_WARP_BRDF_MIXTURE {
+        // Rust: `lattice_logit`: the outputs are a residual on the logit of the
+        // shifted lattice point, read back from its input features.
+        for (var o = 0u; o < NULD_OUTPUTS; o++) {
+            let q = clamp((input[7u + o] + 1.0) * 0.5, NULD_LATTICE_LOGIT_EPS, 1.0 - NULD_LATTICE_LOGIT_EPS);
+            out[o] = out[o] + log(q / (1.0 - q));
+        }
+    }
+    return out;
 }
 
 // Rust: `ConditionalSampler::network_square_point` (network mode): the network's
@@ -676,8 +791,7 @@ struct NuldSample {
 fn nuld_sample(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
     let cs = nuld_conditional();
     let u = nuld_normalize(cs.info, cond);
-    let p = nuld_square_point_of(cs, u, instance, i);
-    return NuldSample(nuld_to_direction(cs.info.domain, p), nuld_weight_of(cs, u));
+    return nuld_mapped(cs, nuld_square_point_of(cs, u, instance, i), u);
 }
 
 // Rust: `ConditionalSampler::sample_network` (network mode): as `nuld_sample`, every
@@ -685,8 +799,25 @@ fn nuld_sample(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
 fn nuld_sample_network(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
     let cs = nuld_conditional();
     let u = nuld_normalize(cs.info, cond);
-    let p = nuld_network_square_point_of(cs, u, instance, i);
-    return NuldSample(nuld_to_direction(cs.info.domain, p), nuld_weight_of(cs, u));
+    return nuld_mapped(cs, nuld_network_square_point_of(cs, u, instance, i), u);
+}
+
+// Rust: `ConditionalSampler::mapped`: the sample of the square point `p` at the
+// normalized condition `u`: the direction of the blob's point warp (warp 0: the
+// domain's equal-area map; warp 1: the BRDF mixture at the clamped condition with
+// the lobe probability of the weight section's second table) and the weight.
+fn nuld_mapped(cs: NuldConditional, p: vec2<f32>, u: vec2<f32>) -> NuldSample {
+    let cell = nuld_locate(u, cs.info.weight_grid);
+    var direction: vec3<f32>;
+    if cs.info.warp == NULD_WARP_BRDF_MIXTURE {
+        let lo = cs.info.cond_min;
+        let hi = cs.info.cond_max;
+        let c = vec2<f32>(lo.x + u.x * (hi.x - lo.x), lo.y + u.y * (hi.y - lo.y));
+        direction = nuld_brdf_mixture(c, nuld_weight_table_lerp(cs, cell, 1u), p);
+    } else {
+        direction = nuld_to_direction(cs.info.domain, p);
+    }
+    return NuldSample(direction, nuld_weight_table_lerp(cs, cell, 0u));
 }
 
 // `libm::acosf`'s constants (FreeBSD e_acosf.c): pi/2 split in a high part

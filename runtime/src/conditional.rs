@@ -9,7 +9,7 @@
 use glam::{Vec2, Vec3};
 use nuld_core::blob::{BlobError, Domain, Layout, SectionTag};
 use nuld_core::conditional::{
-    unpack_point, ConditionalInfo, ConditionalTarget, GridCell, CONDITIONAL_INFO_LEN,
+    unpack_point, ConditionalInfo, ConditionalTarget, GridCell, PointWarp, CONDITIONAL_INFO_LEN,
 };
 use nuld_core::network::{input_features, Activation, F16Params, Network, Shape};
 use nuld_core::quantize::{f16_is_finite, unorm16_decode};
@@ -41,6 +41,7 @@ pub struct ConditionalSampler<'a> {
     info: ConditionalInfo,
     shape: Shape,
     domain: Domain,
+    warp: PointWarp,
     params: &'a [u16],
     table: &'a [u32],
     weights: &'a [f32],
@@ -88,21 +89,33 @@ impl<'a> ConditionalSampler<'a> {
             Some(d @ (Domain::Sphere | Domain::Hemisphere)) => d,
             _ => return Err(BlobError::ConditionalDomain(info.domain)),
         };
-        if ConditionalTarget::from_code(info.target).is_none() {
+        let Some(target) = ConditionalTarget::from_code(info.target) else {
             return Err(BlobError::UnknownConditionalTarget(info.target));
-        }
-        for axis in 0..2 {
-            let nodes = info.grid[axis];
-            if nodes < 2 {
-                let axis = axis as u32;
-                return Err(BlobError::ConditionalGrid { axis, nodes });
+        };
+        let warp = match info.point_warp() {
+            Some(PointWarp::BrdfMixture)
+                if !(target == ConditionalTarget::GltfBrdf && domain == Domain::Hemisphere) =>
+            {
+                return Err(BlobError::UnknownPointWarp(info.warp))
             }
-        }
-        for axis in 0..2 {
-            let nodes = info.weight_grid[axis];
-            if nodes < 2 {
-                let axis = axis as u32;
-                return Err(BlobError::ConditionalWeightGrid { axis, nodes });
+            Some(w) => w,
+            None => return Err(BlobError::UnknownPointWarp(info.warp)),
+        };
+        type GridError = fn(u32, u32) -> BlobError;
+        let grids: [([u32; 2], GridError); 2] = [
+            (info.grid, |axis, nodes| BlobError::ConditionalGrid {
+                axis,
+                nodes,
+            }),
+            (info.weight_grid, |axis, nodes| {
+                BlobError::ConditionalWeightGrid { axis, nodes }
+            }),
+        ];
+        for (grid, error) in grids {
+            for (axis, &nodes) in (0u32..).zip(&grid) {
+                if nodes < 2 {
+                    return Err(error(axis, nodes));
+                }
             }
         }
         for axis in 0..2 {
@@ -119,54 +132,45 @@ impl<'a> ConditionalSampler<'a> {
             return Err(BlobError::UnknownActivation(info.activation));
         }
         let shape = info.shape().ok_or(BlobError::NetworkWidths(info.hidden))?;
-        if info.reserved != [0; 3] {
+        if info.reserved != [0; 2] {
             return Err(BlobError::ConditionalReserved(info.reserved));
         }
 
-        let (entry, bytes) = layout.section(SectionTag::NetworkParams)?;
-        if entry.elem_size != 2 {
-            return Err(BlobError::ParamElementSize(entry.elem_size));
-        }
-        // Counted in u64: `Shape::param_len` multiplies `n h1` in `usize`, which a
-        // hostile `n` could overflow on a 32-bit target. The other parameters do not
-        // depend on `n`, so a one-point shape counts them.
-        let h1 = shape.hidden().first().copied().unwrap_or(0) as u64;
-        let rest = Shape::new(1, shape.hidden(), shape.activation(), 0)
-            .map_or(0, |s| s.multiply_adds() as u64);
-        let expected = info.n as u64 * h1 + rest;
-        let got = bytes.len() as u64 / 2;
-        if got != expected {
-            return Err(BlobError::ParamsLength { expected, got });
-        }
-        let params: &[u16] = bytemuck::try_cast_slice(bytes).map_err(|_| BlobError::Misaligned)?;
-
-        let (entry, bytes) = layout.section(SectionTag::PointTable)?;
-        if entry.elem_size != 4 {
-            return Err(BlobError::PointTableElementSize(entry.elem_size));
-        }
-        let expected = info
-            .point_table_len()
-            .ok_or(BlobError::PointTableCountOverflow)?;
-        let got = bytes.len() as u64 / 4;
-        if got != expected {
-            return Err(BlobError::PointTableLength { expected, got });
-        }
-        let table: &[u32] = bytemuck::try_cast_slice(bytes).map_err(|_| BlobError::Misaligned)?;
-
-        let (entry, bytes) = layout.section(SectionTag::WeightTable)?;
-        if entry.elem_size != 4 {
-            return Err(BlobError::WeightElementSize(entry.elem_size));
-        }
-        let expected = info.weight_table_len();
-        let got = bytes.len() as u64 / 4;
-        if got != expected {
-            return Err(BlobError::WeightTableLength { expected, got });
-        }
-        let weights: &[f32] = bytemuck::try_cast_slice(bytes).map_err(|_| BlobError::Misaligned)?;
+        let params: &[u16] = typed_section(
+            layout,
+            SectionTag::NetworkParams,
+            BlobError::ParamElementSize,
+            || {
+                // Counted in u64: `Shape::param_len` multiplies `n h1` in `usize`,
+                // which a hostile `n` could overflow on a 32-bit target;
+                // `multiply_adds` does not depend on `n`.
+                let h1 = shape.hidden().first().copied().unwrap_or(0) as u64;
+                Ok(info.n as u64 * h1 + shape.multiply_adds() as u64)
+            },
+            |expected, got| BlobError::ParamsLength { expected, got },
+        )?;
+        let table: &[u32] = typed_section(
+            layout,
+            SectionTag::PointTable,
+            BlobError::PointTableElementSize,
+            || {
+                info.point_table_len()
+                    .ok_or(BlobError::PointTableCountOverflow)
+            },
+            |expected, got| BlobError::PointTableLength { expected, got },
+        )?;
+        let weights: &[f32] = typed_section(
+            layout,
+            SectionTag::WeightTable,
+            BlobError::WeightElementSize,
+            || Ok(info.weight_table_len() * info.weight_tables()),
+            |expected, got| BlobError::WeightTableLength { expected, got },
+        )?;
         Ok(Self {
             info,
             shape,
             domain,
+            warp,
             params,
             table,
             weights,
@@ -235,9 +239,38 @@ impl<'a> ConditionalSampler<'a> {
     /// `info().normalize(cond)`. Finite and `>= 0`. O(1), never panics.
     #[inline]
     pub fn weight(&self, cond: Vec2) -> f32 {
-        let cell = GridCell::locate(self.info.normalize(cond.to_array()), self.info.weight_grid);
-        let w = |dx, dy| self.weights.get(cell.node(dx, dy)).copied().unwrap_or(0.0);
+        self.weight_table_lerp(&self.weight_cell(cond), 0)
+    }
+
+    /// The weight-grid cell of `cond` (blob units, clamped like [`Self::weight`]).
+    #[inline]
+    fn weight_cell(&self, cond: Vec2) -> GridCell {
+        self.weight_cell_at(self.info.normalize(cond.to_array()))
+    }
+
+    /// The weight-grid cell of the normalized condition `u`.
+    #[inline]
+    fn weight_cell_at(&self, u: [f32; 2]) -> GridCell {
+        GridCell::locate(u, self.info.weight_grid)
+    }
+
+    /// Table `table` of the weight section (0: weights, 1: lobe probabilities)
+    /// interpolated bilinearly in `cell`.
+    #[inline]
+    fn weight_table_lerp(&self, cell: &GridCell, table: usize) -> f32 {
+        let base = table * self.info.weight_table_len() as usize;
+        let w = |dx, dy| {
+            let at = base + cell.node(dx, dy);
+            self.weights.get(at).copied().unwrap_or(0.0)
+        };
         cell.lerp(w(0, 0), w(1, 0), w(0, 1), w(1, 1))
+    }
+
+    /// The lobe probability `p_s` of a [`PointWarp::BrdfMixture`] sampler at
+    /// `cond`: the second table of the weight section, interpolated as the weights.
+    #[inline]
+    pub fn lobe_probability(&self, cond: Vec2) -> f32 {
+        self.weight_table_lerp(&self.weight_cell(cond), 1)
     }
 
     /// Table mode's point of the unit square for index `i` (mod `n`) of instance
@@ -248,8 +281,13 @@ impl<'a> ConditionalSampler<'a> {
     /// ([`GridCell::lerp`]), x and y separately. In `(0,1)^2`. O(1), never panics.
     #[inline]
     pub fn square_point(&self, cond: Vec2, instance: u32, i: u32) -> Vec2 {
+        self.square_point_at(self.info.normalize(cond.to_array()), instance, i)
+    }
+
+    /// [`Self::square_point`] at the normalized condition `u`.
+    #[inline]
+    fn square_point_at(&self, u: [f32; 2], instance: u32, i: u32) -> Vec2 {
         let info = &self.info;
-        let u = info.normalize(cond.to_array());
         let cell = GridCell::locate(u, info.grid);
         let k = instance.checked_rem(info.instances).unwrap_or(0);
         let j = i.checked_rem(info.n).unwrap_or(0);
@@ -278,7 +316,12 @@ impl<'a> ConditionalSampler<'a> {
     /// then `sigmoid` per output. In `[0,1]^2`. `O(multiply_adds)`, never panics.
     #[inline]
     pub fn network_square_point(&self, cond: Vec2, instance: u32, i: u32) -> Vec2 {
-        let u = self.info.normalize(cond.to_array());
+        self.network_square_point_at(self.info.normalize(cond.to_array()), instance, i)
+    }
+
+    /// [`Self::network_square_point`] at the normalized condition `u`.
+    #[inline]
+    fn network_square_point_at(&self, u: [f32; 2], instance: u32, i: u32) -> Vec2 {
         let input = input_features::<f32>(&self.shape, u, instance, i);
         let params = self.params;
         let net = Network {
@@ -308,7 +351,8 @@ impl<'a> ConditionalSampler<'a> {
     /// ```
     #[inline]
     pub fn sample(&self, cond: Vec2, instance: u32, i: u32) -> Sample {
-        self.mapped(self.square_point(cond, instance, i), cond)
+        let u = self.info.normalize(cond.to_array());
+        self.mapped(self.square_point_at(u, instance, i), u)
     }
 
     /// Network mode: as [`Self::sample`] with [`Self::network_square_point`]; every
@@ -316,7 +360,8 @@ impl<'a> ConditionalSampler<'a> {
     /// `O(multiply_adds)`, never panics.
     #[inline]
     pub fn sample_network(&self, cond: Vec2, instance: u32, i: u32) -> Sample {
-        self.mapped(self.network_square_point(cond, instance, i), cond)
+        let u = self.info.normalize(cond.to_array());
+        self.mapped(self.network_square_point_at(u, instance, i), u)
     }
 
     /// Table mode for a BRDF sampler ([`ConditionalTarget::GltfBrdf`]) at any view:
@@ -359,13 +404,53 @@ impl<'a> ConditionalSampler<'a> {
         rotate(self.sample_network(cond, instance, i), azimuth)
     }
 
+    /// The sample of point `p` at the normalized condition `u`: the direction of
+    /// [`PointWarp::direction`], the weight of [`Self::weight`]; one weight-grid
+    /// cell serves the weight and the lobe probability.
     #[inline]
-    fn mapped(&self, p: Vec2, cond: Vec2) -> Sample {
+    fn mapped(&self, p: Vec2, u: [f32; 2]) -> Sample {
+        let cell = self.weight_cell_at(u);
+        // Only the mixture warp reads the condition and `p_s`; the equal-area map
+        // skips their lookups.
+        let (cond, p_s) = match self.warp {
+            PointWarp::EqualArea => ([0.0; 2], 0.0),
+            PointWarp::BrdfMixture => {
+                // The clamped condition in blob units, as the tables see it.
+                let (lo, hi) = (self.info.cond_min, self.info.cond_max);
+                let c = [0, 1].map(|a| lo[a] + u[a] * (hi[a] - lo[a]));
+                (c, self.weight_table_lerp(&cell, 1))
+            }
+        };
+        let direction = self.warp.direction(self.domain, cond, p_s, p.to_array());
         Sample {
-            direction: Vec3::from_array(self.domain.to_direction_real(p.to_array())),
-            weight: self.weight(cond),
+            direction: Vec3::from_array(direction),
+            weight: self.weight_table_lerp(&cell, 0),
         }
     }
+}
+
+/// Section `tag` of `layout` as a slice of `T`, checked in this order: the section
+/// exists; its `elem_size` is `size_of::<T>()` (else `bad_size(elem_size)`); it holds
+/// exactly `expected()?` elements (else `bad_length(expected, got)`); it is aligned
+/// for `T` (else [`BlobError::Misaligned`]).
+fn typed_section<'a, T: bytemuck::Pod>(
+    layout: &Layout<'a>,
+    tag: SectionTag,
+    bad_size: fn(u32) -> BlobError,
+    expected: impl FnOnce() -> Result<u64, BlobError>,
+    bad_length: fn(u64, u64) -> BlobError,
+) -> Result<&'a [T], BlobError> {
+    let (entry, bytes) = layout.section(tag)?;
+    let size = core::mem::size_of::<T>();
+    if entry.elem_size as usize != size {
+        return Err(bad_size(entry.elem_size));
+    }
+    let expected = expected()?;
+    let got = (bytes.len() / size) as u64;
+    if got != expected {
+        return Err(bad_length(expected, got));
+    }
+    bytemuck::try_cast_slice(bytes).map_err(|_| BlobError::Misaligned)
 }
 
 /// The condition `(roughness, theta_o in degrees)` of a view `wo` and its azimuth
@@ -406,7 +491,8 @@ mod tests {
     extern crate std;
     use super::*;
     use crate::Blob;
-    use nuld_core::blob::{encoded_len, write, BlobKind, SectionSpec};
+    use nuld_core::blob::{encoded_len, write, BlobKind};
+    use nuld_core::conditional::sections;
     use nuld_core::quantize::f16_encode;
     use std::vec::Vec;
 
@@ -448,7 +534,8 @@ mod tests {
             hidden: [4, 3, 0],
             activation: Activation::Silu as u32,
             lattice_generator: 2,
-            reserved: [0; 3],
+            warp: 0,
+            reserved: [0; 2],
         };
         let len = info.shape().unwrap().param_len();
         let params = (0..len as u32)
@@ -480,28 +567,7 @@ mod tests {
     }
 
     fn encode(p: &Parts) -> Bytes {
-        let sections = [
-            SectionSpec {
-                tag: SectionTag::ConditionalInfo,
-                elem_size: CONDITIONAL_INFO_LEN as u32,
-                bytes: bytemuck::bytes_of(&p.info),
-            },
-            SectionSpec {
-                tag: SectionTag::NetworkParams,
-                elem_size: 2,
-                bytes: bytemuck::cast_slice(&p.params),
-            },
-            SectionSpec {
-                tag: SectionTag::PointTable,
-                elem_size: 4,
-                bytes: bytemuck::cast_slice(&p.table),
-            },
-            SectionSpec {
-                tag: SectionTag::WeightTable,
-                elem_size: 4,
-                bytes: bytemuck::cast_slice(&p.weights),
-            },
-        ];
+        let sections = sections(&p.info, &p.params, &p.table, &p.weights);
         let meta = [0u8, 0, 0];
         let len = encoded_len(&meta, &sections);
         let mut buf = std::vec![0u128; len.div_ceil(16)];
@@ -686,7 +752,7 @@ mod tests {
     fn each_validation_failure_has_its_error() {
         assert_eq!(with(|_| {}), Ok(()));
         type Change = fn(&mut Parts);
-        let cases: [(Change, BlobError); 22] = [
+        let cases: [(Change, BlobError); 24] = [
             (|p| p.info.n = 0, BlobError::ConditionalNoPoints),
             (|p| p.info.instances = 0, BlobError::ConditionalNoInstances),
             (|p| p.info.domain = 0, BlobError::ConditionalDomain(0)),
@@ -741,8 +807,16 @@ mod tests {
                 BlobError::NetworkWidths([129, 3, 0]),
             ),
             (
-                |p| p.info.reserved[2] = 1,
-                BlobError::ConditionalReserved([0, 0, 1]),
+                |p| p.info.reserved[1] = 1,
+                BlobError::ConditionalReserved([0, 1]),
+            ),
+            (|p| p.info.warp = 7, BlobError::UnknownPointWarp(7)),
+            (
+                |p| {
+                    p.info.warp = 1;
+                    p.info.domain = 1;
+                },
+                BlobError::UnknownPointWarp(1),
             ),
             (
                 |p| {

@@ -274,8 +274,8 @@ pub fn doc_example_blob() -> Aligned<[u8; 160]> {
 /// one-unit network.
 #[doc(hidden)]
 pub fn doc_example_conditional_blob() -> Aligned<[u8; 400]> {
-    use nuld_core::blob::{write, SectionSpec};
-    use nuld_core::conditional::{pack_point, CONDITIONAL_INFO_LEN};
+    use nuld_core::blob::write;
+    use nuld_core::conditional::pack_point;
     let info = ConditionalInfo {
         n: 2,
         instances: 2,
@@ -288,7 +288,8 @@ pub fn doc_example_conditional_blob() -> Aligned<[u8; 400]> {
         hidden: [1, 0, 0],
         activation: 0,
         lattice_generator: 1,
-        reserved: [0; 3],
+        warp: 0,
+        reserved: [0; 2],
     };
     // 2 x 1 embedding, 1 x 11 + 1 first layer, 2 x 1 + 2 output: 18 parameters.
     let params: [u16; 18] =
@@ -302,28 +303,7 @@ pub fn doc_example_conditional_blob() -> Aligned<[u8; 400]> {
     let meta = [
         3, b'd', b'o', b'c', 7, b'g', b'l', b't', b'f', b'-', b'd', b'o', 0,
     ];
-    let sections = [
-        SectionSpec {
-            tag: SectionTag::ConditionalInfo,
-            elem_size: CONDITIONAL_INFO_LEN as u32,
-            bytes: bytemuck::bytes_of(&info),
-        },
-        SectionSpec {
-            tag: SectionTag::NetworkParams,
-            elem_size: 2,
-            bytes: bytemuck::cast_slice(&params),
-        },
-        SectionSpec {
-            tag: SectionTag::PointTable,
-            elem_size: 4,
-            bytes: bytemuck::cast_slice(&table),
-        },
-        SectionSpec {
-            tag: SectionTag::WeightTable,
-            elem_size: 4,
-            bytes: bytemuck::cast_slice(&weights),
-        },
-    ];
+    let sections = nuld_core::conditional::sections(&info, &params, &table, &weights);
     // 48 + 4 x 32 + 13 -> 192; info 80 -> 272; params 36 -> 320; table 64 -> 384;
     // weights 16 -> 400 bytes: exactly the array, which `write` checks.
     let mut out = Aligned([0u8; 400]);

@@ -14,6 +14,7 @@
 #[path = "shader_sample.rs"]
 mod shader_sample;
 
+use nuld_core::conditional::PointWarp;
 use nuld_core::network::Activation;
 use nuld_runtime::shader::{kernel_wgsl, KernelMode, KernelParams, KERNEL_ENTRY_POINT};
 use nuld_tests::{conditional_parts, META};
@@ -61,7 +62,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ),
     ];
     for (label, hidden, act, mode, instances) in cases {
-        let bytes = conditional_parts(64, hidden, act, 16, [10, 9], 2).to_blob(&META)?;
+        let bytes = conditional_parts(64, hidden, act, 16, [10, 9], PointWarp::BrdfMixture, 2)
+            .to_blob(&META)?;
         // 16 x 16 conditions over the blob's range, `instances` instances, 64 indices.
         let mut p = KernelParams::new(mode, [0.1, 0.0], [0.06, 5.9], [16, 16], 0..instances, 0..64);
         p.view = [0.3, 0.4, 0.866, 0.0];

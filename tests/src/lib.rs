@@ -40,9 +40,10 @@ pub fn conditional_parts(
     activation: nuld_core::network::Activation,
     instances: u32,
     grid: [u32; 2],
+    warp: nuld_core::conditional::PointWarp,
     seed: u64,
 ) -> nuld_build_tool::conditional::blob::ConditionalParts {
-    nuld_build_tool::runtime_speed::random_parts(n, hidden, activation, instances, grid, seed)
+    nuld_build_tool::runtime_speed::random_parts(n, hidden, activation, instances, grid, warp, seed)
         .expect("a valid fixture shape")
 }
 

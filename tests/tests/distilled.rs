@@ -3,6 +3,7 @@
 //! independent quadrature.
 
 use glam::Vec2;
+use nuld_build_tool::pointset::AlignedBytes;
 use nuld_build_tool::sphere::brdf_albedo::directional_albedo;
 use nuld_core::brdf::BrdfModel;
 use nuld_core::quantize::UNORM16_MAX_ERROR;
@@ -10,25 +11,30 @@ use nuld_runtime::{Blob, ConditionalSampler};
 use nuld_tests::{distilled_parts, META};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
+use std::sync::OnceLock;
 
 const GRID: [u32; 2] = [5, 6];
 const WEIGHT_GRID: [u32; 2] = [10, 9];
 const INSTANCES: u32 = 3;
 
-/// Hands the runtime's view of a briefly trained, distilled blob to `f`.
-fn with_distilled(f: impl FnOnce(ConditionalSampler<'_>)) {
-    let parts = distilled_parts(INSTANCES, GRID, WEIGHT_GRID);
-    let bytes = parts.to_blob(&META).unwrap();
-    f(Blob::parse(bytes.as_slice())
+/// The runtime's view of the distilled blob of a small network trained for a few
+/// steps (enough to leave the initialization); trained once, shared by the tests.
+fn distilled() -> ConditionalSampler<'static> {
+    static BLOB: OnceLock<AlignedBytes> = OnceLock::new();
+    let bytes = BLOB.get_or_init(|| {
+        distilled_parts(INSTANCES, GRID, WEIGHT_GRID)
+            .to_blob(&META)
+            .unwrap()
+    });
+    Blob::parse(bytes.as_slice())
         .unwrap()
         .conditional()
-        .unwrap());
+        .unwrap()
 }
 
-/// The condition of grid node `(j0, j1)` on `nodes`, in blob units.
-fn node(j: [u32; 2], nodes: [u32; 2]) -> Vec2 {
-    let t = |a: usize| j[a] as f32 / (nodes[a] - 1) as f32;
-    Vec2::new(0.1 + 0.9 * t(0), 89.0 * t(1))
+/// A node's condition (`f64`, blob units) as the `f32` condition a caller passes.
+fn node(c: [f64; 2]) -> Vec2 {
+    Vec2::new(c[0] as f32, c[1] as f32)
 }
 
 /// Table mode equals network mode at the grid nodes up to the table's u16 code
@@ -40,54 +46,54 @@ fn node(j: [u32; 2], nodes: [u32; 2]) -> Vec2 {
 /// conditions to stay within twice the largest midpoint error plus the node bound.
 #[test]
 fn table_mode_follows_network_mode_within_a_measured_bound() {
-    with_distilled(|cs| {
-        let n = cs.len();
-        let gap = |c: Vec2, k: u32, i: u32| {
-            (cs.square_point(c, k, i) - cs.network_square_point(c, k, i))
-                .abs()
-                .max_element()
-        };
-        let node_bound = UNORM16_MAX_ERROR as f32 + 1e-5;
-        let mut at_nodes = 0.0f32;
-        let mut at_midpoints = 0.0f32;
-        for j1 in 0..GRID[1] {
-            for j0 in 0..GRID[0] {
-                let here = node([j0, j1], GRID);
-                let steps = [
-                    (node([(j0 + 1).min(GRID[0] - 1), j1], GRID) - here) / 2.0,
-                    (node([j0, (j1 + 1).min(GRID[1] - 1)], GRID) - here) / 2.0,
-                ];
-                for k in 0..INSTANCES {
-                    for i in 0..n {
-                        at_nodes = at_nodes.max(gap(here, k, i));
-                        for mid in [here + steps[0], here + steps[1], here + steps[0] + steps[1]] {
-                            at_midpoints = at_midpoints.max(gap(mid, k, i));
-                        }
+    let cs = distilled();
+    let n = cs.len();
+    let gap = |c: Vec2, k: u32, i: u32| {
+        (cs.square_point(c, k, i) - cs.network_square_point(c, k, i))
+            .abs()
+            .max_element()
+    };
+    let node_bound = UNORM16_MAX_ERROR as f32 + 1e-5;
+    let mut at_nodes = 0.0f32;
+    let mut at_midpoints = 0.0f32;
+    for j1 in 0..GRID[1] {
+        for j0 in 0..GRID[0] {
+            let at = |j| node(cs.info().grid_condition(j));
+            let here = at([j0, j1]);
+            let steps = [
+                (at([(j0 + 1).min(GRID[0] - 1), j1]) - here) / 2.0,
+                (at([j0, (j1 + 1).min(GRID[1] - 1)]) - here) / 2.0,
+            ];
+            for k in 0..INSTANCES {
+                for i in 0..n {
+                    at_nodes = at_nodes.max(gap(here, k, i));
+                    for mid in [here + steps[0], here + steps[1], here + steps[0] + steps[1]] {
+                        at_midpoints = at_midpoints.max(gap(mid, k, i));
                     }
                 }
             }
         }
-        assert!(
-            at_nodes <= node_bound,
-            "at the nodes: {at_nodes} > {node_bound}"
-        );
-        let bound = 2.0 * at_midpoints + node_bound;
-        let mut rng = Pcg64Mcg::seed_from_u64(3);
-        let mut worst = 0.0f32;
-        for _ in 0..20_000 {
-            let c = Vec2::new(rng.random_range(0.1..1.0), rng.random_range(0.0..89.0));
-            worst = worst.max(gap(
-                c,
-                rng.random_range(0..INSTANCES),
-                rng.random_range(0..n),
-            ));
-        }
-        println!(
-            "table vs network (square units): nodes {at_nodes:.2e}, midpoints {at_midpoints:.2e}, \
-             20k random conditions {worst:.2e} (bound {bound:.2e})"
-        );
-        assert!(worst <= bound, "{worst} > {bound}");
-    });
+    }
+    assert!(
+        at_nodes <= node_bound,
+        "at the nodes: {at_nodes} > {node_bound}"
+    );
+    let bound = 2.0 * at_midpoints + node_bound;
+    let mut rng = Pcg64Mcg::seed_from_u64(3);
+    let mut worst = 0.0f32;
+    for _ in 0..20_000 {
+        let c = Vec2::new(rng.random_range(0.1..1.0), rng.random_range(0.0..89.0));
+        worst = worst.max(gap(
+            c,
+            rng.random_range(0..INSTANCES),
+            rng.random_range(0..n),
+        ));
+    }
+    println!(
+        "table vs network (square units): nodes {at_nodes:.2e}, midpoints {at_midpoints:.2e}, \
+         20k random conditions {worst:.2e} (bound {bound:.2e})"
+    );
+    assert!(worst <= bound, "{worst} > {bound}");
 }
 
 /// The weights at the weight-grid nodes equal the glTF directional albedo of the
@@ -95,20 +101,19 @@ fn table_mode_follows_network_mode_within_a_measured_bound() {
 /// within 1e-4, in both modes.
 #[test]
 fn weights_equal_the_albedo_at_the_weight_grid_nodes() {
-    with_distilled(|cs| {
-        for j1 in 0..WEIGHT_GRID[1] {
-            for j0 in 0..WEIGHT_GRID[0] {
-                let c = node([j0, j1], WEIGHT_GRID);
-                let want = directional_albedo(BrdfModel::Gltf, c.x as f64, c.y as f64).total();
-                for got in [cs.sample(c, 0, 0).weight, cs.sample_network(c, 5, 1).weight] {
-                    assert!(
-                        (got as f64 - want).abs() < 1e-4,
-                        "({}, {}): {got} vs {want}",
-                        c.x,
-                        c.y
-                    );
-                }
+    let cs = distilled();
+    for j1 in 0..WEIGHT_GRID[1] {
+        for j0 in 0..WEIGHT_GRID[0] {
+            let c = node(cs.info().weight_grid_condition([j0, j1]));
+            let want = directional_albedo(BrdfModel::Gltf, c.x as f64, c.y as f64).total();
+            for got in [cs.sample(c, 0, 0).weight, cs.sample_network(c, 5, 1).weight] {
+                assert!(
+                    (got as f64 - want).abs() < 1e-4,
+                    "({}, {}): {got} vs {want}",
+                    c.x,
+                    c.y
+                );
             }
         }
-    });
+    }
 }

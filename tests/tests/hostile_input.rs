@@ -7,7 +7,7 @@ use nuld_core::blob::{
     checksum, encoded_len, write, BlobError, Domain, Layout, SectionSpec, SectionTag,
     CHECKSUM_OFFSET, MAX_SECTIONS,
 };
-use nuld_core::conditional::CONDITIONAL_INFO_LEN;
+use nuld_core::conditional::{PointWarp, CONDITIONAL_INFO_LEN};
 use nuld_core::network::Activation;
 use nuld_core::quantize::f16_decode;
 use nuld_runtime::glam::{Vec2, Vec3};
@@ -76,9 +76,17 @@ fn check_sample(s: nuld_runtime::Sample) {
 /// A small conditional blob with random contents (n 4, hidden [3, 2], 2 instances,
 /// a 3 x 2 grid).
 fn conditional_blob() -> AlignedBytes {
-    conditional_parts(4, &[3, 2], Activation::Silu, 2, [3, 2], 5)
-        .to_blob(&META)
-        .unwrap()
+    conditional_parts(
+        4,
+        &[3, 2],
+        Activation::Silu,
+        2,
+        [3, 2],
+        PointWarp::BrdfMixture,
+        5,
+    )
+    .to_blob(&META)
+    .unwrap()
 }
 
 fn valid_blobs() -> Vec<AlignedBytes> {
@@ -487,7 +495,8 @@ struct ConditionalFields {
     cond_max: [f32; 2],
     hidden: [u32; 3],
     activation: u32,
-    reserved: [u32; 3],
+    warp: u32,
+    reserved: [u32; 2],
 }
 
 /// What a parsed conditional blob promises (core/FORMAT.md, "Validation"), checked
@@ -523,7 +532,8 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
         cond_max: [real(40), real(44)],
         hidden: [word(48), word(52), word(56)],
         activation: word(60),
-        reserved: [word(68), word(72), word(76)],
+        warp: word(68),
+        reserved: [word(72), word(76)],
     };
     let h = info.hidden;
     let layers = h.iter().take_while(|&&w| w > 0).count();
@@ -541,7 +551,9 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
         && ranges_ok
         && info.activation <= 1
         && widths_ok
-        && info.reserved == [0; 3])
+        // Warp 1 (the BRDF mixture) exists for the glTF BRDF on the hemisphere only.
+        && (info.warp == 0 || (info.warp == 1 && info.domain == 2))
+        && info.reserved == [0; 2])
     {
         return false;
     }
@@ -555,7 +567,10 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
     expected_params += 2 * (fan_in + 1);
     let table_len =
         info.grid[0] as u128 * info.grid[1] as u128 * info.instances as u128 * info.n as u128;
-    let weight_len = info.weight_grid[0] as u128 * info.weight_grid[1] as u128;
+    // Warp 1 stores the lobe probabilities after the weights.
+    let weight_len = info.weight_grid[0] as u128
+        * info.weight_grid[1] as u128
+        * if info.warp == 1 { 2 } else { 1 };
     pe.elem_size == 2
         && te.elem_size == 4
         && we.elem_size == 4

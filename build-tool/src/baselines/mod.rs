@@ -16,7 +16,8 @@
 //! * [`spherical_fibonacci`]: spherical Fibonacci directions.
 //! * [`warp`]: the warps baselines use for non-uniform targets.
 //! * [`warped_owen_sobol`]: the standard 2D baseline, Owen-Sobol through the
-//!   target's inverse CDF (the optimizer's start).
+//!   target's inverse CDF (the optimizer's start);
+//!   [`warped_owen_sobol_directions`] its twin for direction targets.
 //! * [`Baseline`]: an enum over the uniform 2D methods, for evaluation loops.
 
 mod gbn;
@@ -42,7 +43,7 @@ pub use sobol_cp::{sobol_cranley_patterson, sobol_points, SOBOL_CP_MAX_POINTS};
 pub use sot::{sliced_optimal_transport, sliced_wasserstein, SOT_DEFAULT_ITERATIONS};
 pub use spherical_fibonacci::spherical_fibonacci;
 pub use warp::{cosine_hemisphere, hierarchical_warp, warp_inverse_cdf, HierarchicalWarp};
-pub use warped::{seeded_owen_sobol, warped_owen_sobol};
+pub use warped::{seeded_owen_sobol, warped_owen_sobol, warped_owen_sobol_directions};
 
 /// The largest `f64` below 1: generators clamp coordinates to `[0, BELOW_ONE]` so that
 /// points stay in `[0,1)^2`.

@@ -1,10 +1,12 @@
-//! The standard baseline for a 2D target, and the optimizer's starting set:
-//! Owen-scrambled Sobol points warped by the target's inverse CDF.
+//! The standard baseline for a 2D or a direction target, and the optimizers'
+//! starting set: Owen-scrambled Sobol points warped by the target's inverse CDF or
+//! its standard direction warp.
 
 use super::owen_sobol;
 use crate::density::Density2D;
 use crate::seeding::derive_seed;
-use glam::DVec2;
+use crate::sphere::DirectionDensity;
+use glam::{DVec2, DVec3};
 
 /// Stream of [`derive_seed`] that turns a run seed into an Owen scramble.
 const SCRAMBLE_STREAM: u64 = 0x1417;
@@ -23,6 +25,22 @@ pub fn warped_owen_sobol(density: &dyn Density2D, n: usize, seed: u64) -> Vec<DV
     seeded_owen_sobol(n, seed)
         .into_iter()
         .map(|u| density.inverse_cdf(u))
+        .collect()
+}
+
+/// [`seeded_owen_sobol`] points mapped by `density`'s standard warp
+/// ([`DirectionDensity::sample`]; for a BRDF the renderer's importance-sampling
+/// mixture): the directions a renderer gets from the standard sampler, the
+/// trainer's and the quality check's baseline, and where
+/// [`crate::optimize::directions::optimize_directions`] starts for the same seed.
+pub fn warped_owen_sobol_directions(
+    density: &dyn DirectionDensity,
+    n: usize,
+    seed: u64,
+) -> Vec<DVec3> {
+    seeded_owen_sobol(n, seed)
+        .into_iter()
+        .map(|u| density.sample(u))
         .collect()
 }
 

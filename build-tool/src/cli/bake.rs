@@ -7,24 +7,28 @@ use anyhow::{ensure, Result};
 use clap::Args;
 use std::path::PathBuf;
 
-/// Arguments of `build-tool bake`.
+/// Arguments of `build-tool bake`. Defaults are [`BakeConfig::default`]'s and
+/// [`TrainConfig::default`]'s, read from there.
 #[derive(Args, Debug)]
 pub struct BakeArgs {
     /// Bake the glTF 2.0 BRDF sampler (condition: roughness, view angle).
     #[arg(long)]
     pub brdf: bool,
     /// Points per set.
-    #[arg(long, default_value_t = 64, allow_negative_numbers = true, value_parser = super::count)]
+    #[arg(long, default_value_t = TrainConfig::default().n as usize, allow_negative_numbers = true, value_parser = super::count)]
     pub n: usize,
     /// Instances stored in the point table.
-    #[arg(long, default_value_t = 16, allow_negative_numbers = true, value_parser = super::count)]
+    #[arg(long, default_value_t = BakeConfig::default().instances as usize, allow_negative_numbers = true, value_parser = super::count)]
     pub instances: usize,
     /// Point-table grid nodes: roughness,theta_o (each >= 2).
-    #[arg(long, default_value = "10,12")]
-    pub grid: String,
-    /// Training steps after 300 steps of pretraining on the warp [default: 12000, about 7 min on 2 cores]
-    #[arg(long, allow_negative_numbers = true, value_parser = super::count)]
-    pub steps: Option<usize>,
+    #[arg(long, value_delimiter = ',', default_values_t = BakeConfig::default().grid,
+        hide_default_value = true,
+        help = with_list_default("Point-table grid nodes: roughness,theta_o (each >= 2)", &BakeConfig::default().grid))]
+    pub grid: Vec<u32>,
+    /// Training steps after the pretraining on the warp (the default takes about 7
+    /// min on 2 cores).
+    #[arg(long, default_value_t = TrainConfig::default().steps, allow_negative_numbers = true, value_parser = super::count)]
+    pub steps: usize,
     /// Seed; fixes the output bit for bit whatever the thread count.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -32,33 +36,32 @@ pub struct BakeArgs {
     #[arg(long)]
     pub resume: bool,
     /// Hidden widths, comma-separated (1 to 3 layers).
-    #[arg(long)]
-    pub hidden: Option<String>,
+    #[arg(long, value_delimiter = ',', default_values_t = TrainConfig::default().hidden,
+        hide_default_value = true,
+        help = with_list_default("Hidden widths, comma-separated (1 to 3 layers)", &TrainConfig::default().hidden))]
+    pub hidden: Vec<u32>,
     /// SiLU hidden units instead of ReLU.
     #[arg(long)]
     pub silu: bool,
     /// Weight of the union-of-instances term.
-    #[arg(long)]
-    pub union_weight: Option<f64>,
+    #[arg(long, default_value_t = TrainConfig::default().union_weight)]
+    pub union_weight: f64,
     /// Initial Adam step.
-    #[arg(long)]
-    pub lr: Option<f64>,
+    #[arg(long, default_value_t = TrainConfig::default().learning_rate)]
+    pub lr: f64,
     /// Held-out conditions per axis of the quality check in the report (0: none).
-    #[arg(long, default_value_t = 4, allow_negative_numbers = true, value_parser = super::count)]
+    #[arg(long, default_value_t = BakeConfig::default().quality_grid, allow_negative_numbers = true, value_parser = super::count)]
     pub quality_grid: usize,
     /// Output directory.
     #[arg(long)]
     pub out: PathBuf,
 }
 
-fn numbers(s: &str, what: &str) -> Result<Vec<u32>> {
-    s.split(',')
-        .map(|x| {
-            x.trim()
-                .parse::<u32>()
-                .map_err(|_| anyhow::anyhow!("{what}: {x:?} is not a whole number"))
-        })
-        .collect()
+/// `help` followed by `[default: a,b,...]`: clap shows a list's default joined by
+/// spaces, which a comma-separated option does not parse.
+fn with_list_default(help: &str, default: &[u32]) -> String {
+    let values: Vec<String> = default.iter().map(u32::to_string).collect();
+    format!("{help} [default: {}]", values.join(","))
 }
 
 /// Runs `build-tool bake`.
@@ -74,39 +77,33 @@ pub fn run(a: BakeArgs) -> Result<()> {
         "--instances must be in 1..=65536, got {}",
         a.instances
     );
-    let grid = numbers(&a.grid, "--grid")?;
     ensure!(
-        grid.len() == 2 && grid.iter().all(|&g| (2..=256).contains(&g)),
+        a.grid.len() == 2 && a.grid.iter().all(|&g| (2..=256).contains(&g)),
         "--grid must be two node counts in 2..=256, like 10,12"
     );
-    let mut train = TrainConfig {
+    ensure!(a.steps >= 1, "--steps must be at least 1");
+    ensure!(
+        a.union_weight.is_finite() && a.union_weight >= 0.0,
+        "--union-weight must be finite and >= 0"
+    );
+    ensure!(
+        a.lr.is_finite() && a.lr > 0.0,
+        "--lr must be finite and > 0"
+    );
+    let train = TrainConfig {
         n: a.n as u32,
-        seed: a.seed,
+        hidden: a.hidden,
         silu: a.silu,
+        steps: a.steps,
+        union_weight: a.union_weight,
+        learning_rate: a.lr,
+        seed: a.seed,
         ..TrainConfig::default()
     };
-    if let Some(s) = a.steps {
-        ensure!(s >= 1, "--steps must be at least 1");
-        train.steps = s;
-    }
-    if let Some(h) = &a.hidden {
-        train.hidden = numbers(h, "--hidden")?;
-    }
-    if let Some(w) = a.union_weight {
-        ensure!(
-            w.is_finite() && w >= 0.0,
-            "--union-weight must be finite and >= 0"
-        );
-        train.union_weight = w;
-    }
-    if let Some(lr) = a.lr {
-        ensure!(lr.is_finite() && lr > 0.0, "--lr must be finite and > 0");
-        train.learning_rate = lr;
-    }
     let config = BakeConfig {
         train,
         instances: a.instances as u32,
-        grid: [grid[0], grid[1]],
+        grid: [a.grid[0], a.grid[1]],
         quality_grid: a.quality_grid,
         resume: a.resume,
         ..BakeConfig::default()

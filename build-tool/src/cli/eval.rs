@@ -2,7 +2,8 @@
 
 use crate::eval::conditional::{blob_sets, evaluate, ConditionalSettings, MixtureOwenSobol};
 use crate::eval::{run_figure, EvalSettings, Figure};
-use anyhow::{Context, Result};
+use crate::pointset::AlignedBytes;
+use anyhow::Result;
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -118,11 +119,6 @@ impl EvalArgs {
 
 /// Runs `build-tool eval`.
 pub fn run(a: EvalArgs) -> Result<()> {
-    if a.fig == FigArg::Conditional {
-        return run_conditional(&a);
-    }
-    let s = a.settings();
-    s.validate()?;
     let figures: Vec<Figure> = match a.fig {
         FigArg::Fig2 => vec![Figure::Fig2],
         FigArg::Fig3 => vec![Figure::Fig3],
@@ -130,8 +126,10 @@ pub fn run(a: EvalArgs) -> Result<()> {
         FigArg::Fig6 => vec![Figure::Fig6],
         FigArg::Fig7 => vec![Figure::Fig7],
         FigArg::All => Figure::ALL.to_vec(),
-        FigArg::Conditional => unreachable!("dispatched above"),
+        FigArg::Conditional => return run_conditional(&a),
     };
+    let s = a.settings();
+    s.validate()?;
     for f in figures {
         let started = Instant::now();
         let rep = run_figure(f, &s)?;
@@ -168,7 +166,6 @@ fn run_conditional(a: &EvalArgs) -> Result<()> {
     if let Some(v) = a.direction_epochs {
         s.direct_epochs = v;
     }
-    s.validate()?;
     anyhow::ensure!(
         a.blob.is_some() || a.calibrate,
         "eval conditional needs --blob FILE (or --calibrate)"
@@ -179,9 +176,8 @@ fn run_conditional(a: &EvalArgs) -> Result<()> {
     let owned;
     let samplers: Vec<&dyn crate::eval::conditional::ConditionalSets> = match &a.blob {
         Some(path) => {
-            bytes =
-                std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
-            owned = blob_sets(&bytes)?;
+            bytes = AlignedBytes::read(path)?;
+            owned = blob_sets(bytes.as_slice())?;
             owned.iter().map(|b| b.as_ref()).collect()
         }
         None => {

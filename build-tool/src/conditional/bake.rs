@@ -207,9 +207,11 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
 fn render_sets(path: &Path, params: &crate::network::Params) -> Result<()> {
     let shipped = params.rounded_to_f16();
     let conds = [[0.15, 20.0], [0.15, 75.0], [0.5, 45.0], [0.9, 80.0]];
+    // Only the density and the lobe probability are read: no cap-measure table
+    // worth building.
     let targets = conds
         .iter()
-        .map(|c| BrdfTarget::new(c[0], c[1], Domain::Hemisphere))
+        .map(|c| BrdfTarget::coarse(c[0], c[1], 1 << 10))
         .collect::<Result<Vec<_>, _>>()?;
     let densities: Vec<Box<dyn Fn(DVec2) -> f64 + '_>> = targets
         .iter()
@@ -221,10 +223,11 @@ fn render_sets(path: &Path, params: &crate::network::Params) -> Result<()> {
     let panels: Vec<SquarePanel<'_>> = conds
         .iter()
         .zip(&densities)
-        .map(|(c, d)| SquarePanel {
+        .zip(&targets)
+        .map(|((c, d), t)| SquarePanel {
             caption: format!("roughness {}, theta_o {} deg", c[0], c[1]),
             density: d.as_ref(),
-            points: instance_directions(&shipped, *c, 0)
+            points: instance_directions(&shipped, *c, t.lobe_probability(), 0)
                 .into_iter()
                 .map(|x| Domain::Hemisphere.to_square(x))
                 .collect(),
@@ -270,7 +273,8 @@ mod tests {
         let shape = config.train.shape().unwrap();
         assert_eq!(len(SectionTag::NetworkParams), 2 * shape.param_len());
         assert_eq!(len(SectionTag::PointTable), 4 * 2 * 3 * 3 * 8);
-        assert_eq!(len(SectionTag::WeightTable), 4 * 8);
+        // The weights, then the mixture warp's lobe probabilities.
+        assert_eq!(len(SectionTag::WeightTable), 4 * 8 * 2);
         for f in ["report.json", "loss.png", "sets.png", "checkpoint.bin"] {
             assert!(dir.join(f).is_file(), "{f}");
         }

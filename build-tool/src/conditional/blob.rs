@@ -3,8 +3,8 @@
 
 use crate::pointset::AlignedBytes;
 use anyhow::{bail, Context, Result};
-use nuld_core::blob::{encoded_len, write, BlobKind, Metadata, SectionSpec, SectionTag};
-use nuld_core::conditional::{ConditionalInfo, CONDITIONAL_INFO_LEN};
+use nuld_core::blob::{encoded_len, write, BlobKind, Metadata};
+use nuld_core::conditional::{sections, ConditionalInfo};
 use std::path::Path;
 
 /// Everything a conditional blob holds besides its metadata (layouts in
@@ -17,7 +17,9 @@ pub struct ConditionalParts {
     pub params: Vec<u16>,
     /// The point table: `x | y << 16` u16 unorm codes, `[node][instance][index]`.
     pub table: Vec<u32>,
-    /// The weight table, one `f32` per weight-grid node, axis 0 fastest.
+    /// The weight table, one `f32` per weight-grid node, axis 0 fastest; for
+    /// [`nuld_core::conditional::PointWarp::BrdfMixture`] followed by the lobe
+    /// probabilities on the same nodes.
     pub weights: Vec<f32>,
 }
 
@@ -43,36 +45,16 @@ impl ConditionalParts {
                 info.point_table_len()
             );
         }
-        if self.weights.len() as u64 != info.weight_table_len() {
+        let weight_len = info.weight_table_len() * info.weight_tables();
+        if self.weights.len() as u64 != weight_len {
             bail!(
                 "weight table has {} entries, the grid calls for {}",
                 self.weights.len(),
-                info.weight_table_len()
+                weight_len
             );
         }
         let meta_bytes = postcard::to_allocvec(meta).context("cannot encode metadata")?;
-        let sections = [
-            SectionSpec {
-                tag: SectionTag::ConditionalInfo,
-                elem_size: CONDITIONAL_INFO_LEN as u32,
-                bytes: bytemuck::bytes_of(info),
-            },
-            SectionSpec {
-                tag: SectionTag::NetworkParams,
-                elem_size: 2,
-                bytes: bytemuck::cast_slice(&self.params),
-            },
-            SectionSpec {
-                tag: SectionTag::PointTable,
-                elem_size: 4,
-                bytes: bytemuck::cast_slice(&self.table),
-            },
-            SectionSpec {
-                tag: SectionTag::WeightTable,
-                elem_size: 4,
-                bytes: bytemuck::cast_slice(&self.weights),
-            },
-        ];
+        let sections = sections(info, &self.params, &self.table, &self.weights);
         let mut out = AlignedBytes::zeroed(encoded_len(&meta_bytes, &sections));
         write(
             out.as_mut_slice(),

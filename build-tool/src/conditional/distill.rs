@@ -6,29 +6,31 @@
 //!   network's square point evaluated in `f64` on the *f16-rounded* parameters
 //!   (exactly what ships), as u16 unorm codes ([`unorm16_encode`], [`pack_point`]);
 //! * **weight table**: the glTF directional albedo `A` at every weight-grid node
-//!   ([`directional_albedo`]).
+//!   ([`directional_albedo`]), followed for a [`PointWarp::BrdfMixture`] sampler by
+//!   the lobe probability `p_s = A_spec / A` at the same nodes (what
+//!   [`crate::sphere::brdf_albedo::lobe_probability`] computes, from the same
+//!   quadrature).
 
 use super::ConditionalParts;
 use crate::network::Params;
 use crate::sphere::brdf_albedo::directional_albedo;
-use crate::train::pool::{COND_MAX, COND_MIN};
 use nuld_core::blob::Domain;
-use nuld_core::brdf::BrdfModel;
-use nuld_core::conditional::{pack_point, ConditionalInfo, ConditionalTarget};
-use nuld_core::network::MAX_HIDDEN_LAYERS;
+use nuld_core::brdf::{BrdfModel, BrdfParts, CONDITION_MAX, CONDITION_MIN};
+use nuld_core::conditional::{pack_point, ConditionalInfo, ConditionalTarget, PointWarp};
+use nuld_core::network::{Shape, MAX_HIDDEN_LAYERS};
 use nuld_core::quantize::unorm16_encode;
 use rayon::prelude::*;
 
-/// The info record of a glTF BRDF sampler with `params`' architecture, `instances`
-/// stored instances, and the given point and weight grids (nodes per axis, each
-/// `>= 2`).
+/// The info record of a glTF BRDF sampler over the condition range
+/// ([`CONDITION_MIN`] to [`CONDITION_MAX`]) with a network of `shape` (its point
+/// warp [`PointWarp::of_shape`]), `instances` stored instances, and the given point
+/// and weight grids (nodes per axis, each `>= 2`).
 pub fn brdf_info(
-    params: &Params,
+    shape: &Shape,
     instances: u32,
     grid: [u32; 2],
     weight_grid: [u32; 2],
 ) -> ConditionalInfo {
-    let shape = params.shape;
     let mut hidden = [0u32; MAX_HIDDEN_LAYERS];
     hidden[..shape.hidden().len()].copy_from_slice(shape.hidden());
     ConditionalInfo {
@@ -38,12 +40,13 @@ pub fn brdf_info(
         target: ConditionalTarget::GltfBrdf as u32,
         grid,
         weight_grid,
-        cond_min: COND_MIN.map(|x| x as f32),
-        cond_max: COND_MAX.map(|x| x as f32),
+        cond_min: CONDITION_MIN.map(|x| x as f32),
+        cond_max: CONDITION_MAX.map(|x| x as f32),
         hidden,
         activation: shape.activation() as u32,
         lattice_generator: shape.lattice_generator(),
-        reserved: [0; 3],
+        warp: PointWarp::of_shape(shape) as u32,
+        reserved: [0; 2],
     }
 }
 
@@ -55,7 +58,7 @@ pub fn distill(
     grid: [u32; 2],
     weight_grid: [u32; 2],
 ) -> ConditionalParts {
-    let info = brdf_info(params, instances, grid, weight_grid);
+    let info = brdf_info(&params.shape, instances, grid, weight_grid);
     let shipped = params.rounded_to_f16();
     let n = info.n;
     let nodes = (grid[0] * grid[1]) as usize;
@@ -71,21 +74,25 @@ pub fn distill(
             let shipped = &shipped;
             (0..instances).flat_map(move |k| {
                 (0..n).map(move |i| {
-                    let p = shipped.trace(unit, k, i).square_point();
+                    let p = shipped.square_point(unit, k, i);
                     pack_point(unorm16_encode(p[0]), unorm16_encode(p[1]))
                 })
             })
         })
         .collect();
-    let weight_nodes = (weight_grid[0] * weight_grid[1]) as usize;
-    let weights: Vec<f32> = (0..weight_nodes)
+    let weight_nodes = weight_grid[0] * weight_grid[1];
+    // One quadrature per node gives both tables: `A` and `p_s = A_spec / A`.
+    let albedos: Vec<BrdfParts<f64>> = (0..weight_nodes)
         .into_par_iter()
         .map(|node| {
-            let j = [node as u32 % weight_grid[0], node as u32 / weight_grid[0]];
-            let c = info.weight_grid_condition(j);
-            directional_albedo(BrdfModel::Gltf, c[0], c[1]).total() as f32
+            let c = info.weight_grid_condition([node % weight_grid[0], node / weight_grid[0]]);
+            directional_albedo(BrdfModel::Gltf, c[0], c[1])
         })
         .collect();
+    let mut weights: Vec<f32> = albedos.iter().map(|a| a.total() as f32).collect();
+    if info.weight_tables() > 1 {
+        weights.extend(albedos.iter().map(|a| (a.specular / a.total()) as f32));
+    }
     ConditionalParts {
         info,
         params: params.to_f16_bits(),
@@ -98,7 +105,7 @@ pub fn distill(
 mod tests {
     use super::*;
     use nuld_core::conditional::unpack_point;
-    use nuld_core::network::{Activation, Shape};
+    use nuld_core::network::Activation;
     use nuld_core::quantize::{f16_decode, unorm16_decode_f64};
 
     #[test]

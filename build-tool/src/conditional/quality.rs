@@ -11,16 +11,16 @@
 //!   of the next instance over the mean nearest-neighbour angle within a set
 //!   (independent Owen-Sobol sets: about 0.65; identical sets: 0).
 
-use crate::baselines::seeded_owen_sobol;
+use crate::baselines::warped_owen_sobol_directions;
 use crate::eval::conditional::diversity;
 use crate::network::Params;
 use crate::sphere::metrics::{CapRadius, MeasuredCaps};
 use crate::sphere::{BrdfTarget, DirectionDensity};
 use crate::train::pool::normalized;
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 use nuld_core::blob::Domain;
-use nuld_core::network::input_features;
-use nuld_core::sphere::square_to_hemisphere;
+use nuld_core::brdf::{CONDITION_MAX, CONDITION_MIN};
+use nuld_core::conditional::PointWarp;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -44,10 +44,12 @@ impl QualityConfig {
     /// (off any point-table grid with an odd node count... and most even ones),
     /// 8 instances, unions of 64, 4096 caps.
     pub fn held_out(k: usize, seed: u64) -> Self {
-        let at = |j: usize, lo: f64, hi: f64| lo + (j as f64 + 0.5) / k as f64 * (hi - lo);
-        let conditions = (0..k * k)
-            .map(|j| [at(j % k, 0.1, 1.0), at(j / k, 0.0, 89.0)])
-            .collect();
+        // Cell centre `j` of axis `a` of the condition range.
+        let at = |j: usize, a: usize| {
+            let (lo, hi) = (CONDITION_MIN[a], CONDITION_MAX[a]);
+            lo + (j as f64 + 0.5) / k as f64 * (hi - lo)
+        };
+        let conditions = (0..k * k).map(|j| [at(j % k, 0), at(j / k, 1)]).collect();
         Self {
             conditions,
             instances: 8,
@@ -90,15 +92,16 @@ pub struct Quality {
     pub mean_nn_ratio: f64,
 }
 
-/// The directions of instance `k` at `cond` (network mode, `params` as given).
-pub fn instance_directions(params: &Params, cond: [f64; 2], k: u32) -> Vec<DVec3> {
+/// The directions of instance `k` at `cond` (network mode, `params` as given),
+/// `p_s` the condition's lobe probability (used by the mixture warp,
+/// [`PointWarp::direction`]).
+pub fn instance_directions(params: &Params, cond: [f64; 2], p_s: f64, k: u32) -> Vec<DVec3> {
     let unit = normalized(cond);
+    let warp = PointWarp::of_shape(&params.shape);
     (0..params.shape.n())
         .map(|i| {
-            let s = params
-                .network()
-                .square_point(i, input_features(&params.shape, unit, k, i));
-            square_to_hemisphere(DVec2::new(s[0], s[1]))
+            let s = params.square_point(unit, k, i);
+            DVec3::from_array(warp.direction(Domain::Hemisphere, cond, p_s, s))
         })
         .collect()
 }
@@ -123,7 +126,7 @@ pub fn evaluate(params: &Params, config: &QualityConfig) -> Quality {
             let d = |pts: &[DVec3]| caps.l2_squared(pts, CapRadius::ThetaUniform).0.sqrt();
             let sets: Vec<Vec<DVec3>> = (0..config.union_instances.max(config.instances).max(2))
                 .into_par_iter()
-                .map(|k| instance_directions(&shipped, cond, k))
+                .map(|k| instance_directions(&shipped, cond, target.lobe_probability(), k))
                 .collect();
             let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len() as f64;
             let ours = mean(
@@ -136,11 +139,11 @@ pub fn evaluate(params: &Params, config: &QualityConfig) -> Quality {
                 (0..config.instances as u64)
                     .into_par_iter()
                     .map(|s| {
-                        let pts: Vec<DVec3> = seeded_owen_sobol(n, config.seed ^ (s + 1))
-                            .into_iter()
-                            .map(|u| target.sample(u))
-                            .collect();
-                        d(&pts)
+                        d(&warped_owen_sobol_directions(
+                            &target,
+                            n,
+                            config.seed ^ (s + 1),
+                        ))
                     })
                     .collect(),
             );

@@ -1,5 +1,6 @@
-//! The backward pass of [`nuld_core::network::Network::forward`] and of the two
-//! maps after it (the sigmoid onto the square, the hemisphere's equal-area map).
+//! The backward pass of [`nuld_core::network::Network::forward`] and of the
+//! sigmoid onto the square after it (the map from the square to a direction is the
+//! caller's: its Jacobian chains in front of [`output_gradient`]).
 //!
 //! With `a_0` the input, `z_l = W_l a_(l-1) + b_l (+ E[i] for l = 1)`,
 //! `a_l = act(z_l)`, `o = W_o a_L + b_o`, `p = sigmoid(o)`, `x = M(p)`:
@@ -12,18 +13,10 @@
 //! dL/da_(l-1) = W_l^T dL/dz_l
 //! ```
 
-use crate::optimize::directions::map_jacobian;
-use glam::{DVec2, DVec3};
-use nuld_core::blob::Domain;
-use nuld_core::network::{sigmoid, Shape, Trace, INPUTS, MAX_WIDTH, OUTPUTS};
-
-/// `dL/dp` of the hemisphere's square point `p` from `dL/dx` of its direction
-/// `x = M(p)` (ambient gradient `g`): `(J_x . g, J_y . g)` with the map's Jacobian
-/// columns by central differences.
-pub fn hemisphere_square_gradient(p: DVec2, g: DVec3) -> DVec2 {
-    let (jx, jy) = map_jacobian(Domain::Hemisphere, p);
-    DVec2::new(jx.dot(g), jy.dot(g))
-}
+use glam::DVec2;
+use nuld_core::network::{
+    sigmoid, LayerSpan, Shape, Trace, INPUTS, MAX_HIDDEN_LAYERS, MAX_WIDTH, OUTPUTS,
+};
 
 /// `dL/do` of the outputs before the sigmoid from `dL/dp` of the square point
 /// `p = sigmoid(o)`: `dL/dp p (1 - p)` per coordinate.
@@ -52,19 +45,11 @@ pub fn backward(
     let act = shape.activation();
     let hidden = shape.hidden();
     let layers = hidden.len();
-    // Offsets of every layer's weights (biases follow them), output layer last.
-    let mut offsets = [0usize; 4];
-    let mut fan_ins = [0usize; 4];
-    let mut off = shape.first_layer_offset();
-    let mut fan_in = INPUTS;
-    for (l, &h) in hidden.iter().enumerate() {
-        offsets[l] = off;
-        fan_ins[l] = fan_in;
-        off += h as usize * (fan_in + 1);
-        fan_in = h as usize;
+    // Every layer's place in the array, output layer last: walked backwards below.
+    let mut spans = [LayerSpan::default(); MAX_HIDDEN_LAYERS + 1];
+    for (slot, span) in spans.iter_mut().zip(shape.layers()) {
+        *slot = span;
     }
-    offsets[layers] = off;
-    fan_ins[layers] = fan_in;
 
     let activation = |l: usize| -> [f64; MAX_WIDTH] {
         let mut a = [0.0; MAX_WIDTH];
@@ -82,7 +67,12 @@ pub fn backward(
     };
 
     // Output layer.
-    let (off, fan_in) = (offsets[layers], fan_ins[layers]);
+    let LayerSpan {
+        weights: off,
+        bias,
+        fan_in,
+        ..
+    } = spans[layers];
     let a = activation(layers);
     let mut delta_a = [0.0; MAX_WIDTH];
     for (o, &d) in d_output.iter().enumerate() {
@@ -91,11 +81,16 @@ pub fn backward(
             grad[row + k] += d * a[k];
             delta_a[k] += params[row + k] * d;
         }
-        grad[off + OUTPUTS * fan_in + o] += d;
+        grad[bias + o] += d;
     }
     // Hidden layers, last first.
     for l in (0..layers).rev() {
-        let (off, fan_in, h) = (offsets[l], fan_ins[l], hidden[l] as usize);
+        let LayerSpan {
+            weights: off,
+            bias,
+            fan_in,
+            width: h,
+        } = spans[l];
         let a = activation(l);
         let mut delta_z = [0.0; MAX_WIDTH];
         for o in 0..h {
@@ -111,7 +106,7 @@ pub fn backward(
                 grad[row + k] += d * a[k];
                 next[k] += params[row + k] * d;
             }
-            grad[off + h * fan_in + o] += d;
+            grad[bias + o] += d;
             if l == 0 {
                 grad[shape.embedding_offset(i) + o] += d;
             }
@@ -124,6 +119,9 @@ pub fn backward(
 mod tests {
     use super::*;
     use crate::network::Params;
+    use crate::optimize::directions::map_jacobian;
+    use glam::DVec3;
+    use nuld_core::blob::Domain;
     use nuld_core::network::Activation;
     use nuld_core::sphere::square_to_hemisphere;
 
@@ -177,7 +175,10 @@ mod tests {
                 let s = t.square_point();
                 let sq = DVec2::new(s[0], s[1]);
                 let g3 = loss_of(square_to_hemisphere(sq)).1;
-                let d_out = output_gradient(&t, hemisphere_square_gradient(sq, g3));
+                // dL/dp = (J_x . g, J_y . g), the map's Jacobian columns by central
+                // differences.
+                let (jx, jy) = map_jacobian(Domain::Hemisphere, sq);
+                let d_out = output_gradient(&t, DVec2::new(jx.dot(g3), jy.dot(g3)));
                 backward(&shape, &p.values, &t, i, d_out, &mut grad);
             }
             let h = 1e-6;

@@ -8,5 +8,5 @@
 pub mod backward;
 pub mod params;
 
-pub use backward::{backward, hemisphere_square_gradient, output_gradient};
+pub use backward::{backward, output_gradient};
 pub use params::Params;

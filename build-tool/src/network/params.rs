@@ -2,7 +2,7 @@
 //! [`nuld_core::network`], with a deterministic initialization and f16 rounding.
 
 use crate::seeding::rng;
-use nuld_core::network::{input_features, Network, Shape, Trace, INPUTS, OUTPUTS};
+use nuld_core::network::{input_features, Network, Shape, Trace};
 use nuld_core::quantize::{f16_decode, f16_encode};
 use rand::Rng;
 
@@ -24,21 +24,13 @@ impl Params {
     pub fn init(shape: Shape, seed: u64) -> Self {
         let mut values = vec![0.0; shape.param_len()];
         let mut r = rng(seed, 0x6e65_7477);
-        let mut off = shape.first_layer_offset();
-        let mut fan_in = INPUTS;
-        let widths: Vec<(usize, f64)> = shape
-            .hidden()
-            .iter()
-            .map(|&h| (h as usize, 6.0))
-            .chain(std::iter::once((OUTPUTS, 3.0)))
-            .collect();
-        for (h, gain) in widths {
-            let bound = (gain / fan_in as f64).sqrt();
-            for w in &mut values[off..off + h * fan_in] {
+        let hidden = shape.hidden().len();
+        for (l, span) in shape.layers().enumerate() {
+            let gain = if l < hidden { 6.0 } else { 3.0 };
+            let bound = (gain / span.fan_in as f64).sqrt();
+            for w in &mut values[span.weights..span.bias] {
                 *w = bound * (2.0 * r.random::<f64>() - 1.0);
             }
-            off += h * fan_in + h;
-            fan_in = h;
         }
         Self { shape, values }
     }
@@ -55,6 +47,14 @@ impl Params {
     pub fn trace(&self, c: [f64; 2], k: u32, i: u32) -> Trace<f64> {
         self.network()
             .forward(i, input_features(&self.shape, c, k, i))
+    }
+
+    /// The point of the unit square of index `i`, instance `k`, normalized condition
+    /// `c`: [`Network::square_point`], the same bits as
+    /// `self.trace(c, k, i).square_point()` without recording a [`Trace`].
+    pub fn square_point(&self, c: [f64; 2], k: u32, i: u32) -> [f64; 2] {
+        self.network()
+            .square_point(i, input_features(&self.shape, c, k, i))
     }
 
     /// The parameters as f16 bits (round to nearest even through `f32`).
@@ -79,7 +79,7 @@ impl Params {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nuld_core::network::Activation;
+    use nuld_core::network::{Activation, INPUTS};
 
     #[test]
     fn init_is_deterministic_sized_and_bounded() {

@@ -95,12 +95,13 @@ impl<P: AdamParam> Adam<P> {
         }
     }
 
-    /// The state to checkpoint: first and second moments and the step count.
-    pub fn state(&self) -> (&[P], &[P], i32) {
-        (&self.m, &self.v, self.t)
+    /// The state to checkpoint, moved out: first and second moments and the step
+    /// count.
+    pub fn into_state(self) -> (Vec<P>, Vec<P>, i32) {
+        (self.m, self.v, self.t)
     }
 
-    /// Restores a state saved by [`Adam::state`] (default decay rates and epsilon).
+    /// Restores a state taken by [`Adam::into_state`] (default decay rates and epsilon).
     ///
     /// # Panics
     /// If `m` and `v` differ in length.
@@ -157,5 +158,23 @@ mod tests {
             b.step_scaled(&mut q, &g, 0.03, None);
         }
         assert_eq!(p, q);
+    }
+
+    #[test]
+    fn a_state_moved_out_and_back_continues_bit_for_bit() {
+        let g = |k: usize| [0.3 - 0.1 * k as f64, -1.7 / (k + 1) as f64, 2.5];
+        let (mut p, mut q) = (vec![1.0f64, -2.0, 0.5], vec![1.0f64, -2.0, 0.5]);
+        let mut straight = Adam::<f64>::new(3);
+        let mut moved = Adam::<f64>::new(3);
+        for k in 0..6 {
+            straight.step(&mut p, &g(k), 0.05);
+            moved.step(&mut q, &g(k), 0.05);
+            let (m, v, t) = moved.into_state();
+            assert_eq!(t, k as i32 + 1);
+            moved = Adam::from_state(m, v, t);
+        }
+        let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&p), bits(&q));
+        assert_ne!(p, vec![1.0, -2.0, 0.5]);
     }
 }

@@ -5,6 +5,7 @@
 
 use super::adam::Adam;
 use super::{epoch_schedule, AreaOption, EpochReport};
+use crate::baselines::warped_owen_sobol_directions;
 use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea, CapTree};
 use crate::discrepancy::GradientPath;
 use crate::seeding::{derive_seed, rng};
@@ -115,9 +116,9 @@ pub(crate) fn map_jacobian(domain: Domain, p: DVec2) -> (DVec3, DVec3) {
 /// expressed in the domain's equal-area square.
 pub fn initial_square_points(density: &dyn DirectionDensity, n: usize, seed: u64) -> Vec<DVec2> {
     let domain = density.domain();
-    super::initial_parameters(n, seed)
+    warped_owen_sobol_directions(density, n, seed)
         .into_iter()
-        .map(|u| domain.to_square(density.sample(u)))
+        .map(|d| domain.to_square(d))
         .collect()
 }
 
@@ -250,11 +251,7 @@ fn run(
 ) -> Vec<DVec2> {
     let domain = density.domain();
     let mut params = initial_square_points(density, n, config.seed);
-    let area_of_domain = if domain == Domain::Hemisphere {
-        2.0
-    } else {
-        4.0
-    } * std::f64::consts::PI;
+    let area_of_domain = domain.area();
     let spacing = (area_of_domain / n as f64).sqrt();
     // Square units per radian: the equal-area map scales areas by 1/area_of_domain.
     let square_per_radian = 1.0 / area_of_domain.sqrt();

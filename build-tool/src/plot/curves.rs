@@ -1,7 +1,7 @@
 //! Log-log line plots: one line per method, as the paper's discrepancy and error
 //! figures show them.
 
-use super::register_fonts;
+use super::{err, write_png};
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
 use std::path::Path;
@@ -41,7 +41,6 @@ pub fn render_loglog(
     series: &[Series],
     (width, height): (u32, u32),
 ) -> Result<()> {
-    register_fonts();
     let positive = |&(x, y): &(f64, f64)| x > 0.0 && y > 0.0 && x.is_finite() && y.is_finite();
     let all: Vec<(f64, f64)> = series
         .iter()
@@ -56,11 +55,8 @@ pub fn render_loglog(
     let (ymin, ymax) = all
         .iter()
         .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
-    let mut buf = vec![255u8; (width * height * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buf, (width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
-        let mut chart = ChartBuilder::on(&root)
+    write_png(path, (width, height), |root| {
+        let mut chart = ChartBuilder::on(root)
             .caption(title, ("sans-serif", 20))
             .margin(14)
             .x_label_area_size(44)
@@ -69,7 +65,7 @@ pub fn render_loglog(
                 (xmin / 1.2..xmax * 1.2).log_scale(),
                 (ymin / 1.5..ymax * 1.5).log_scale(),
             )
-            .map_err(|e| anyhow!("plot: {e}"))?;
+            .map_err(err)?;
         chart
             .configure_mesh()
             .x_desc(x_label)
@@ -78,7 +74,7 @@ pub fn render_loglog(
             .y_label_formatter(&|v| format!("{v:.0e}"))
             .light_line_style(RGBColor(235, 235, 235))
             .draw()
-            .map_err(|e| anyhow!("plot: {e}"))?;
+            .map_err(err)?;
         let mut order: Vec<usize> = (0..series.len()).collect();
         // "ours" last, so it is drawn on top.
         order.sort_by_key(|&i| series[i].label.eq_ignore_ascii_case("ours"));
@@ -94,7 +90,7 @@ pub fn render_loglog(
             let pts: Vec<(f64, f64)> = s.points.iter().copied().filter(positive).collect();
             chart
                 .draw_series(LineSeries::new(pts.clone(), style))
-                .map_err(|e| anyhow!("plot: {e}"))?
+                .map_err(err)?
                 .label(s.label.clone())
                 .legend(move |(x, y)| {
                     PathElement::new(
@@ -110,7 +106,7 @@ pub fn render_loglog(
                     pts.iter()
                         .map(|&p| Circle::new(p, if ours { 4 } else { 3 }, style)),
                 )
-                .map_err(|e| anyhow!("plot: {e}"))?;
+                .map_err(err)?;
         }
         chart
             .configure_series_labels()
@@ -119,14 +115,9 @@ pub fn render_loglog(
             .border_style(BLACK)
             .label_font(("sans-serif", 15))
             .draw()
-            .map_err(|e| anyhow!("plot: {e}"))?;
-        root.present().map_err(|e| anyhow!("plot: {e}"))?;
-    }
-    let img =
-        image::RgbImage::from_raw(width, height, buf).ok_or_else(|| anyhow!("plot buffer size"))?;
-    let mut png = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
-    crate::output::write_atomic(path, &png)
+            .map_err(err)?;
+        Ok(())
+    })
 }
 
 #[cfg(test)]

@@ -1,7 +1,7 @@
 //! Heat maps of a value over a grid of two parameters, each cell coloured on a
 //! diverging scale about a reference value and labelled with its value.
 
-use super::write_png;
+use super::{err, write_png};
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
 use std::path::Path;
@@ -24,10 +24,6 @@ pub struct Heatmap<'a> {
     /// The value drawn white: larger values go to red, smaller to blue, saturating
     /// at twice and half of it.
     pub center: f64,
-}
-
-fn err(e: impl std::fmt::Display) -> anyhow::Error {
-    anyhow!("plot: {e}")
 }
 
 /// The parameter value at integer tick `v` (cell centres), empty elsewhere.

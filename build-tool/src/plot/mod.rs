@@ -31,6 +31,11 @@ pub(crate) fn register_fonts() {
     });
 }
 
+/// A plotters error as this crate's error, `plot: ...`.
+pub(crate) fn err(e: impl std::fmt::Display) -> anyhow::Error {
+    anyhow!("plot: {e}")
+}
+
 /// Renders into a fresh `w x h` buffer and writes it as PNG to `path` atomically.
 pub(crate) fn write_png(
     path: &Path,
@@ -41,9 +46,9 @@ pub(crate) fn write_png(
     let mut buf = vec![255u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| anyhow!("plot: {e}"))?;
+        root.fill(&WHITE).map_err(err)?;
         draw(&root)?;
-        root.present().map_err(|e| anyhow!("plot: {e}"))?;
+        root.present().map_err(err)?;
     }
     let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| anyhow!("plot buffer size"))?;
     let mut png = Vec::new();

@@ -2,15 +2,11 @@
 //! unit square, and direction sets both in their equal-area square and as
 //! orthographic views of the sphere.
 
-use super::{write_png, Area};
-use anyhow::{anyhow, Result};
+use super::{err, write_png, Area};
+use anyhow::Result;
 use glam::{DVec2, DVec3};
 use plotters::prelude::*;
 use std::path::Path;
-
-fn err(e: impl std::fmt::Display) -> anyhow::Error {
-    anyhow!("plot: {e}")
-}
 
 /// Fills the plotting area of a `[lo, hi]^2` chart with `shade(x, y)` (grayscale,
 /// white = high, scaled to the 99th percentile so a sharp peak does not wash out the
@@ -84,6 +80,27 @@ fn draw_panel(
     Ok(())
 }
 
+/// A unit-square panel with y pointing down (row 0 of an image at the top): the
+/// density and the points are flipped together.
+fn draw_square(
+    area: &Area<'_>,
+    caption: &str,
+    x_desc: &str,
+    density: &dyn Fn(DVec2) -> f64,
+    points: &[DVec2],
+) -> Result<()> {
+    let flipped: Vec<(f64, f64)> = points.iter().map(|p| (p.x, 1.0 - p.y)).collect();
+    draw_panel(
+        area,
+        caption,
+        (0.0, 1.0),
+        Some((x_desc, "y (down)")),
+        &|x, y| Some(density(DVec2::new(x, 1.0 - y))),
+        &[],
+        &flipped,
+    )
+}
+
 /// Draws `points` (in `[0,1]^2`) over `density` and writes a PNG of
 /// `size x (size + 60)` pixels to `path` atomically. The y axis points down, as
 /// image rows do (docs/targets.md: y grows with the row index), so an `image:` target
@@ -95,17 +112,8 @@ pub fn render_point_set(
     points: &[DVec2],
     size: u32,
 ) -> Result<()> {
-    let flipped: Vec<(f64, f64)> = points.iter().map(|p| (p.x, 1.0 - p.y)).collect();
     write_png(path, (size, size + 60), |root| {
-        draw_panel(
-            root,
-            title,
-            (0.0, 1.0),
-            Some(("x", "y (down)")),
-            &|x, y| Some(density(DVec2::new(x, 1.0 - y))),
-            &[],
-            &flipped,
-        )
+        draw_square(root, title, "x", density, points)
     })
 }
 
@@ -125,7 +133,6 @@ pub fn render_direction_set(
     size: u32,
 ) -> Result<()> {
     let dirs: Vec<DVec3> = square_points.iter().map(|&p| to_direction(p)).collect();
-    let flipped: Vec<(f64, f64)> = square_points.iter().map(|p| (p.x, 1.0 - p.y)).collect();
     // The map tells the domain: the sphere's map sends the square's corners to -z,
     // the hemisphere's sends the whole square to z >= 0. A 9 x 9 grid includes the
     // corners.
@@ -146,14 +153,12 @@ pub fn render_direction_set(
     let columns = 1 + views.len();
     write_png(path, (columns as u32 * size, size + 60), |root| {
         let panels = root.split_evenly((1, columns));
-        draw_panel(
+        draw_square(
             &panels[0],
             title,
-            (0.0, 1.0),
-            Some(("equal-area square x", "y (down)")),
-            &|x, y| Some(density(to_direction(DVec2::new(x, 1.0 - y)))),
-            &[],
-            &flipped,
+            "equal-area square x",
+            &|p| density(to_direction(p)),
+            square_points,
         )?;
         for (panel, &(sign, caption)) in panels[1..].iter().zip(views) {
             let visible: Vec<(f64, f64)> = dirs
@@ -198,15 +203,12 @@ pub fn render_square_panels(path: &Path, panels: &[SquarePanel<'_>], size: u32) 
     write_png(path, (columns as u32 * size, size + 60), |root| {
         let areas = root.split_evenly((1, columns));
         for (area, panel) in areas.iter().zip(panels) {
-            let flipped: Vec<(f64, f64)> = panel.points.iter().map(|p| (p.x, 1.0 - p.y)).collect();
-            draw_panel(
+            draw_square(
                 area,
                 &panel.caption,
-                (0.0, 1.0),
-                Some(("equal-area square x", "y (down)")),
-                &|x, y| Some((panel.density)(DVec2::new(x, 1.0 - y))),
-                &[],
-                &flipped,
+                "equal-area square x",
+                panel.density,
+                &panel.points,
             )?;
         }
         Ok(())

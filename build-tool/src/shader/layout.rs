@@ -11,8 +11,11 @@ use nuld_core::blob::{
     BlobKind, Domain, Header, PointSetInfo, SectionEntry, SectionTag, HEADER_LEN, MAX_SECTIONS,
     SECTION_ENTRY_LEN,
 };
-use nuld_core::conditional::ConditionalInfo;
-use nuld_core::network::{Activation, DOT_LANES, INPUTS, MAX_HIDDEN_LAYERS, MAX_WIDTH, OUTPUTS};
+use nuld_core::brdf::{MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
+use nuld_core::conditional::{ConditionalInfo, PointWarp};
+use nuld_core::network::{
+    Activation, DOT_LANES, INPUTS, LATTICE_LOGIT_EPS, MAX_HIDDEN_LAYERS, MAX_WIDTH, OUTPUTS,
+};
 use nuld_core::quantize::{f16_decode_finite, UNORM16_CELLS};
 use nuld_runtime::shader::{KernelParams, KERNEL_WORKGROUP_SIZE, SAMPLE_STRIDE};
 use std::mem::{offset_of, size_of};
@@ -108,6 +111,9 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
             "NULD_INFO_LATTICE_GENERATOR",
             offset_of!(ConditionalInfo, lattice_generator) as u64,
         ),
+        ("NULD_INFO_WARP", offset_of!(ConditionalInfo, warp) as u64),
+        ("NULD_WARP_EQUAL_AREA", PointWarp::EqualArea as u64),
+        ("NULD_WARP_BRDF_MIXTURE", PointWarp::BrdfMixture as u64),
         ("NULD_INPUTS", INPUTS as u64),
         ("NULD_MAX_WIDTH", MAX_WIDTH as u64),
         ("NULD_MAX_HIDDEN_LAYERS", MAX_HIDDEN_LAYERS as u64),
@@ -118,6 +124,15 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_FRAC_PI_4", f(core::f32::consts::FRAC_PI_4)),
         ("NULD_FRAC_PI_2", f(core::f32::consts::FRAC_PI_2)),
         ("NULD_DEGREES_PER_RADIAN", f(180.0 / core::f32::consts::PI)),
+        ("NULD_PI", f(core::f32::consts::PI)),
+        (
+            "NULD_RADIANS_PER_DEGREE",
+            f((core::f64::consts::PI / 180.0) as f32),
+        ),
+        ("NULD_MIN_ROUGHNESS", f(MIN_ROUGHNESS as f32)),
+        ("NULD_MAX_ROUGHNESS", f(MAX_ROUGHNESS as f32)),
+        ("NULD_MAX_THETA_O_DEG", f(MAX_THETA_O_DEG as f32)),
+        ("NULD_LATTICE_LOGIT_EPS", f(LATTICE_LOGIT_EPS as f32)),
         ("NULD_UNORM16_SCALE", f(1.0 / UNORM16_CELLS as f32)),
         ("NULD_INSTANCE_UNIT", f((1.0f64 / 16_777_216.0) as f32)),
         // libm's acosf (FreeBSD e_acosf.c), its literals and hex comments.
@@ -187,6 +202,10 @@ fn rust_structs() -> Vec<(&'static str, u64)> {
         (
             "NuldConditionalInfo.lattice_generator",
             offset_of!(ConditionalInfo, lattice_generator) as u64,
+        ),
+        (
+            "NuldConditionalInfo.warp",
+            offset_of!(ConditionalInfo, warp) as u64,
         ),
         ("NuldKernelParams", size_of::<KernelParams>() as u64),
         (

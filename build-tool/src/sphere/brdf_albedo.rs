@@ -54,6 +54,14 @@ pub fn directional_albedo(model: BrdfModel, roughness: f64, theta_o_deg: f64) ->
     albedo_with(model, roughness, theta_o_deg, &gauss_legendre(NODES))
 }
 
+/// The specular share `p_s = A_spec / A` of the albedo at a condition: the
+/// probability with which the renderer's mixture warp
+/// ([`nuld_core::warp::brdf_mixture_real`]) picks the GGX lobe.
+pub fn lobe_probability(model: BrdfModel, roughness: f64, theta_o_deg: f64) -> f64 {
+    let a = directional_albedo(model, roughness, theta_o_deg);
+    a.specular / a.total()
+}
+
 /// [`directional_albedo`] on a grid: entry `i * theta_o_deg.len() + j` is the
 /// albedo `A` at `(roughness[i], theta_o_deg[j])` (row-major, roughness slowest).
 /// Computed in parallel; the result does not depend on the thread count.

@@ -32,14 +32,13 @@ pub use pool::{ConditionPool, PoolCondition};
 
 use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use crate::discrepancy::GradientPath;
-use crate::network::{backward, hemisphere_square_gradient, output_gradient, Params};
+use crate::network::{backward, output_gradient, Params};
 use crate::optimize::adam::Adam;
 use crate::optimize::epoch_schedule;
 use crate::seeding::rng;
 use glam::{DVec2, DVec3};
+use nuld_core::blob::Domain;
 use nuld_core::network::{Activation, Shape};
-use nuld_core::sphere::square_to_hemisphere;
-use pool::HEMISPHERE_AREA;
 use rand::Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -53,6 +52,11 @@ pub struct TrainConfig {
     pub hidden: Vec<u32>,
     /// `true` for SiLU hidden units, `false` for ReLU.
     pub silu: bool,
+    /// `true`: the network emits a residual on the logit of the shifted lattice
+    /// point in the primary sample space of the renderer's mixture warp
+    /// ([`nuld_core::conditional::PointWarp::BrdfMixture`]); `false`: a point of
+    /// the equal-area square.
+    pub mixture_prior: bool,
     /// Gradient steps on the cap loss.
     pub steps: usize,
     /// Steps before those that fit the network to the renderer's warp of its
@@ -89,6 +93,7 @@ impl Default for TrainConfig {
             n: 64,
             hidden: vec![32, 32],
             silu: false,
+            mixture_prior: true,
             steps: 12_000,
             pretrain_steps: 300,
             conditions_per_step: 8,
@@ -115,6 +120,7 @@ impl TrainConfig {
             Activation::Relu
         };
         Shape::new(self.n, &self.hidden, act, lattice_generator(self.n))
+            .map(|s| s.with_lattice_residual(self.mixture_prior))
     }
 }
 
@@ -303,10 +309,7 @@ impl Trainer {
             self.state.adam_t,
         );
         adam.step(&mut self.state.params, &grad, lr);
-        let (m, v, at) = adam.state();
-        self.state.adam_m = m.to_vec();
-        self.state.adam_v = v.to_vec();
-        self.state.adam_t = at;
+        (self.state.adam_m, self.state.adam_v, self.state.adam_t) = adam.into_state();
         self.state.losses.push(loss);
         self.state.step += 1;
         StepReport {
@@ -365,20 +368,20 @@ fn condition_step(
     let caps: Vec<Cap> = (0..m).map(|j| pc.caps[idx(j)]).collect();
     let mu: Vec<f64> = (0..m).map(|j| pc.measures[idx(j)]).collect();
     let mut traces = Vec::with_capacity(s * n);
-    let mut squares = Vec::with_capacity(s * n);
+    let mut jacobians = Vec::with_capacity(s * n);
     let mut dirs = Vec::with_capacity(s * n);
     for &k in instances {
         for i in 0..cfg.n {
             let t = params.trace(pc.unit, k, i);
             let sq = t.square_point();
-            let p = DVec2::new(sq[0], sq[1]);
+            let (d, jx, jy) = pc.direction(DVec2::new(sq[0], sq[1]));
             traces.push(t);
-            squares.push(p);
-            dirs.push(square_to_hemisphere(p));
+            jacobians.push((jx, jy));
+            dirs.push(d);
         }
     }
     let local: Vec<f64> = dirs.iter().map(|&x| pc.local_factor(x)).collect();
-    let spacing = |points: usize| (HEMISPHERE_AREA / points as f64).sqrt();
+    let spacing = |points: usize| (Domain::Hemisphere.area() / points as f64).sqrt();
     let mut grad3 = vec![DVec3::ZERO; s * n];
     let mut g = vec![DVec3::ZERO; s * n];
     let mut set_loss = 0.0;
@@ -416,8 +419,8 @@ fn condition_step(
         }
     }
     let mut grad = vec![0.0; params.values.len()];
-    for (j, ((t, &p), &g3)) in traces.iter().zip(&squares).zip(&grad3).enumerate() {
-        let d_out = output_gradient(t, hemisphere_square_gradient(p, g3));
+    for (j, ((t, &(jx, jy)), &g3)) in traces.iter().zip(&jacobians).zip(&grad3).enumerate() {
+        let d_out = output_gradient(t, DVec2::new(jx.dot(g3), jy.dot(g3)));
         let i = (j % n) as u32;
         backward(&params.shape, &params.values, t, i, d_out, &mut grad);
     }
@@ -516,6 +519,9 @@ mod tests {
             pool_caps: 256,
             caps_per_step: 128,
             learning_rate: 1e-2,
+            // The equal-area output, whose start is far from the warp; with the
+            // mixture prior the start is the warp already.
+            mixture_prior: false,
             ..TrainConfig::default()
         };
         let mut t = Trainer::new(cfg, None);

@@ -10,35 +10,29 @@
 //! of `M` of each one's caps. The caps are measured with a `2^14`-point rule
 //! ([`BrdfTarget::coarse`], [`POOL_RULE_POINTS`]): the pool is paid once, nothing per step.
 
-use crate::baselines::seeded_owen_sobol;
+use crate::baselines::warped_owen_sobol_directions;
 use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use crate::discrepancy::GradientPath;
+use crate::optimize::directions::map_jacobian;
 use crate::optimize::directions::{epoch_caps, local_factor};
 use crate::seeding::derive_seed;
 use crate::sphere::{BrdfTarget, DirectionDensity};
 use glam::{DVec2, DVec3};
-use nuld_core::brdf::{view_direction, BrdfModel, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
+use nuld_core::blob::Domain;
+use nuld_core::brdf::{view_direction, BrdfModel, CONDITION_MAX, CONDITION_MIN};
+use nuld_core::conditional::PointWarp;
 use nuld_core::network::{instance_offset, shifted_lattice_point, Shape};
 use nuld_core::sphere::hemisphere_to_square;
 use rayon::prelude::*;
-use std::f64::consts::PI;
 
 /// Points of the rule that measures a pool condition's caps: `2^14`, 1/16 of a
 /// [`BrdfTarget::new`]'s, so that building the pool costs seconds, not minutes.
 pub const POOL_RULE_POINTS: usize = 1 << 14;
 
-/// Solid angle of the hemisphere.
-pub const HEMISPHERE_AREA: f64 = 2.0 * PI;
-
-/// The condition range of a BRDF sampler: `(roughness, theta_o in degrees)` from
-/// `COND_MIN` to `COND_MAX`.
-pub const COND_MIN: [f64; 2] = [MIN_ROUGHNESS, 0.0];
-/// Upper end of the condition range.
-pub const COND_MAX: [f64; 2] = [MAX_ROUGHNESS, MAX_THETA_O_DEG];
-
-/// The normalized condition in `[0,1]^2` of `(roughness, theta_o_deg)`.
+/// The normalized condition in `[0,1]^2` of `(roughness, theta_o_deg)`: its place
+/// between [`CONDITION_MIN`] and [`CONDITION_MAX`].
 pub fn normalized(cond: [f64; 2]) -> [f64; 2] {
-    core::array::from_fn(|a| (cond[a] - COND_MIN[a]) / (COND_MAX[a] - COND_MIN[a]))
+    core::array::from_fn(|a| (cond[a] - CONDITION_MIN[a]) / (CONDITION_MAX[a] - CONDITION_MIN[a]))
 }
 
 /// One training condition: what a step needs to score a set for it.
@@ -63,6 +57,11 @@ pub struct PoolCondition {
     /// Cap loss of `N` Owen-Sobol points through the renderer's warp on the first
     /// window of caps: the scale against which the trainer ranks conditions.
     pub baseline_loss: f64,
+    /// The specular share `p_s = A_spec / A` of the albedo, the mixture warp's lobe
+    /// probability.
+    pub lobe_probability: f64,
+    /// How the network's points become directions ([`PointWarp::of_shape`]).
+    pub warp: PointWarp,
 }
 
 impl PoolCondition {
@@ -74,7 +73,37 @@ impl PoolCondition {
     /// Local sharpness factor `sqrt(2 pi q(x))`, clamped (direction optimizer's
     /// local units).
     pub fn local_factor(&self, x: DVec3) -> f64 {
-        local_factor(HEMISPHERE_AREA, self.pdf(x))
+        local_factor(Domain::Hemisphere.area(), self.pdf(x))
+    }
+
+    /// The direction of the network's point `p` ([`PointWarp::direction`]) and its
+    /// derivatives along `p.x` and `p.y`: for the mixture warp by central
+    /// differences of step `1e-6`, zeroed where they straddle the lobe boundary (a
+    /// jump that no gradient can follow); for the hemisphere map exact.
+    pub fn direction(&self, p: DVec2) -> (DVec3, DVec3, DVec3) {
+        let warp = |u: DVec2| {
+            DVec3::from_array(self.warp.direction(
+                Domain::Hemisphere,
+                self.cond,
+                self.lobe_probability,
+                u.to_array(),
+            ))
+        };
+        if self.warp == PointWarp::EqualArea {
+            let (jx, jy) = map_jacobian(Domain::Hemisphere, p);
+            return (warp(p), jx, jy);
+        }
+        const H: f64 = 1e-6;
+        let diff = |e: DVec2| {
+            let j = (warp(p + H * e) - warp(p - H * e)) / (2.0 * H);
+            // A smooth warp moves a direction by at most ~1/alpha per unit of p.
+            if j.is_finite() && j.length() < 1e3 {
+                j
+            } else {
+                DVec3::ZERO
+            }
+        };
+        (warp(p), diff(DVec2::X), diff(DVec2::Y))
     }
 }
 
@@ -82,17 +111,24 @@ impl PoolCondition {
 pub const PRETRAIN_INSTANCES: u32 = 8;
 
 /// The warp's square points for the shifted lattices of the first
-/// [`PRETRAIN_INSTANCES`] instances: the renderer's mixture warp
-/// ([`BrdfTarget::sample`]) of each shifted lattice point, which the network reads
-/// as an input, so the start is a warped randomly shifted lattice.
+/// [`PRETRAIN_INSTANCES`] instances, so the start is a warped randomly shifted
+/// lattice: with a [lattice residual](Shape::lattice_residual) the shifted lattice
+/// point itself (a zero residual; the mixture warp follows), otherwise the
+/// square point of the renderer's mixture warp ([`BrdfTarget::sample`]) of it.
 fn warp_targets(target: &BrdfTarget, shape: &Shape) -> Vec<DVec2> {
     let (shape_n, g) = (shape.n(), shape.lattice_generator());
+    let residual = shape.lattice_residual();
     (0..PRETRAIN_INSTANCES)
         .flat_map(|k| {
             let z = instance_offset::<f64>(k);
             (0..shape_n).map(move |i| {
                 let u = shifted_lattice_point(i, shape_n, g, z);
-                hemisphere_to_square(target.sample(DVec2::new(u[0], u[1])))
+                let u = DVec2::new(u[0], u[1]);
+                if residual {
+                    u
+                } else {
+                    hemisphere_to_square(target.sample(u))
+                }
             })
         })
         .collect()
@@ -116,8 +152,9 @@ impl ConditionPool {
                     sobol_burley::sample(p as u32, 0, scramble) as f64,
                     sobol_burley::sample(p as u32, 1, scramble) as f64,
                 ];
-                let cond: [f64; 2] =
-                    core::array::from_fn(|a| COND_MIN[a] + u[a] * (COND_MAX[a] - COND_MIN[a]));
+                let cond: [f64; 2] = core::array::from_fn(|a| {
+                    CONDITION_MIN[a] + u[a] * (CONDITION_MAX[a] - CONDITION_MIN[a])
+                });
                 condition(cond, caps, window, shape, derive_seed(seed, p as u64))
             })
             .collect();
@@ -159,12 +196,11 @@ fn condition(
         measures,
         warp_targets: warp_targets(&target, shape),
         baseline_loss: 0.0,
+        lobe_probability: target.lobe_probability(),
+        warp: PointWarp::of_shape(shape),
     };
     let w = window.min(pc.caps.len());
-    let pts: Vec<DVec3> = seeded_owen_sobol(n, seed)
-        .into_iter()
-        .map(|u| target.sample(u))
-        .collect();
+    let pts = warped_owen_sobol_directions(&target, n, seed);
     let local: Vec<f64> = pts.iter().map(|&x| pc.local_factor(x)).collect();
     let mut g = vec![DVec3::ZERO; n];
     let baseline_loss = cap_loss_and_gradient(

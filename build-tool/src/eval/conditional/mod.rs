@@ -157,7 +157,10 @@ impl ConditionalSettings {
                 "condition ({r}, {t}) is outside roughness [0.1, 1] x theta_o [0, 89]"
             );
         }
-        ensure!(self.instances >= 1, "--instances must be at least 1");
+        ensure!(
+            self.instances >= 1,
+            "instances per condition must be at least 1"
+        );
         ensure!(
             self.union_instances >= 2,
             "--n-instances must be at least 2"
@@ -262,7 +265,6 @@ pub fn evaluate(
         settings.total_steps(samplers.len()),
         "set",
     );
-    let started = std::time::Instant::now();
     let star = settings.star_options();
     let per_instance = settings.instances.max(settings.union_instances);
     let mut results = Vec::with_capacity(settings.conditions.len());
@@ -352,11 +354,8 @@ pub fn evaluate(
             [roughness, theta],
             target.albedo(),
             methods,
-            References {
-                exact,
-                mixture,
-                direct,
-            },
+            [exact, mixture],
+            direct,
             diversities,
             examples,
         ));
@@ -367,7 +366,6 @@ pub fn evaluate(
         samplers.iter().map(|s| s.name().to_string()).collect(),
         n,
         results,
-        started.elapsed().as_secs_f64(),
     ))
 }
 

@@ -3,6 +3,8 @@
 //! `conditional-summary.md`, ratio heat maps and sets drawn over their target).
 
 use super::{ConditionalSettings, Diversity};
+use crate::eval::cache::sanitize;
+use crate::eval::stats;
 use crate::plot::{render_direction_set, render_heatmap, Heatmap};
 use crate::sphere::{BrdfTarget, DirectionDensity};
 use anyhow::Result;
@@ -48,23 +50,18 @@ impl MethodScore {
     /// If `scores` is empty.
     pub fn from_scores(method: &str, scores: &[(f64, f64, f64)]) -> Self {
         assert!(!scores.is_empty(), "no sets scored");
-        let k = scores.len() as f64;
-        let cap_l2 = scores.iter().map(|s| s.0).sum::<f64>() / k;
-        let var = if scores.len() > 1 {
-            scores.iter().map(|s| (s.0 - cap_l2).powi(2)).sum::<f64>() / (k - 1.0)
-        } else {
-            0.0
-        };
-        let se_instances = (var / k).sqrt();
-        let se_caps = scores.iter().map(|s| s.1).sum::<f64>() / k;
+        let column =
+            |f: fn(&(f64, f64, f64)) -> f64| stats::mean(&scores.iter().map(f).collect::<Vec<_>>());
+        let cap_l2 = column(|s| s.0);
+        let se_caps = column(|s| s.1).value;
         Self {
             method: method.into(),
             sets: scores.len(),
-            cap_l2,
-            cap_l2_se: se_instances.hypot(se_caps),
-            cap_l2_se_instances: se_instances,
+            cap_l2: cap_l2.value,
+            cap_l2_se: cap_l2.stderr.hypot(se_caps),
+            cap_l2_se_instances: cap_l2.stderr,
             cap_l2_se_caps: se_caps,
-            cap_star: scores.iter().map(|s| s.2).sum::<f64>() / k,
+            cap_star: column(|s| s.2).value,
         }
     }
 }
@@ -82,6 +79,19 @@ pub struct SamplerRatios {
     pub to_direct: Option<f64>,
     /// Largest local discrepancy over the exact reference's.
     pub star_to_exact: f64,
+}
+
+impl SamplerRatios {
+    /// The ratios of `score` to the references at its condition.
+    pub fn of(score: &MethodScore, refs: &References<'_>) -> Self {
+        Self {
+            sampler: score.method.clone(),
+            to_exact: score.cap_l2 / refs.exact.cap_l2,
+            to_mixture: score.cap_l2 / refs.mixture.cap_l2,
+            to_direct: refs.direct.map(|d| score.cap_l2 / d.cap_l2),
+            star_to_exact: score.cap_star / refs.exact.cap_star,
+        }
+    }
 }
 
 /// A method's diversity at one condition.
@@ -104,13 +114,13 @@ pub struct ExampleSet {
 }
 
 /// The references' scores at one condition.
-pub struct References {
+pub struct References<'a> {
     /// Exact-inverse-CDF reference.
-    pub exact: MethodScore,
+    pub exact: &'a MethodScore,
     /// Mixture reference.
-    pub mixture: MethodScore,
+    pub mixture: &'a MethodScore,
     /// Direct optimization, where it ran.
-    pub direct: Option<MethodScore>,
+    pub direct: Option<&'a MethodScore>,
 }
 
 /// Everything measured at one condition.
@@ -145,23 +155,19 @@ impl ConditionResult {
         [roughness, theta_o_deg]: [f64; 2],
         albedo: f64,
         samplers: Vec<MethodScore>,
-        References {
-            exact,
-            mixture,
-            direct,
-        }: References,
+        [exact, mixture]: [MethodScore; 2],
+        direct: Option<MethodScore>,
         diversity: Vec<(String, Diversity)>,
         examples: Vec<(String, Vec<DVec3>)>,
     ) -> Self {
+        let refs = References {
+            exact: &exact,
+            mixture: &mixture,
+            direct: direct.as_ref(),
+        };
         let ratios = samplers
             .iter()
-            .map(|s| SamplerRatios {
-                sampler: s.method.clone(),
-                to_exact: s.cap_l2 / exact.cap_l2,
-                to_mixture: s.cap_l2 / mixture.cap_l2,
-                to_direct: direct.as_ref().map(|d| s.cap_l2 / d.cap_l2),
-                star_to_exact: s.cap_star / exact.cap_star,
-            })
+            .map(|s| SamplerRatios::of(s, &refs))
             .collect();
         Self {
             roughness,
@@ -183,6 +189,15 @@ impl ConditionResult {
                     directions: d.iter().map(|v| v.to_array()).collect(),
                 })
                 .collect(),
+        }
+    }
+
+    /// The references' scores here.
+    pub fn references(&self) -> References<'_> {
+        References {
+            exact: &self.exact,
+            mixture: &self.mixture,
+            direct: self.direct.as_ref(),
         }
     }
 
@@ -258,14 +273,16 @@ impl ConditionalReport {
         samplers: Vec<String>,
         n: usize,
         conditions: Vec<ConditionResult>,
-        _seconds: f64,
     ) -> Self {
         let mut summary: Vec<SamplerSummary> = samplers
             .iter()
             .enumerate()
-            .map(|(j, name)| summarize(name, &conditions, |c| Some(&c.ratios[j])))
+            .map(|(j, name)| summarize(name, &conditions, |c| c.ratios[j].clone()))
             .collect();
-        summary.push(summarize(EXACT, &conditions, |_| None));
+        // The exact reference against itself: ratios 1, its own diversity.
+        summary.push(summarize(EXACT, &conditions, |c| {
+            SamplerRatios::of(&c.exact, &c.references())
+        }));
         Self {
             title: format!(
                 "conditional sampler on held-out conditions, N = {n}: cap L2 and largest \
@@ -373,7 +390,8 @@ impl ConditionalReport {
     /// (`conditional-<sampler>-ratio.png`) and of its union ratio
     /// (`conditional-<sampler>-union.png`), and instance 0 of every sampler and of
     /// the exact reference over the target at up to three conditions
-    /// (`conditional-sets-r<R>-t<T>.png`, one row per method); returns the paths.
+    /// (`conditional-sets-<method>-r<R>-t<T>.png`, one file per method and
+    /// condition); returns the paths.
     pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
         crate::output::ensure_dir(dir)?;
         let mut written = Vec::new();
@@ -463,7 +481,8 @@ impl ConditionalReport {
         picks.dedup();
         let mut written = Vec::new();
         for c in picks.into_iter().map(|i| pool[i]) {
-            let target = BrdfTarget::new(c.roughness, c.theta_o_deg, Domain::Hemisphere)?;
+            // Only the density is drawn: no cap-measure table worth building.
+            let target = BrdfTarget::coarse(c.roughness, c.theta_o_deg, 1 << 10)?;
             for e in &c.examples {
                 let square: Vec<glam::DVec2> = e
                     .directions
@@ -494,30 +513,15 @@ impl ConditionalReport {
     }
 }
 
-/// `name` with every character outside `[A-Za-z0-9.-]` replaced by `_`.
-fn sanitize(name: &str) -> String {
-    name.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '.' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
-}
-
-/// The summary of one sampler (`ratio(c)` its ratios at condition `c`), or of the
-/// exact reference when `ratio` gives `None` (ratios 1, its own diversity).
-fn summarize<'a>(
+/// The summary of one sampler over all conditions, `ratio(c)` its ratios at
+/// condition `c`.
+fn summarize(
     name: &str,
-    conditions: &'a [ConditionResult],
-    ratio: impl Fn(&'a ConditionResult) -> Option<&'a SamplerRatios>,
+    conditions: &[ConditionResult],
+    ratio: impl Fn(&ConditionResult) -> SamplerRatios,
 ) -> SamplerSummary {
-    let to_exact: Vec<f64> = conditions
-        .iter()
-        .map(|c| ratio(c).map_or(1.0, |r| r.to_exact))
-        .collect();
+    let ratios: Vec<SamplerRatios> = conditions.iter().map(ratio).collect();
+    let to_exact: Vec<f64> = ratios.iter().map(|r| r.to_exact).collect();
     let (worst_at, worst) =
         to_exact
             .iter()
@@ -540,22 +544,9 @@ fn summarize<'a>(
             conditions[worst_at].theta_o_deg,
         ],
         conditions_above_one: to_exact.iter().filter(|&&v| v > 1.0).count(),
-        mean_ratio_mixture: mean(
-            conditions
-                .iter()
-                .map(|c| ratio(c).map_or(c.exact.cap_l2 / c.mixture.cap_l2, |r| r.to_mixture)),
-        )
-        .unwrap_or(f64::NAN),
-        mean_ratio_direct: mean(conditions.iter().filter_map(|c| match ratio(c) {
-            Some(r) => r.to_direct,
-            None => c.direct.as_ref().map(|d| c.exact.cap_l2 / d.cap_l2),
-        })),
-        mean_star_ratio_exact: mean(
-            conditions
-                .iter()
-                .map(|c| ratio(c).map_or(1.0, |r| r.star_to_exact)),
-        )
-        .unwrap_or(f64::NAN),
+        mean_ratio_mixture: mean(ratios.iter().map(|r| r.to_mixture)).unwrap_or(f64::NAN),
+        mean_ratio_direct: mean(ratios.iter().filter_map(|r| r.to_direct)),
+        mean_star_ratio_exact: mean(ratios.iter().map(|r| r.star_to_exact)).unwrap_or(f64::NAN),
         mean_union_ratio: mean(div.iter().map(|d| d.union_ratio)).unwrap_or(f64::NAN),
         worst_union_ratio: div.iter().map(|d| d.union_ratio).fold(f64::NAN, f64::max),
         mean_nn_ratio: mean(div.iter().map(|d| d.nn_ratio)).unwrap_or(f64::NAN),

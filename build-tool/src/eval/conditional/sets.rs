@@ -5,12 +5,11 @@
 
 use crate::baselines::seeded_owen_sobol;
 use crate::seeding::derive_seed;
-use crate::sphere::{BrdfTarget, DirectionDensity};
+use crate::sphere::brdf_albedo::lobe_probability;
 use anyhow::Result;
 use glam::DVec3;
-use nuld_core::blob::Domain;
-use std::collections::HashMap;
-use std::sync::{Arc, Mutex};
+use nuld_core::brdf::{clamp_roughness, clamp_theta_o_deg, BrdfModel};
+use nuld_core::conditional::brdf_mixture_direction;
 
 /// One conditional sampler: the `len()` directions of instance `k` at condition
 /// `(roughness, theta_o_deg)` (glTF BRDF of `nuld_core::brdf`, view in the
@@ -63,10 +62,10 @@ impl<F: Fn(f64, f64, u32, u32) -> DVec3 + Sync> ConditionalSets for SampleFnSets
 }
 
 /// Independent Owen-scrambled Sobol sets, one scramble per instance
-/// (`seeded_owen_sobol(n, derive_seed(seed, instance))`), warped by the target's
-/// mixture warp ([`BrdfTarget::sample`]: VNDF with probability `A_spec / A`, else
-/// cosine): what a renderer does today, as a [`ConditionalSets`]. The targets are
-/// built once per condition and kept.
+/// (`seeded_owen_sobol(n, derive_seed(seed, instance))`), warped by the renderer's
+/// mixture warp ([`brdf_mixture_direction`]: VNDF with probability
+/// `p_s = A_spec / A`, else cosine; what [`crate::sphere::BrdfTarget::sample`]
+/// does): what a renderer does today, as a [`ConditionalSets`].
 ///
 /// It is the calibration sampler of the report: its instances are independent
 /// randomizations, so the diversity figures come out near their independent values
@@ -74,28 +73,12 @@ impl<F: Fn(f64, f64, u32, u32) -> DVec3 + Sync> ConditionalSets for SampleFnSets
 pub struct MixtureOwenSobol {
     n: usize,
     seed: u64,
-    targets: Mutex<HashMap<(u64, u64), Arc<BrdfTarget>>>,
 }
 
 impl MixtureOwenSobol {
     /// Sets of `n` points for scramble seed `seed`.
     pub fn new(n: usize, seed: u64) -> Self {
-        Self {
-            n,
-            seed,
-            targets: Mutex::new(HashMap::new()),
-        }
-    }
-
-    fn target(&self, roughness: f64, theta_o_deg: f64) -> Arc<BrdfTarget> {
-        let key = (roughness.to_bits(), theta_o_deg.to_bits());
-        let mut memo = self.targets.lock().unwrap_or_else(|e| e.into_inner());
-        Arc::clone(memo.entry(key).or_insert_with(|| {
-            let r = roughness.clamp(0.1, 1.0);
-            let t = theta_o_deg.clamp(0.0, 89.0);
-            // In range after the clamp, so construction cannot fail.
-            Arc::new(BrdfTarget::new(r, t, Domain::Hemisphere).expect("clamped condition"))
-        }))
+        Self { n, seed }
     }
 }
 
@@ -107,10 +90,11 @@ impl ConditionalSets for MixtureOwenSobol {
         self.n
     }
     fn set(&self, roughness: f64, theta_o_deg: f64, instance: u32) -> Vec<DVec3> {
-        let target = self.target(roughness, theta_o_deg);
+        let cond = [clamp_roughness(roughness), clamp_theta_o_deg(theta_o_deg)];
+        let p_s = lobe_probability(BrdfModel::Gltf, cond[0], cond[1]);
         seeded_owen_sobol(self.n, derive_seed(self.seed, instance as u64))
             .into_iter()
-            .map(|u| target.sample(u))
+            .map(|u| DVec3::from_array(brdf_mixture_direction(cond, p_s, u.to_array())))
             .collect()
     }
 }
