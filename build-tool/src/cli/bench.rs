@@ -56,6 +56,10 @@ pub enum BenchPart {
     /// Only the runtime's conditional sampler against the incumbent warp
     /// (nanoseconds per sample, one thread; not part of `all`).
     Runtime,
+    /// Only the conditional sampler's training: milliseconds per step at N = 64,
+    /// 256 and 2048, all threads, and the default bake's training time that
+    /// implies (not part of `all`).
+    Training,
 }
 
 fn direction_seconds_per_epoch(
@@ -154,7 +158,46 @@ pub fn run(a: BenchArgs) -> Result<()> {
         BenchPart::Directions => run_directions(&a),
         BenchPart::Baselines => run_baselines(&a),
         BenchPart::Runtime => run_runtime(),
+        BenchPart::Training => run_training(),
     }
+}
+
+/// Sizes of the training timings and the cap-loss steps timed at each (a step
+/// costs about linearly in N).
+const TRAINING_SIZES: [(u32, usize); 3] = [(64, 20), (256, 6), (2048, 2)];
+
+/// Milliseconds per training step of the conditional BRDF sampler, all threads,
+/// and the default bake's training time at that rate.
+fn run_training() -> Result<()> {
+    let sizes: Vec<u32> = TRAINING_SIZES.iter().map(|s| s.0).collect();
+    let steps = |n| TRAINING_SIZES.iter().find(|s| s.0 == n).map_or(1, |s| s.1);
+    let d = crate::train::TrainConfig::default();
+    println!(
+        "conditional sampler training, {} rayon threads, hidden {:?}, {} conditions x {} instances per step",
+        rayon::current_num_threads(),
+        d.hidden,
+        d.conditions_per_step,
+        d.instances_per_condition
+    );
+    println!(
+        "{:>6} {:>10} {:>8} {:>12} {:>30}",
+        "N",
+        "setup s",
+        "steps",
+        "ms/step",
+        format!("{} steps at that rate, min", d.pretrain_steps + d.steps)
+    );
+    for t in crate::train::speed::measure(&sizes, steps) {
+        println!(
+            "{:>6} {:>10.1} {:>8} {:>12.1} {:>30.1}",
+            t.n,
+            t.setup_s,
+            t.timed_steps,
+            t.ms_per_step,
+            t.default_training_s / 60.0
+        );
+    }
+    Ok(())
 }
 
 /// Samples timed per method (a tenth of it in network mode).

@@ -26,6 +26,7 @@
 
 pub mod checkpoint;
 pub mod pool;
+pub mod speed;
 
 pub use checkpoint::Checkpoint;
 pub use pool::{ConditionPool, PoolCondition};
