@@ -544,11 +544,18 @@ fn layer<T: Real>(
     let fan_in = x.len().min(MAX_WIDTH);
     let x = &x[..fan_in];
     let mut scratch = [T::ZERO; MAX_WIDTH];
-    for (o, slot) in out.iter_mut().enumerate() {
-        let mut acc = w.get(bias + o);
-        if let Some(e) = extra {
-            acc = acc + w.get(e + o);
+    // The biases (and the embedding row) in one vectorized read each, not a
+    // bounds-checked decode per unit: `out` holds each unit's `acc` until its dot.
+    w.read(bias, out);
+    if let Some(e) = extra {
+        let extra = &mut scratch[..out.len().min(MAX_WIDTH)];
+        w.read(e, extra);
+        for (acc, &v) in out.iter_mut().zip(extra.iter()) {
+            *acc = *acc + v;
         }
+    }
+    for (o, slot) in out.iter_mut().enumerate() {
+        let acc = *slot;
         *slot = finish(o, acc + w.row_dot(off + o * fan_in, x, &mut scratch));
     }
 }
