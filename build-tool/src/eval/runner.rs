@@ -127,10 +127,12 @@ fn evaluator<'a>(
                 "{}/{}/{}",
                 s.cap_star_caps, s.cap_star_refine, s.cap_star_rounds
             );
+            // v2: `brdf:` specs name the glTF BRDF; v1 entries of brdf panels were
+            // computed when they named the Burley BRDF, and must not be hits.
             let fp = if uniform {
-                format!("sph-v1;{};star={}", panel.spec, star)
+                format!("sph-v2;{};star={}", panel.spec, star)
             } else {
-                format!("sph-v1;{};star={};l2mc={}", panel.spec, star, s.cap_l2_caps)
+                format!("sph-v2;{};star={};l2mc={}", panel.spec, star, s.cap_l2_caps)
             };
             let sampler = DirectionSampler {
                 density: density.as_ref(),
@@ -185,7 +187,8 @@ fn evaluator<'a>(
             (
                 Box::new(f),
                 format!(
-                    "int3-v1;{};{};proj={}",
+                    // v2 as `sph-v2`: the brdf factor is the glTF BRDF.
+                    "int3-v2;{};{};proj={}",
                     it.name,
                     it.factors(),
                     super::methods::PROJECTION_RESOLUTION
