@@ -99,6 +99,29 @@ impl PointWarp {
             Self::BrdfMixture => brdf_mixture_direction(cond, p_s, p),
         }
     }
+
+    /// Central differences of [`Self::direction`] along `p.x` and `p.y` with step
+    /// `h`: `(d(p + h e_a) - d(p - h e_a)) / (2 h)` per axis `a`, unclamped (the
+    /// caller decides what a difference across the mixture's lobe boundary, a
+    /// jump, means). The mixture warp has no closed-form Jacobian worth keeping.
+    pub fn direction_differences<T: Real>(
+        self,
+        domain: Domain,
+        cond: [T; 2],
+        p_s: T,
+        p: [T; 2],
+        h: T,
+    ) -> [[T; 3]; 2] {
+        core::array::from_fn(|a| {
+            let step = |sign: T| {
+                let mut q = p;
+                q[a] = q[a] + sign * h;
+                self.direction(domain, cond, p_s, q)
+            };
+            let (hi, lo) = (step(T::ONE), step(T::ZERO - T::ONE));
+            core::array::from_fn(|c| (hi[c] - lo[c]) / (T::of(2.0) * h))
+        })
+    }
 }
 
 /// Contents of the conditional info section (80 bytes, `#[repr(C)]`,
@@ -235,6 +258,15 @@ impl ConditionalInfo {
                 0.0
             }
         })
+    }
+
+    /// The condition (blob units) of a normalized `u`: `cond_min + u (cond_max -
+    /// cond_min)` per axis, in `f32` in this order. Of [`Self::normalize`]'s
+    /// output, the condition clamped into the range, as the tables see it.
+    #[inline]
+    pub fn denormalize(&self, u: [f32; 2]) -> [f32; 2] {
+        let (lo, hi) = (self.cond_min, self.cond_max);
+        core::array::from_fn(|a| lo[a] + u[a] * (hi[a] - lo[a]))
     }
 
     /// The condition (blob units) of point-table node `(j0, j1)`:
@@ -383,6 +415,44 @@ mod tests {
             lattice_generator: 3,
             warp: 0,
             reserved: [0; 2],
+        }
+    }
+
+    #[test]
+    fn denormalize_gives_the_clamped_condition() {
+        let inf = info();
+        let back = |c: [f32; 2]| inf.denormalize(inf.normalize(c));
+        assert_eq!(back([0.1, 0.0]), [0.1, 0.0]);
+        assert_eq!(back([-3.0, 200.0]), [0.1, 89.0]);
+        assert_eq!(back([f32::NAN, f32::NAN]), [0.1, 0.0]);
+        let c = back([0.55, 30.0]);
+        assert!(
+            (c[0] - 0.55).abs() < 1e-6 && (c[1] - 30.0).abs() < 1e-5,
+            "{c:?}"
+        );
+    }
+
+    /// The equal-area maps scale area by the domain's area (4 pi, 2 pi): the cross
+    /// product of the two difference columns has that length away from the maps'
+    /// creases (the octahedral map's `|u| + |v| = 1` and axes, the concentric
+    /// map's diagonals, with `u = 2 p - 1`).
+    #[test]
+    fn direction_differences_of_the_equal_area_maps_have_their_area_scale() {
+        for domain in [Domain::Sphere, Domain::Hemisphere] {
+            for p in [[0.3, 0.12], [0.62, 0.41], [0.15, 0.7], [0.8, 0.9]] {
+                let [jx, jy] =
+                    PointWarp::EqualArea.direction_differences(domain, [0.0; 2], 0.0, p, 1e-6);
+                let cross = [
+                    jx[1] * jy[2] - jx[2] * jy[1],
+                    jx[2] * jy[0] - jx[0] * jy[2],
+                    jx[0] * jy[1] - jx[1] * jy[0],
+                ];
+                let area = cross.iter().map(|c| c * c).sum::<f64>().sqrt();
+                assert!(
+                    (area - domain.area()).abs() < 1e-5,
+                    "{domain:?} {p:?}: {area}"
+                );
+            }
         }
     }
 

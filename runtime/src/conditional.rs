@@ -416,9 +416,7 @@ impl<'a> ConditionalSampler<'a> {
             PointWarp::EqualArea => ([0.0; 2], 0.0),
             PointWarp::BrdfMixture => {
                 // The clamped condition in blob units, as the tables see it.
-                let (lo, hi) = (self.info.cond_min, self.info.cond_max);
-                let c = [0, 1].map(|a| lo[a] + u[a] * (hi[a] - lo[a]));
-                (c, self.weight_table_lerp(&cell, 1))
+                (self.info.denormalize(u), self.weight_table_lerp(&cell, 1))
             }
         };
         let direction = self.warp.direction(self.domain, cond, p_s, p.to_array());

@@ -93,17 +93,25 @@ impl PoolCondition {
             let (jx, jy) = map_jacobian(Domain::Hemisphere, p);
             return (warp(p), jx, jy);
         }
-        const H: f64 = 1e-6;
-        let diff = |e: DVec2| {
-            let j = (warp(p + H * e) - warp(p - H * e)) / (2.0 * H);
-            // A smooth warp moves a direction by at most ~1/alpha per unit of p.
-            if j.is_finite() && j.length() < 1e3 {
-                j
-            } else {
-                DVec3::ZERO
-            }
-        };
-        (warp(p), diff(DVec2::X), diff(DVec2::Y))
+        let [jx, jy] = self
+            .warp
+            .direction_differences(
+                Domain::Hemisphere,
+                self.cond,
+                self.lobe_probability,
+                p.to_array(),
+                1e-6,
+            )
+            .map(|j| {
+                let j = DVec3::from_array(j);
+                // A smooth warp moves a direction by at most ~1/alpha per unit of p.
+                if j.is_finite() && j.length() < 1e3 {
+                    j
+                } else {
+                    DVec3::ZERO
+                }
+            });
+        (warp(p), jx, jy)
     }
 }
 
