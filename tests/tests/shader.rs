@@ -32,7 +32,7 @@
 mod shader_sample;
 
 use nuld_core::blob::Domain;
-use nuld_core::conditional::{brdf_mixture_direction, ConditionalInfo, PointWarp};
+use nuld_core::conditional::PointWarp;
 use nuld_core::network::Activation;
 use nuld_runtime::glam::{DVec3, Vec2, Vec3};
 use nuld_runtime::shader::{kernel_wgsl, KernelMode, KernelParams, KERNEL_ENTRY_POINT};
@@ -165,35 +165,31 @@ fn shader_point_and_direction_sets_match_the_runtime() {
 /// How much the blob's point warp at condition `cond` (blob units) amplifies a
 /// perturbation of the square point `p`, the factor on the tolerances: 1 for the
 /// equal-area maps; for the BRDF mixture `1 + J`, `J` the largest column norm of
-/// the warp's Jacobian (central differences in `f64`, step `2^-20`, points clamped
-/// into the square). The mixture's GGX branch is ill-conditioned where `u.x / p_s`
+/// the warp's Jacobian (`PointWarp::direction_differences` in `f64`, step
+/// `2^-20`). The mixture's GGX branch is ill-conditioned where `u.x / p_s`
 /// nears 1 (the rim of the visible-normal disk, where `sqrt(1 - p1^2 - p2^2)`
 /// cancels): there the same `f32` operations, rounded by another `sqrt`, `sin` or
 /// division, move the direction by far more than a few ulps (the runtime's own
 /// `f32` result is as far from the exact direction).
-fn warp_gain(info: &ConditionalInfo, cond: [f64; 2], p_s: f32, p: Vec2) -> f32 {
-    if info.point_warp() != Some(PointWarp::BrdfMixture) {
+fn warp_gain(cs: &ConditionalSampler, cond: Vec2, p: Vec2) -> f32 {
+    let info = cs.info();
+    let Some(warp @ PointWarp::BrdfMixture) = info.point_warp() else {
         return 1.0;
-    }
-    let h = 1.0 / 1_048_576.0;
-    let at = |d: [f64; 2]| {
-        let q = [0, 1].map(|a| (p[a] as f64 + d[a]).clamp(0.0, 1.0));
-        DVec3::from_array(brdf_mixture_direction(cond, p_s as f64, q))
     };
-    let column = |a: usize| {
-        let mut d = [0.0; 2];
-        d[a] = h;
-        let lo = at(d.map(|x| -x));
-        (at(d) - lo).length() / (2.0 * h)
-    };
-    1.0 + column(0).max(column(1)) as f32
-}
-
-/// The condition of `cond` (blob units) clamped into the blob's range, as the
-/// runtime's tables see it.
-fn clamped(info: &ConditionalInfo, cond: Vec2) -> [f64; 2] {
-    let u = info.normalize(cond.to_array());
-    [0, 1].map(|a| (info.cond_min[a] + u[a] * (info.cond_max[a] - info.cond_min[a])) as f64)
+    // The clamped condition, as the runtime's tables and warp see it.
+    let c = info.denormalize(info.normalize(cond.to_array()));
+    let columns = warp.direction_differences(
+        Domain::Hemisphere,
+        c.map(f64::from),
+        cs.lobe_probability(cond) as f64,
+        p.as_dvec2().to_array(),
+        1.0 / 1_048_576.0,
+    );
+    let j = columns
+        .iter()
+        .map(|d| DVec3::from_array(*d).length())
+        .fold(0.0, f64::max);
+    1.0 + j as f32
 }
 
 /// `theta_o` in degrees of a BRDF view `wo` (any length; zero, infinite or NaN:
@@ -245,12 +241,7 @@ fn check_conditional(kernel: &Kernel, bytes: &[u8], label: &str) {
     let mut worst_table = Worst::default();
     for (e, got) in out.iter().enumerate() {
         let (c, k, i) = sample_of(&table, e as u32);
-        let gain = warp_gain(
-            &info,
-            clamped(&info, c),
-            cs.lobe_probability(c),
-            cs.square_point(c, k, i),
-        );
+        let gain = warp_gain(&cs, c, cs.square_point(c, k, i));
         worst_table.add(gap(got, cs.sample(c, k, i)), gain);
     }
     let network = grid(KernelMode::Network);
@@ -258,8 +249,7 @@ fn check_conditional(kernel: &Kernel, bytes: &[u8], label: &str) {
     let mut worst_network = Worst::default();
     for (e, got) in out.iter().enumerate() {
         let (c, k, i) = sample_of(&network, e as u32);
-        let p = cs.network_square_point(c, k, i);
-        let gain = warp_gain(&info, clamped(&info, c), cs.lobe_probability(c), p);
+        let gain = warp_gain(&cs, c, cs.network_square_point(c, k, i));
         worst_network.add(gap(got, cs.sample_network(c, k, i)), gain);
     }
     // Views: generic, along z, grazing, below the horizon, zero, huge, tiny, NaN.
@@ -306,13 +296,7 @@ fn check_conditional(kernel: &Kernel, bytes: &[u8], label: &str) {
                         cs.network_square_point(cond, k, i),
                     ),
                 };
-                let gain = warp_gain(
-                    &info,
-                    clamped(&info, cond),
-                    cs.lobe_probability(cond),
-                    point,
-                );
-                worst.add(gap(got, want), gain);
+                worst.add(gap(got, want), warp_gain(&cs, cond, point));
             }
         }
     }
@@ -333,26 +317,18 @@ fn check_conditional(kernel: &Kernel, bytes: &[u8], label: &str) {
         worst_view_network.scaled,
         worst_view_network.raw,
     );
-    assert!(
-        worst_table.scaled <= TABLE_TOLERANCE,
-        "{label} table: {}",
-        worst_table.scaled
-    );
-    assert!(
-        worst_network.scaled <= NETWORK_TOLERANCE,
-        "{label} network: {}",
-        worst_network.scaled
-    );
-    assert!(
-        worst_view.scaled <= TABLE_TOLERANCE,
-        "{label} views: {}",
-        worst_view.scaled
-    );
-    assert!(
-        worst_view_network.scaled <= NETWORK_TOLERANCE,
-        "{label} views, network: {}",
-        worst_view_network.scaled
-    );
+    for (what, worst, tolerance) in [
+        ("table", &worst_table, TABLE_TOLERANCE),
+        ("network", &worst_network, NETWORK_TOLERANCE),
+        ("views", &worst_view, TABLE_TOLERANCE),
+        ("views, network", &worst_view_network, NETWORK_TOLERANCE),
+    ] {
+        assert!(
+            worst.scaled <= tolerance,
+            "{label} {what}: {}",
+            worst.scaled
+        );
+    }
 }
 
 #[test]
