@@ -169,9 +169,8 @@ const TRAINING_SIZES: [(u32, usize); 3] = [(64, 20), (256, 6), (2048, 2)];
 /// Milliseconds per training step of the conditional BRDF sampler, all threads,
 /// and the default bake's training time at that rate.
 fn run_training() -> Result<()> {
-    let sizes: Vec<u32> = TRAINING_SIZES.iter().map(|s| s.0).collect();
-    let steps = |n| TRAINING_SIZES.iter().find(|s| s.0 == n).map_or(1, |s| s.1);
     let d = crate::train::TrainConfig::default();
+    let bake_steps = d.pretrain_steps + d.steps;
     println!(
         "conditional sampler training, {} rayon threads, hidden {:?}, {} conditions x {} instances per step",
         rayon::current_num_threads(),
@@ -185,16 +184,16 @@ fn run_training() -> Result<()> {
         "setup s",
         "steps",
         "ms/step",
-        format!("{} steps at that rate, min", d.pretrain_steps + d.steps)
+        format!("{bake_steps} steps at that rate, min")
     );
-    for t in crate::train::speed::measure(&sizes, steps) {
+    for t in crate::train::speed::measure(&TRAINING_SIZES) {
         println!(
             "{:>6} {:>10.1} {:>8} {:>12.1} {:>30.1}",
             t.n,
             t.setup_s,
             t.timed_steps,
             t.ms_per_step,
-            t.default_training_s / 60.0
+            t.run_seconds(bake_steps) / 60.0
         );
     }
     Ok(())

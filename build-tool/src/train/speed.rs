@@ -16,21 +16,26 @@ pub struct TrainTiming {
     pub ms_per_step: f64,
     /// Steps timed.
     pub timed_steps: usize,
-    /// The default bake's training time this implies, in seconds: setup plus the
-    /// default pretraining and training steps at `ms_per_step` (pretraining steps
-    /// cost less, so this is an upper estimate of those).
-    pub default_training_s: f64,
 }
 
-/// Times the default [`TrainConfig`] at each `n` of `sizes`: the trainer's setup,
-/// then one untimed step (first-touch allocations) and `timed_steps(n)` timed
-/// cap-loss steps (pretraining skipped, so every timed step is a training step).
-pub fn measure(sizes: &[u32], timed_steps: impl Fn(u32) -> usize) -> Vec<TrainTiming> {
-    let default = TrainConfig::default();
+impl TrainTiming {
+    /// Seconds of a run of `steps` steps at this rate, setup included (the
+    /// pretraining steps of a bake cost less, so counting them as steps gives an
+    /// upper estimate).
+    pub fn run_seconds(&self, steps: usize) -> f64 {
+        self.setup_s + steps as f64 * self.ms_per_step * 1e-3
+    }
+}
+
+/// Times the default [`TrainConfig`] at each `(n, steps)` of `sizes`: the
+/// trainer's setup, then one untimed step (first-touch allocations) and `steps`
+/// (at least 1) timed cap-loss steps (pretraining skipped, so every timed step is
+/// a training step).
+pub fn measure(sizes: &[(u32, usize)]) -> Vec<TrainTiming> {
     sizes
         .iter()
-        .map(|&n| {
-            let steps = timed_steps(n).max(1);
+        .map(|&(n, steps)| {
+            let steps = steps.max(1);
             let config = TrainConfig {
                 n,
                 pretrain_steps: 0,
@@ -45,14 +50,11 @@ pub fn measure(sizes: &[u32], timed_steps: impl Fn(u32) -> usize) -> Vec<TrainTi
             for _ in 0..steps {
                 trainer.step();
             }
-            let ms_per_step = t.elapsed().as_secs_f64() * 1e3 / steps as f64;
-            let total = default.pretrain_steps + default.steps;
             TrainTiming {
                 n,
                 setup_s,
-                ms_per_step,
+                ms_per_step: t.elapsed().as_secs_f64() * 1e3 / steps as f64,
                 timed_steps: steps,
-                default_training_s: setup_s + total as f64 * ms_per_step * 1e-3,
             }
         })
         .collect()
@@ -63,14 +65,25 @@ mod tests {
     use super::*;
 
     #[test]
-    fn timings_are_positive_and_scale_with_the_step_count() {
-        let t = measure(&[8], |_| 2);
-        assert_eq!(t.len(), 1);
-        let t = t[0];
-        assert_eq!((t.n, t.timed_steps), (8, 2));
-        assert!(t.ms_per_step > 0.0 && t.setup_s > 0.0);
-        let d = TrainConfig::default();
-        let want = t.setup_s + (d.pretrain_steps + d.steps) as f64 * t.ms_per_step * 1e-3;
-        assert!((t.default_training_s - want).abs() < 1e-9 * want);
+    fn each_size_is_timed_with_its_step_count() {
+        let t = measure(&[(8, 2), (4, 0)]);
+        assert_eq!(
+            t.iter().map(|t| (t.n, t.timed_steps)).collect::<Vec<_>>(),
+            [(8, 2), (4, 1)]
+        );
+        assert!(t
+            .iter()
+            .all(|t| t.ms_per_step.is_finite() && t.ms_per_step > 0.0 && t.setup_s > 0.0));
+    }
+
+    #[test]
+    fn run_seconds_adds_the_setup_to_the_steps() {
+        let t = TrainTiming {
+            n: 64,
+            setup_s: 1.5,
+            ms_per_step: 20.0,
+            timed_steps: 3,
+        };
+        assert_eq!(t.run_seconds(100), 3.5);
     }
 }
