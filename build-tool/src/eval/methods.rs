@@ -293,8 +293,11 @@ impl DirectionSampler<'_> {
             Method::Ours => {
                 let spec = self.density.spec();
                 let group = ours_group(domain.name(), &spec);
+                // v2: `brdf:` names the glTF BRDF, whose cap-measure rule has jittered
+                // strata; v1 sets were optimized against the Burley BRDF or the
+                // midpoint rule's ringed measures.
                 let fp = format!(
-                    "v1;{spec};{};area={:?}",
+                    "v2;{spec};{};area={:?}",
                     method_fingerprint(method, self.epochs),
                     AreaOption::Exact
                 );

@@ -127,12 +127,14 @@ fn evaluator<'a>(
                 "{}/{}/{}",
                 s.cap_star_caps, s.cap_star_refine, s.cap_star_rounds
             );
-            // v2: `brdf:` specs name the glTF BRDF; v1 entries of brdf panels were
-            // computed when they named the Burley BRDF, and must not be hits.
+            // v3: `brdf:` specs name the glTF BRDF (v2) and measure caps with a
+            // jittered rule (v3); v1 entries of brdf panels were computed when they
+            // named the Burley BRDF, v2 ones with the midpoint rule's ringed
+            // measures near the horizon, and must not be hits.
             let fp = if uniform {
-                format!("sph-v2;{};star={}", panel.spec, star)
+                format!("sph-v3;{};star={}", panel.spec, star)
             } else {
-                format!("sph-v2;{};star={};l2mc={}", panel.spec, star, s.cap_l2_caps)
+                format!("sph-v3;{};star={};l2mc={}", panel.spec, star, s.cap_l2_caps)
             };
             let sampler = DirectionSampler {
                 density: density.as_ref(),
@@ -187,8 +189,8 @@ fn evaluator<'a>(
             (
                 Box::new(f),
                 format!(
-                    // v2 as `sph-v2`: the brdf factor is the glTF BRDF.
-                    "int3-v2;{};{};proj={}",
+                    // v3 as `sph-v3`: the glTF BRDF and its jittered rule.
+                    "int3-v3;{};{};proj={}",
                     it.name,
                     it.factors(),
                     super::methods::PROJECTION_RESOLUTION
