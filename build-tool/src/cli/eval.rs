@@ -68,6 +68,10 @@ pub struct EvalArgs {
     /// file is missing are skipped with a note.
     #[arg(long, default_value = "../shared/data")]
     pub data: PathBuf,
+    /// Run only this panel (repeatable; the CSV `target` column, e.g. `brdf` of
+    /// fig6, `brdf-envmap` of fig7); the figure's files then hold only these.
+    #[arg(long = "panel", value_name = "NAME")]
+    pub panels: Vec<String>,
     /// conditional: the `.nuld` conditional blob whose table and network modes are
     /// judged.
     #[arg(long)]
@@ -113,6 +117,7 @@ impl EvalArgs {
         if let Some(v) = self.cap_star_caps {
             s.cap_star_caps = v;
         }
+        s.only_panels.clone_from(&self.panels);
         s
     }
 }

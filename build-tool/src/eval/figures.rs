@@ -7,7 +7,7 @@ use super::{EvalSettings, Figure};
 use crate::baselines::Baseline;
 use crate::density::{parse_spec, Density2D};
 use crate::sphere::{parse_direction_spec, BrdfTarget, DirectionDensity, EnvmapDensity};
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use nuld_core::blob::Domain;
 use serde::Serialize;
 use std::path::Path;
@@ -431,6 +431,39 @@ pub fn panels(figure: Figure, s: &EvalSettings) -> Result<(Vec<Panel>, Vec<Skipp
     Ok((panels, skipped))
 }
 
+/// The panels and skipped panels of `figure` whose short names are in `names`
+/// (all of them when `names` is empty), in the figure's order: a rerun of a few
+/// panels, e.g. after a target's definition changed.
+///
+/// # Errors
+/// A name that is no panel of `figure` (the message lists the figure's panels).
+pub fn select(
+    figure: Figure,
+    panels: Vec<Panel>,
+    skipped: Vec<Skipped>,
+    names: &[String],
+) -> Result<(Vec<Panel>, Vec<Skipped>)> {
+    if names.is_empty() {
+        return Ok((panels, skipped));
+    }
+    let known: Vec<&str> = panels
+        .iter()
+        .map(|p| p.target.as_str())
+        .chain(skipped.iter().map(|s| s.target.as_str()))
+        .collect();
+    if let Some(bad) = names.iter().find(|n| !known.contains(&n.as_str())) {
+        bail!(
+            "{figure} has no panel `{bad}` (its panels: {})",
+            known.join(", ")
+        );
+    }
+    let wanted = |t: &str| names.iter().any(|n| n == t);
+    Ok((
+        panels.into_iter().filter(|p| wanted(&p.target)).collect(),
+        skipped.into_iter().filter(|s| wanted(&s.target)).collect(),
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -452,5 +485,36 @@ mod tests {
             };
             assert_eq!(skipped.len(), expect_skipped, "{f}: {skipped:?}");
         }
+    }
+
+    #[test]
+    fn select_keeps_the_named_panels_in_order_and_rejects_unknown_names() {
+        let s = EvalSettings::quick("/nonexistent-out", "/nonexistent-data");
+        let names = |p: &[Panel]| p.iter().map(|p| p.target.clone()).collect::<Vec<_>>();
+        let (p, k) = panels(Figure::Fig6, &s).unwrap();
+        let all = names(&p);
+        assert_eq!(all, ["cosine", "brdf"]);
+        let (p, k) = select(Figure::Fig6, p, k, &[]).unwrap();
+        assert_eq!((names(&p), k.len()), (all, 1));
+        let (p, k) = select(Figure::Fig6, p, k, &["brdf".to_string()]).unwrap();
+        assert_eq!((names(&p), k.len()), (vec!["brdf".to_string()], 0));
+        // The skipped envmap panel is a known name: selecting it runs nothing.
+        let (p, k) = panels(Figure::Fig6, &s).unwrap();
+        let (p, k) = select(Figure::Fig6, p, k, &["envmap".to_string()]).unwrap();
+        assert_eq!((p.len(), k.len()), (0, 1));
+        let (p, k) = panels(Figure::Fig6, &s).unwrap();
+        let err = select(
+            Figure::Fig6,
+            p,
+            k,
+            &["brdf".to_string(), "bdrf".to_string()],
+        )
+        .err()
+        .unwrap()
+        .to_string();
+        assert!(
+            err.contains("no panel `bdrf`") && err.contains("cosine, brdf, envmap"),
+            "{err}"
+        );
     }
 }

@@ -120,6 +120,10 @@ pub struct EvalSettings {
     pub cap_l2_caps: usize,
     /// Per-pixel midpoint grid side of the `brdf-envmap` reference quadrature.
     pub reference_subdivision: usize,
+    /// Panels to run, by short name (the CSV `target` column); empty runs every
+    /// panel. A filter, not a result-changing setting: a panel's rows are the same
+    /// whether it runs alone or with the others.
+    pub only_panels: Vec<String>,
 }
 
 impl EvalSettings {
@@ -142,6 +146,7 @@ impl EvalSettings {
             cap_star_rounds: 12,
             cap_l2_caps: 4096,
             reference_subdivision: 8,
+            only_panels: Vec::new(),
         }
     }
 
@@ -201,6 +206,7 @@ pub fn run_figure(figure: Figure, settings: &EvalSettings) -> Result<report::Fig
     crate::output::ensure_dir(&settings.out)?;
     let cache = cache::Cache::new(settings.out.join("cache"));
     let (panels, skipped) = figures::panels(figure, settings)?;
+    let (panels, skipped) = figures::select(figure, panels, skipped, &settings.only_panels)?;
     for s in &skipped {
         eprintln!("{figure}: skipping {}: {}", s.target, s.reason);
     }
