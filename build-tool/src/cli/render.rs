@@ -91,3 +91,34 @@ pub fn run(a: RenderArgs) -> Result<()> {
     );
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sample_counts_and_sizes_parse_or_say_why_not() {
+        assert_eq!(spp("16"), Ok(16));
+        assert!(spp("0").unwrap_err().contains("1..=65536"));
+        assert!(spp("-4").is_err() && spp("65537").is_err() && spp("x").is_err());
+        assert_eq!(size("320x240"), Ok((320, 240)));
+        assert!(size("320").is_err() && size("0x5").is_err() && size("5x").is_err());
+    }
+
+    #[test]
+    fn an_envmap_blob_is_refused_until_envmap_samplers_exist() {
+        let a = RenderArgs {
+            envmap: PathBuf::from("map.hdr"),
+            spp: vec![],
+            quick: true,
+            size: None,
+            reference_spp: None,
+            brdf_blob: vec![],
+            envmap_blob: Some(PathBuf::from("env.nuld")),
+            seed: 0,
+            out: std::env::temp_dir().join("nuld-render-cli-never-written"),
+        };
+        let e = run(a).unwrap_err().to_string();
+        assert!(e.contains("envmap samplers are not implemented yet"), "{e}");
+    }
+}

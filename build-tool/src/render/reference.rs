@@ -178,3 +178,147 @@ fn pixel(setup: &Setup<'_>, lobes: &LobeTable, m: u32, seed: u64, x: u32, y: u32
     let var = ((sum2 / mf - mean * mean) * mf / (mf - 1.0).max(1.0)).max(0.0);
     (mean, (var / mf).sqrt())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::density::image::LuminanceImage;
+    use crate::render::camera::Camera;
+    use crate::render::environment::Environment;
+    use crate::render::scene::{Scene, Sphere};
+    use crate::sphere::brdf_albedo::directional_albedo;
+    use nuld_core::brdf::BrdfModel;
+
+    /// A sky: a smooth gradient and a sun of 2 x 1 pixels holding most of the light.
+    fn sun_map() -> Environment {
+        let (w, h) = (64, 32);
+        let values = (0..w * h)
+            .map(|k| {
+                let (c, r) = (k % w, k / w);
+                if r == 6 && (c == 10 || c == 11) {
+                    20_000.0
+                } else if r < h / 2 {
+                    1.0 + r as f64 / 4.0
+                } else {
+                    0.2
+                }
+            })
+            .collect();
+        Environment::from_luminance(
+            &LuminanceImage {
+                width: w,
+                height: h,
+                values,
+            },
+            "sun",
+        )
+        .unwrap()
+    }
+
+    /// `(mean z, mean z^2)` of `z = (a - b) / sqrt(sa^2 + sb^2)` over pixels with
+    /// a positive error.
+    fn z_stats(a: &[f64], sa: &[f64], b: &[f64], sb: &[f64]) -> (f64, f64, usize) {
+        let z: Vec<f64> = (0..a.len())
+            .filter(|&i| sa[i] + sb[i] > 0.0)
+            .map(|i| (a[i] - b[i]) / (sa[i] * sa[i] + sb[i] * sb[i]).sqrt())
+            .collect();
+        let k = z.len() as f64;
+        (
+            z.iter().sum::<f64>() / k,
+            z.iter().map(|v| v * v).sum::<f64>() / k,
+            z.len(),
+        )
+    }
+
+    /// Two seeds agree within their stated standard errors (`z^2` averages to 1
+    /// if the errors are right; a wrong MIS weight or pdf makes the estimates
+    /// disagree or the errors wrong), and in a white furnace the reference is the
+    /// albedo of the independent quadrature.
+    #[test]
+    fn the_reference_converges_to_one_answer_within_its_stated_error() {
+        let env = sun_map();
+        let scene = Scene::spheres_on_ground();
+        let camera = Camera::evaluation(24, 18);
+        let setup = Setup {
+            scene: &scene,
+            camera: &camera,
+            env: &env,
+        };
+        let lobes = LobeTable::new(&[0.1, 0.25, 0.4, 0.7, 1.0, 0.8]);
+        let a = Reference::render(&setup, &lobes, 256, 1, &|| {});
+        let b = Reference::render(&setup, &lobes, 256, 2, &|| {});
+        let (mean, mean_sq, k) = z_stats(&a.image.values, &a.stderr, &b.image.values, &b.stderr);
+        assert!(k > 200, "{k}");
+        assert!(
+            mean.abs() < 4.0 / (k as f64).sqrt() && (0.6..1.5).contains(&mean_sq),
+            "z: mean {mean}, mean square {mean_sq}"
+        );
+
+        let white = Environment::constant(1.0).unwrap();
+        let roughness = 0.4;
+        let ball = Scene {
+            spheres: vec![Sphere {
+                center: glam::DVec3::ZERO,
+                radius: 1.0,
+                roughness,
+            }],
+            ground_roughness: None,
+        };
+        let cam = Camera::new(
+            glam::DVec3::new(0.0, -4.0, 0.0),
+            glam::DVec3::ZERO,
+            32.0,
+            16,
+            16,
+        );
+        let setup = Setup {
+            scene: &ball,
+            camera: &cam,
+            env: &white,
+        };
+        let r = Reference::render(&setup, &LobeTable::new(&[roughness]), 256, 3, &|| {});
+        let mut exact = Vec::new();
+        for y in 0..16 {
+            for x in 0..16 {
+                exact.push(match setup.primary(x, y) {
+                    Primary::Surface { at, .. } => {
+                        directional_albedo(BrdfModel::Gltf, roughness, at.theta_o_deg().min(89.0))
+                            .total()
+                    }
+                    Primary::Background(l) => l,
+                });
+            }
+        }
+        let zero = vec![0.0; exact.len()];
+        let (mean, mean_sq, k) = z_stats(&r.image.values, &r.stderr, &exact, &zero);
+        assert!(
+            k > 100 && mean.abs() < 4.0 / (k as f64).sqrt() && mean_sq < 1.6,
+            "furnace z: mean {mean}, mean square {mean_sq}"
+        );
+    }
+
+    #[test]
+    fn the_cache_round_trips_and_refuses_other_renders() {
+        let dir = std::env::temp_dir().join(format!("nuld-reference-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let r = Reference {
+            image: Image {
+                width: 2,
+                height: 1,
+                values: vec![0.5, -0.0],
+            },
+            stderr: vec![1e-3, 0.0],
+        };
+        r.save(&dir, 7).unwrap();
+        assert_eq!(Reference::load(&dir, 7, 2, 1).unwrap(), Some(r));
+        assert_eq!(Reference::load(&dir, 8, 2, 1).unwrap(), None);
+        std::fs::rename(
+            Reference::cache_path(&dir, 7),
+            Reference::cache_path(&dir, 8),
+        )
+        .unwrap();
+        assert!(Reference::load(&dir, 8, 2, 1).is_err());
+        assert!(Reference::load(&dir, 8, 1, 2).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -349,3 +349,132 @@ fn composite<'a>(
         cells,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::summary::CSV_HEADER;
+
+    /// `../shared/data/envmaps/courtyard.hdr` when present, else a generated sky
+    /// written as PNG into `dir`.
+    fn test_map(dir: &Path) -> PathBuf {
+        let shared =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/envmaps/courtyard.hdr");
+        if shared.is_file() {
+            return shared;
+        }
+        eprintln!("skipped: {} (using a generated sky)", shared.display());
+        let img = image::RgbImage::from_fn(64, 32, |x, y| {
+            let v = if y == 5 && x == 9 {
+                255
+            } else if y < 16 {
+                120 + 4 * y as u8
+            } else {
+                30
+            };
+            image::Rgb([v, v, v])
+        });
+        let path = dir.join("sky.png");
+        img.save(&path).unwrap();
+        path
+    }
+
+    /// `render --quick` end to end, as CI runs it: every output file, the exact
+    /// CSV header and one row per technique, sampler and spp; a second run reuses
+    /// the cached reference and the baked blobs and reproduces every number.
+    #[test]
+    fn quick_render_writes_every_output_and_reproduces_itself() {
+        let out = std::env::temp_dir().join(format!("nuld-render-quick-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&out);
+        std::fs::create_dir_all(&out).unwrap();
+        let config = RenderConfig::quick(test_map(&out));
+        let first = render(&config, &out).unwrap();
+        assert!(first.reference_seconds > 0.0);
+        let csv_text = std::fs::read_to_string(out.join("render.csv")).unwrap();
+        let mut lines = csv_text.lines();
+        assert_eq!(lines.next(), Some(CSV_HEADER));
+        assert_eq!(CSV_HEADER, "technique,sampler,spp,rmse,bias,seconds");
+        let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+        assert_eq!(
+            rows.len(),
+            (BRDF_SAMPLERS.len() + ENVMAP_SAMPLERS.len()) * 2
+        );
+        for (technique, names) in [
+            ("brdf", &BRDF_SAMPLERS[..]),
+            ("envmap", &ENVMAP_SAMPLERS[..]),
+        ] {
+            for name in names {
+                for spp in ["4", "16"] {
+                    let row = rows
+                        .iter()
+                        .find(|r| r[0] == technique && r[1] == *name && r[2] == spp)
+                        .unwrap_or_else(|| panic!("no row {technique},{name},{spp}"));
+                    let nums: Vec<f64> = row[3..].iter().map(|v| v.parse().unwrap()).collect();
+                    assert!(
+                        nums[0] > 0.0
+                            && nums[0].is_finite()
+                            && nums[1].is_finite()
+                            && nums[2] >= 0.0,
+                        "{row:?}"
+                    );
+                    for sub in ["images", "errors"] {
+                        let f = out.join(sub).join(format!("{technique}-{name}-{spp}.png"));
+                        assert!(f.is_file(), "{}", f.display());
+                    }
+                }
+            }
+        }
+        for f in [
+            "render-summary.md",
+            "reference.png",
+            "fig8-brdf.png",
+            "fig8-envmap.png",
+            "fig8-brdf-errors.png",
+            "fig8-envmap-errors.png",
+            "brdf-n4/brdf.nuld",
+            "brdf-n16/brdf.nuld",
+        ] {
+            assert!(out.join(f).is_file(), "{f}");
+        }
+        let png = image::open(out.join("images/brdf-owen-sobol-4.png")).unwrap();
+        assert_eq!((png.width(), png.height()), (32, 24));
+        let leftovers: Vec<_> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .filter(|n| n.contains(".tmp-"))
+            .collect();
+        assert!(leftovers.is_empty(), "{leftovers:?}");
+
+        let second = render(&config, &out).unwrap();
+        assert_eq!(second.reference_seconds, 0.0, "the reference is reused");
+        for (a, b) in first.rows.iter().zip(&second.rows) {
+            assert_eq!(
+                (a.rmse.to_bits(), a.bias.to_bits()),
+                (b.rmse.to_bits(), b.bias.to_bits()),
+                "{}",
+                a.sampler
+            );
+        }
+        std::fs::remove_dir_all(&out).unwrap();
+    }
+
+    #[test]
+    fn bad_input_is_a_one_line_error_before_anything_is_written() {
+        let out = std::env::temp_dir().join(format!("nuld-render-bad-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&out);
+        let missing = RenderConfig::quick(PathBuf::from("/nonexistent/map.hdr"));
+        let e = format!("{:#}", render(&missing, &out).unwrap_err());
+        assert!(
+            e.contains("cannot read environment map /nonexistent/map.hdr") && !e.contains('\n'),
+            "{e}"
+        );
+        for spp in [vec![], vec![0], vec![4, 70_000]] {
+            let bad = RenderConfig {
+                spp,
+                ..RenderConfig::quick(PathBuf::from("x.hdr"))
+            };
+            assert!(format!("{:#}", render(&bad, &out).unwrap_err()).contains("--spp"));
+        }
+        assert!(!out.exists(), "nothing written for bad input");
+    }
+}
