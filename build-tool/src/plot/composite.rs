@@ -116,7 +116,7 @@ mod tests {
     fn tiles_land_in_their_cells_and_bad_grids_are_rejected() {
         let dir = std::env::temp_dir().join(format!("nuld-composite-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let red = vec![255, 0, 0].repeat(4 * 3);
+        let red = [255, 0, 0].repeat(4 * 3);
         let tile = |caption: &str| Tile {
             width: 4,
             height: 3,

@@ -152,7 +152,7 @@ mod tests {
     use super::*;
     use crate::render::blobs::tiny_blob;
     use crate::render::brdf_warp::{LobeTable, MixtureSampler};
-    use crate::render::envmap_warp::{EnvWarp, EnvmapSampler};
+    use crate::render::lineup;
     use crate::render::nuld_sampler::{NuldMode, NuldSampler};
     use crate::render::primary::{Generator, PrimaryPoints};
     use crate::render::scene::Sphere;
@@ -190,24 +190,7 @@ mod tests {
                 env: &env,
             };
             let lobes = LobeTable::new(&[roughness]);
-            let points = |g| PrimaryPoints::new(g, 16, 5);
-            let samplers: Vec<Box<dyn DirectionSampler>> = vec![
-                Box::new(NuldSampler::new(blob.as_slice(), NuldMode::Table).unwrap()),
-                Box::new(NuldSampler::new(blob.as_slice(), NuldMode::Network).unwrap()),
-                Box::new(MixtureSampler::new(points(Generator::OwenSobol), &lobes)),
-                Box::new(MixtureSampler::new(points(Generator::Random), &lobes)),
-                Box::new(MixtureSampler::new(points(Generator::Sot), &lobes)),
-                Box::new(EnvmapSampler::new(
-                    points(Generator::Halton),
-                    EnvWarp::InverseCdf,
-                    &env,
-                )),
-                Box::new(EnvmapSampler::new(
-                    points(Generator::OwenSobol),
-                    EnvWarp::Hierarchical,
-                    &env,
-                )),
-            ];
+            let samplers = lineup::samplers(blob.as_slice(), 16, 5, &lobes, &env).unwrap();
             // A at each surface pixel's view angle.
             let albedo: Vec<Option<f64>> = (0..24)
                 .flat_map(|y| (0..24).map(move |x| (x, y)))

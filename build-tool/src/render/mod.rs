@@ -12,7 +12,7 @@
 //! * environment sampling: Owen-Sobol and Halton points through the map's
 //!   inverse CDF, and Owen-Sobol through hierarchical warping ([`envmap_warp`]).
 //!
-//! A multiple-importance-sampled reference ([`reference`]) gives RMSE and bias
+//! [`lineup`] lists them in table order. A multiple-importance-sampled reference ([`reference`]) gives RMSE and bias
 //! ([`summary`]); [`run`] writes pictures ([`picture`]), the Fig. 8 composites,
 //! `render.csv` and the summary tables.
 
@@ -23,6 +23,7 @@ pub mod environment;
 pub mod envmap_warp;
 pub mod frame;
 pub mod integrator;
+pub mod lineup;
 pub mod nuld_sampler;
 pub mod picture;
 pub mod primary;

@@ -10,16 +10,14 @@
 //! the baked blobs `brdf-nN/` it needed. Every file is written atomically.
 
 use super::blobs::BrdfBlobs;
-use super::brdf_warp::{LobeTable, MixtureSampler};
+use super::brdf_warp::LobeTable;
 use super::camera::Camera;
 use super::environment::Environment;
-use super::envmap_warp::{EnvWarp, EnvmapSampler};
 use super::integrator::{Image, Primary, Setup};
-use super::nuld_sampler::{NuldMode, NuldSampler};
+use super::lineup::{self, BRDF_SAMPLERS, ENVMAP_SAMPLERS};
 use super::picture::{error_map, exposure, tone_map, Picture};
-use super::primary::{Generator, PrimaryPoints};
 use super::reference::{content_hash, Reference};
-use super::sampler::{DirectionSampler, Technique};
+use super::sampler::Technique;
 use super::scene::Scene;
 use super::summary::{csv, errors, markdown, Row};
 use crate::conditional::bake::BakeConfig;
@@ -116,18 +114,6 @@ pub struct RenderReport {
     pub total_seconds: f64,
 }
 
-/// The BRDF sampler names in table order.
-pub const BRDF_SAMPLERS: [&str; 6] = [
-    "nuld-table",
-    "nuld-network",
-    "owen-sobol",
-    "random",
-    "sot",
-    "gbn",
-];
-/// The environment sampler names in table order.
-pub const ENVMAP_SAMPLERS: [&str; 3] = ["owen-sobol", "halton", "owen-sobol-hierarchical"];
-
 /// Runs the evaluation into `out` (see the module docs).
 pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
     let started = Instant::now();
@@ -213,34 +199,8 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
         let (blob_path, bytes) = blobs
             .get(n)
             .with_context(|| format!("no BRDF blob with N = {n}"))?;
-        let ours = |mode| {
-            NuldSampler::new(bytes, mode)
-                .with_context(|| format!("BRDF blob {}", blob_path.display()))
-        };
-        let points = |g| PrimaryPoints::new(g, n, config.seed);
-        let samplers: Vec<Box<dyn DirectionSampler + '_>> = vec![
-            Box::new(ours(NuldMode::Table)?),
-            Box::new(ours(NuldMode::Network)?),
-            Box::new(MixtureSampler::new(points(Generator::OwenSobol), &lobes)),
-            Box::new(MixtureSampler::new(points(Generator::Random), &lobes)),
-            Box::new(MixtureSampler::new(points(Generator::Sot), &lobes)),
-            Box::new(MixtureSampler::new(points(Generator::Gbn), &lobes)),
-            Box::new(EnvmapSampler::new(
-                points(Generator::OwenSobol),
-                EnvWarp::InverseCdf,
-                &env,
-            )),
-            Box::new(EnvmapSampler::new(
-                points(Generator::Halton),
-                EnvWarp::InverseCdf,
-                &env,
-            )),
-            Box::new(EnvmapSampler::new(
-                points(Generator::OwenSobol),
-                EnvWarp::Hierarchical,
-                &env,
-            )),
-        ];
+        let samplers = lineup::samplers(bytes, n, config.seed, &lobes, &env)
+            .with_context(|| format!("BRDF blob {}", blob_path.display()))?;
         for sampler in &samplers {
             progress.set_context(format!(
                 "{} {} {n} spp",
