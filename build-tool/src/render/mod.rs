@@ -12,9 +12,9 @@
 //! * environment sampling: Owen-Sobol and Halton points through the map's
 //!   inverse CDF, and Owen-Sobol through hierarchical warping ([`envmap_warp`]).
 //!
-//! [`lineup`] lists them in table order. A multiple-importance-sampled reference ([`reference`]) gives RMSE and bias
-//! ([`summary`]); [`run`] writes pictures ([`picture`]), the Fig. 8 composites,
-//! `render.csv` and the summary tables.
+//! [`lineup`] lists them in table order. A multiple-importance-sampled reference
+//! ([`mod@reference`]) gives RMSE and bias ([`summary`]); [`run`] writes pictures
+//! ([`picture`]), the Fig. 8 composites, `render.csv` and the summary tables.
 
 pub mod blobs;
 pub mod brdf_warp;

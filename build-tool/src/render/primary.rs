@@ -12,9 +12,10 @@
 //!   too slow to generate per pixel. A pool of [`POOL_SETS`] sets per point count
 //!   is generated once (seeded, in parallel, cached in memory for the run); a pixel
 //!   takes the pool set its key selects, shifted toroidally by a random vector
-//!   from its key (Cranley–Patterson rotation). The shift keeps each set's
-//!   toroidal structure (both are optimized on the torus or nearly so) while
-//!   decorrelating pixels.
+//!   from its key (Cranley–Patterson rotation), which decorrelates pixels. The
+//!   shift keeps GBN's structure (its uniform energy is toroidal); SOT optimizes
+//!   in the square, so a shifted SOT set loses a little of it at the wrap, the
+//!   price of serving per-pixel randomization from a pool.
 
 use crate::baselines::{
     gaussian_blue_noise, owen_sobol, random, scrambled_halton, sliced_optimal_transport,
