@@ -147,6 +147,24 @@ mod tests {
                 );
                 assert_eq!(s.weight, want.weight as f64);
             }
+            // At a tilted normal the world directions are the runtime's local ones
+            // carried by the frame: back in the local frame they agree to rounding,
+            // and they lie above the surface.
+            let n = DVec3::new(-0.5, 0.3, 0.2).normalize();
+            let tilted = ShadingPoint {
+                frame: Frame::new(n),
+                ..at
+            };
+            ours.samples(&tilted, key, 8, &mut out);
+            for (i, s) in out.iter().enumerate() {
+                let want = match mode {
+                    NuldMode::Table => cs.sample_brdf(wo, 0.4, key.instance(), i as u32),
+                    NuldMode::Network => cs.sample_brdf_network(wo, 0.4, key.instance(), i as u32),
+                };
+                let local = tilted.frame.to_local(s.direction);
+                assert!((local - want.direction.as_dvec3()).length() < 1e-12);
+                assert!(s.direction.dot(n) >= 0.0);
+            }
         }
     }
 
