@@ -17,6 +17,7 @@ pub mod output;
 pub mod plot;
 pub mod pointset;
 pub mod progress;
+pub mod render;
 pub mod runtime_speed;
 pub mod seeding;
 pub mod shader;

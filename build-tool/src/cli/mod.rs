@@ -6,6 +6,7 @@ pub mod eval;
 pub mod export;
 pub mod metrics;
 pub mod optimize;
+pub mod render;
 pub mod sample;
 pub mod shader;
 pub mod sobol;
@@ -41,6 +42,8 @@ pub enum Command {
     Bench(bench::BenchArgs),
     /// Write the sampling kernel (WGSL sampler + compute entry point) in a shading language.
     Shader(shader::ShaderArgs),
+    /// Render the Fig. 8 evaluation (BRDF and envmap sampling vs a reference): DIR/render.csv, PNGs.
+    Render(render::RenderArgs),
     /// Evaluate the paper's §5 figures (fig2, fig3, fig5, fig6, fig7, all): CSV, JSON, plots.
     Eval(eval::EvalArgs),
 }
@@ -95,5 +98,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Bench(a) => bench::run(a),
         Command::Eval(a) => eval::run(a),
         Command::Shader(a) => shader::run(a),
+        Command::Render(a) => render::run(a),
     }
 }

@@ -1,9 +1,12 @@
-//! Pictures: point sets over their target density, log-log curves, heat maps.
+//! Pictures: point sets over their target density, log-log curves, heat maps,
+//! labelled grids of pictures.
 
+mod composite;
 mod curves;
 mod heatmap;
 mod points;
 
+pub use composite::{render_composite, Composite, Tile};
 pub use curves::{render_loglog, Series};
 pub use heatmap::{render_heatmap, Heatmap};
 pub use points::{render_direction_set, render_point_set, render_square_panels, SquarePanel};

@@ -1,0 +1,142 @@
+//! The BRDF sampler blobs a render needs: one per sample count, since a blob's
+//! sets have a fixed size `N` and the first `k < N` points of a set are not a
+//! good set of `k`. Given blobs serve the sample count equal to their `N`; for
+//! every other requested count the blob is baked into the output directory
+//! (`DIR/brdf-nN/brdf.nuld`, by [`crate::conditional::bake::bake`]) and reused
+//! when already there.
+//!
+//! This is the only part of the renderer that touches the tool's training code;
+//! the samplers read the resulting bytes through `nuld-runtime` alone
+//! ([`super::nuld_sampler`]).
+
+use super::nuld_sampler::{NuldMode, NuldSampler};
+use crate::conditional::bake::{bake, BakeConfig};
+use crate::pointset::AlignedBytes;
+use anyhow::{anyhow, bail, Context, Result};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Blob bytes by their set size `N`.
+#[derive(Debug, Default)]
+pub struct BrdfBlobs {
+    by_n: BTreeMap<u32, (PathBuf, AlignedBytes)>,
+}
+
+impl BrdfBlobs {
+    /// Reads each of `paths`; an error (one line, naming the file) for an
+    /// unreadable file, a blob that is not a conditional glTF-BRDF sampler, or two
+    /// blobs of the same `N`.
+    pub fn read(paths: &[PathBuf]) -> Result<Self> {
+        let mut blobs = Self::default();
+        for path in paths {
+            let bytes = std::fs::read(path)
+                .with_context(|| format!("cannot read BRDF blob {}", path.display()))?;
+            blobs.insert(path.clone(), AlignedBytes::copy_from(&bytes))?;
+        }
+        Ok(blobs)
+    }
+
+    fn insert(&mut self, path: PathBuf, buf: AlignedBytes) -> Result<()> {
+        let n = NuldSampler::new(buf.as_slice(), NuldMode::Table)
+            .map_err(|e| anyhow!("BRDF blob {}: {e}", path.display()))?
+            .len();
+        if let Some((other, _)) = self.by_n.get(&n) {
+            bail!(
+                "BRDF blobs {} and {} both have N = {n}; give one blob per sample count",
+                other.display(),
+                path.display()
+            );
+        }
+        self.by_n.insert(n, (path, buf));
+        Ok(())
+    }
+
+    /// Bakes (or reuses) a blob in `dir/brdf-nN/` for every count of `spp` that no
+    /// blob serves, with `template` at `N` points per set.
+    pub fn complete(&mut self, spp: &[u32], dir: &Path, template: &BakeConfig) -> Result<()> {
+        for &n in spp {
+            if self.by_n.contains_key(&n) {
+                continue;
+            }
+            let sub = dir.join(format!("brdf-n{n}"));
+            let path = sub.join("brdf.nuld");
+            if !path.is_file() {
+                let mut config = template.clone();
+                config.train.n = n;
+                eprintln!(
+                    "render: no BRDF blob with N = {n}; baking one into {}",
+                    sub.display()
+                );
+                bake(&config, &sub)?;
+            }
+            let bytes = std::fs::read(&path)
+                .with_context(|| format!("cannot read BRDF blob {}", path.display()))?;
+            self.insert(path, AlignedBytes::copy_from(&bytes))?;
+        }
+        Ok(())
+    }
+
+    /// The bytes and path of the blob with `N = n`, if any.
+    pub fn get(&self, n: u32) -> Option<(&Path, &[u8])> {
+        self.by_n.get(&n).map(|(p, b)| (p.as_path(), b.as_slice()))
+    }
+}
+
+/// A tiny baked BRDF sampler with `N = n` (the `--quick` bake, a finer weight
+/// grid), baked into a fresh temporary directory: barely trained, so it checks
+/// the sampler path, not its quality.
+#[cfg(test)]
+pub(crate) fn tiny_blob(n: u32) -> AlignedBytes {
+    use std::sync::atomic::{AtomicU32, Ordering};
+    static COUNTER: AtomicU32 = AtomicU32::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "nuld-render-blob-{}-{}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    let mut config = super::RenderConfig::quick(PathBuf::new()).bake;
+    config.train.n = n;
+    config.weight_grid = [32, 32];
+    bake(&config, &dir).unwrap();
+    let bytes = AlignedBytes::read(&dir.join("brdf.nuld")).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    bytes
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn blobs_of_the_wrong_kind_or_a_repeated_n_are_refused_by_name() {
+        let dir = std::env::temp_dir().join(format!("nuld-render-blobs-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // A valid 2D point-set blob (the runtime's doc example) is the wrong kind.
+        let points = dir.join("points.nuld");
+        std::fs::write(&points, nuld_runtime::doc_example_blob().0).unwrap();
+        let e = BrdfBlobs::read(std::slice::from_ref(&points))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("points.nuld") && e.contains("not a conditional BRDF sampler"),
+            "{e}"
+        );
+        let junk = dir.join("junk.nuld");
+        std::fs::write(&junk, b"not a blob").unwrap();
+        let e = BrdfBlobs::read(&[junk]).unwrap_err().to_string();
+        assert!(e.contains("not a valid nuld blob"), "{e}");
+        let e = BrdfBlobs::read(&[dir.join("missing.nuld")])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("cannot read BRDF blob"), "{e}");
+        let blob = dir.join("b.nuld");
+        std::fs::write(&blob, tiny_blob(4).as_slice()).unwrap();
+        let e = BrdfBlobs::read(&[blob.clone(), blob.clone()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("both have N = 4"), "{e}");
+        let blobs = BrdfBlobs::read(&[blob]).unwrap();
+        assert!(blobs.get(4).is_some() && blobs.get(16).is_none());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

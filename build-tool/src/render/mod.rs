@@ -1,0 +1,36 @@
+//! The rendering evaluation of paper Fig. 8 (`build-tool render`): a small,
+//! physically based renderer whose only job is to compare samplers.
+//!
+//! Spheres of the glTF BRDF at roughnesses 0.1 to 1 on a ground plane
+//! ([`scene`]), a pinhole camera ([`camera`]), lit only by an environment map
+//! ([`environment`]); direct lighting with visibility by ray casting, one
+//! estimator per pixel ([`integrator`]). Every sampler implements one trait
+//! ([`sampler::DirectionSampler`], returning [`sampler::Sample`]s):
+//! * BRDF sampling: ours in table and network mode ([`nuld_sampler`], through
+//!   `nuld-runtime` on the blob bytes only), and Owen-Sobol, random, SOT and GBN
+//!   points ([`primary`]) through the renderer's mixture warp ([`brdf_warp`]);
+//! * environment sampling: Owen-Sobol and Halton points through the map's
+//!   inverse CDF, and Owen-Sobol through hierarchical warping ([`envmap_warp`]).
+//!
+//! [`lineup`] lists them in table order. A multiple-importance-sampled reference
+//! ([`mod@reference`]) gives RMSE and bias ([`summary`]); [`run`] writes pictures
+//! ([`picture`]), the Fig. 8 composites, `render.csv` and the summary tables.
+
+pub mod blobs;
+pub mod brdf_warp;
+pub mod camera;
+pub mod environment;
+pub mod envmap_warp;
+pub mod frame;
+pub mod integrator;
+pub mod lineup;
+pub mod nuld_sampler;
+pub mod picture;
+pub mod primary;
+pub mod reference;
+pub mod run;
+pub mod sampler;
+pub mod scene;
+pub mod summary;
+
+pub use run::{render, RenderConfig, RenderReport};

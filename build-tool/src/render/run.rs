@@ -1,0 +1,440 @@
+//! `build-tool render`: the whole evaluation of paper Fig. 8 into one directory.
+//!
+//! Writes into `DIR`: `render.csv` ([`super::summary::CSV_HEADER`]),
+//! `render-summary.md` (equal-sample-count and equal-time tables),
+//! `reference.png` and the cached `reference-KEY.bin`, `images/T-S-N.png`
+//! (technique `T`, sampler `S`, `N` spp; tone-mapped with the reference's exposure),
+//! `errors/T-S-N.png` (absolute error against the reference, white at twice
+//! Owen-Sobol's RMSE of the same technique and spp), `fig8-brdf.png`,
+//! `fig8-envmap.png` (and `-errors` twins: rows = samplers, columns = spp), and
+//! the baked blobs `brdf-nN/` it needed. Every file is written atomically.
+
+use super::blobs::BrdfBlobs;
+use super::brdf_warp::LobeTable;
+use super::camera::Camera;
+use super::environment::Environment;
+use super::integrator::{Image, Primary, Setup};
+use super::lineup::{self, BRDF_SAMPLERS, ENVMAP_SAMPLERS};
+use super::picture::{error_map, exposure, tone_map, Picture};
+use super::reference::{content_hash, Reference};
+use super::sampler::Technique;
+use super::scene::Scene;
+use super::summary::{csv, errors, markdown, Row};
+use crate::conditional::bake::BakeConfig;
+use crate::output::{ensure_dir, write_atomic};
+use crate::plot::{render_composite, Composite, Tile};
+use crate::progress::Progress;
+use crate::train::TrainConfig;
+use anyhow::{bail, Context, Result};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// Settings of a render.
+#[derive(Clone, Debug)]
+pub struct RenderConfig {
+    /// The environment map (HDR, EXR, PNG).
+    pub envmap: PathBuf,
+    /// Samples per pixel, each in `1..=65536`.
+    pub spp: Vec<u32>,
+    /// Image size in pixels.
+    pub width: u32,
+    /// Image size in pixels.
+    pub height: u32,
+    /// Samples of each technique per pixel of the reference.
+    pub reference_samples: u32,
+    /// Given BRDF sampler blobs (one per set size).
+    pub brdf_blobs: Vec<PathBuf>,
+    /// How missing blobs are baked (`train.n` is set per sample count).
+    pub bake: BakeConfig,
+    /// Fixes every pixel key, pool set and reference sample.
+    pub seed: u64,
+}
+
+impl RenderConfig {
+    /// The full evaluation: 320 x 240 pixels, 4/16/64/256 spp, a reference of
+    /// 4096 + 4096 samples per pixel, missing blobs baked with the default bake.
+    pub fn full(envmap: PathBuf) -> Self {
+        Self {
+            envmap,
+            spp: vec![4, 16, 64, 256],
+            width: 320,
+            height: 240,
+            reference_samples: 4096,
+            brdf_blobs: Vec::new(),
+            bake: BakeConfig::default(),
+            seed: 0,
+        }
+    }
+
+    /// `--quick`, for tests: 32 x 24 pixels, 4/16 spp, a reference of 256 + 256
+    /// samples per pixel, missing blobs baked in a few steps (a tiny network that
+    /// is barely trained: it exercises the path, not the quality).
+    pub fn quick(envmap: PathBuf) -> Self {
+        Self {
+            spp: vec![4, 16],
+            width: 32,
+            height: 24,
+            reference_samples: 256,
+            bake: BakeConfig {
+                train: TrainConfig {
+                    hidden: vec![8],
+                    steps: 4,
+                    pretrain_steps: 4,
+                    conditions_per_step: 2,
+                    instances_per_condition: 2,
+                    pool_conditions: 4,
+                    pool_caps: 64,
+                    caps_per_step: 32,
+                    ..TrainConfig::default()
+                },
+                instances: 4,
+                grid: [3, 3],
+                weight_grid: [8, 8],
+                quality_grid: 0,
+                checkpoint_every: Duration::from_secs(3600),
+                ..BakeConfig::default()
+            },
+            ..Self::full(envmap)
+        }
+    }
+}
+
+/// What a render measured.
+#[derive(Clone, Debug)]
+pub struct RenderReport {
+    /// One row per technique, sampler and spp (as in `render.csv`).
+    pub rows: Vec<Row>,
+    /// `render-summary.md`.
+    pub summary: String,
+    /// Seconds spent on the reference (0 when it came from the cache).
+    pub reference_seconds: f64,
+    /// Mean standard error of the reference over surface pixels.
+    pub reference_stderr: f64,
+    /// Seconds for everything.
+    pub total_seconds: f64,
+}
+
+/// Runs the evaluation into `out` (see the module docs).
+pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
+    let started = Instant::now();
+    if config.spp.is_empty() || config.spp.iter().any(|&n| !(1..=65536).contains(&n)) {
+        bail!("--spp must list sample counts in 1..=65536, like 4,16,64,256");
+    }
+    if config.width == 0 || config.height == 0 || config.reference_samples < 2 {
+        bail!("the image needs at least 1 x 1 pixels and the reference 2 samples");
+    }
+    let map_bytes = std::fs::read(&config.envmap)
+        .with_context(|| format!("cannot read environment map {}", config.envmap.display()))?;
+    let env = Environment::from_file(&config.envmap)?;
+    let mut blobs = BrdfBlobs::read(&config.brdf_blobs)?;
+    ensure_dir(out)?;
+    ensure_dir(&out.join("images"))?;
+    ensure_dir(&out.join("errors"))?;
+    blobs.complete(&config.spp, out, &config.bake)?;
+
+    let scene = Scene::spheres_on_ground();
+    let camera = Camera::evaluation(config.width, config.height);
+    let setup = Setup {
+        scene: &scene,
+        camera: &camera,
+        env: &env,
+    };
+    let mut roughnesses: Vec<f64> = scene.spheres.iter().map(|s| s.roughness).collect();
+    roughnesses.extend(scene.ground_roughness);
+    let lobes = LobeTable::new(&roughnesses);
+
+    // The reference, cached by everything it depends on.
+    let key = content_hash(
+        format!(
+            "reference v1 {:016x} {scene:?} {camera:?} {} {}",
+            content_hash(&map_bytes),
+            config.reference_samples,
+            config.seed
+        )
+        .as_bytes(),
+    );
+    let (w, h) = (config.width, config.height);
+    let t = Instant::now();
+    let (reference, reference_seconds) = match Reference::load(out, key, w, h)? {
+        Some(r) => (r, 0.0),
+        None => {
+            let progress = Progress::stderr("render reference", h as u64, "row");
+            let r = Reference::render(
+                &setup,
+                &lobes,
+                config.reference_samples,
+                config.seed,
+                &|| progress.inc(1),
+            );
+            progress.finish();
+            r.save(out, key)?;
+            (r, t.elapsed().as_secs_f64())
+        }
+    };
+    let mask: Vec<bool> = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| matches!(setup.primary(x, y), Primary::Surface { .. }))
+        .collect();
+    let surface = mask.iter().filter(|m| **m).count().max(1);
+    let reference_stderr = reference
+        .stderr
+        .iter()
+        .zip(&mask)
+        .filter(|(_, m)| **m)
+        .map(|(s, _)| s)
+        .sum::<f64>()
+        / surface as f64;
+    let exposure = exposure(&reference.image);
+    tone_map(&reference.image, exposure).write_png(&out.join("reference.png"))?;
+
+    let per_spp = BRDF_SAMPLERS.len() + ENVMAP_SAMPLERS.len();
+    let progress = Progress::stderr(
+        "render",
+        (per_spp * config.spp.len()) as u64 * h as u64,
+        "row",
+    );
+    let mut rows = Vec::new();
+    let mut images: Vec<(Row, Image)> = Vec::new();
+    for &n in &config.spp {
+        let (blob_path, bytes) = blobs
+            .get(n)
+            .with_context(|| format!("no BRDF blob with N = {n}"))?;
+        let samplers = lineup::samplers(bytes, n, config.seed, &lobes, &env)
+            .with_context(|| format!("BRDF blob {}", blob_path.display()))?;
+        for sampler in &samplers {
+            progress.set_context(format!(
+                "{} {} {n} spp",
+                sampler.technique().name(),
+                sampler.name()
+            ));
+            let t = Instant::now();
+            let image = setup.render(sampler.as_ref(), n, config.seed, &|| progress.inc(1));
+            let seconds = t.elapsed().as_secs_f64();
+            let (rmse, bias) = errors(&image, &reference.image, &mask);
+            let row = Row {
+                technique: sampler.technique().name().to_string(),
+                sampler: sampler.name().to_string(),
+                spp: n,
+                rmse,
+                bias,
+                seconds,
+            };
+            tone_map(&image, exposure).write_png(&out.join("images").join(file_name(&row)))?;
+            rows.push(row.clone());
+            images.push((row, image));
+        }
+    }
+    progress.finish();
+
+    // Error maps, white at twice Owen-Sobol's RMSE of the same technique and spp.
+    let mut errors_of = Vec::new();
+    for (row, image) in &images {
+        let scale = rows
+            .iter()
+            .find(|r| r.technique == row.technique && r.spp == row.spp && r.sampler == "owen-sobol")
+            .map_or(row.rmse, |r| r.rmse);
+        let pic = error_map(image, &reference.image, 2.0 * scale.max(f64::MIN_POSITIVE));
+        pic.write_png(&out.join("errors").join(file_name(row)))?;
+        errors_of.push(pic);
+    }
+    let tone_mapped: Vec<Picture> = images.iter().map(|(_, i)| tone_map(i, exposure)).collect();
+    for technique in [Technique::Brdf, Technique::Envmap] {
+        for (suffix, pictures) in [("", &tone_mapped), ("-errors", &errors_of)] {
+            let composite = composite(technique, &config.spp, &images, pictures, suffix);
+            render_composite(
+                &out.join(format!("fig8-{}{suffix}.png", technique.name())),
+                &composite,
+            )?;
+        }
+    }
+    write_atomic(&out.join("render.csv"), csv(&rows).as_bytes())?;
+    let summary = markdown(&rows);
+    write_atomic(&out.join("render-summary.md"), summary.as_bytes())?;
+    Ok(RenderReport {
+        rows,
+        summary,
+        reference_seconds,
+        reference_stderr,
+        total_seconds: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// `T-S-N.png`.
+fn file_name(row: &Row) -> String {
+    format!("{}-{}-{}.png", row.technique, row.sampler, row.spp)
+}
+
+/// The Fig. 8 grid of one technique: rows = its samplers, columns = `spp`.
+fn composite<'a>(
+    technique: Technique,
+    spp: &[u32],
+    images: &[(Row, Image)],
+    pictures: &'a [Picture],
+    suffix: &str,
+) -> Composite<'a> {
+    let names: &[&str] = match technique {
+        Technique::Brdf => &BRDF_SAMPLERS,
+        Technique::Envmap => &ENVMAP_SAMPLERS,
+    };
+    let cells = names
+        .iter()
+        .map(|name| {
+            spp.iter()
+                .map(|&n| {
+                    images
+                        .iter()
+                        .zip(pictures)
+                        .find(|((r, _), _)| {
+                            r.technique == technique.name() && r.sampler == *name && r.spp == n
+                        })
+                        .map(|((r, _), p)| Tile {
+                            width: p.width,
+                            height: p.height,
+                            rgb: &p.rgb,
+                            caption: format!("RMSE {:.3e}", r.rmse),
+                        })
+                })
+                .collect()
+        })
+        .collect();
+    let what = if suffix.is_empty() {
+        "renders"
+    } else {
+        "absolute error (white = 2x owen-sobol RMSE)"
+    };
+    Composite {
+        title: format!("{} sampling: {what}", technique.name()),
+        row_labels: names.iter().map(|s| s.to_string()).collect(),
+        column_labels: spp.iter().map(|n| format!("{n} spp")).collect(),
+        cells,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::summary::CSV_HEADER;
+
+    /// `../shared/data/envmaps/courtyard.hdr` when present, else a generated sky
+    /// written as PNG into `dir`.
+    fn test_map(dir: &Path) -> PathBuf {
+        let shared =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/envmaps/courtyard.hdr");
+        if shared.is_file() {
+            return shared;
+        }
+        eprintln!("skipped: {} (using a generated sky)", shared.display());
+        let img = image::RgbImage::from_fn(64, 32, |x, y| {
+            let v = if y == 5 && x == 9 {
+                255
+            } else if y < 16 {
+                120 + 4 * y as u8
+            } else {
+                30
+            };
+            image::Rgb([v, v, v])
+        });
+        let path = dir.join("sky.png");
+        img.save(&path).unwrap();
+        path
+    }
+
+    /// `render --quick` end to end, as CI runs it: every output file, the exact
+    /// CSV header and one row per technique, sampler and spp; a second run reuses
+    /// the cached reference and the baked blobs and reproduces every number.
+    #[test]
+    fn quick_render_writes_every_output_and_reproduces_itself() {
+        let out = std::env::temp_dir().join(format!("nuld-render-quick-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&out);
+        std::fs::create_dir_all(&out).unwrap();
+        let config = RenderConfig::quick(test_map(&out));
+        let first = render(&config, &out).unwrap();
+        assert!(first.reference_seconds > 0.0);
+        let csv_text = std::fs::read_to_string(out.join("render.csv")).unwrap();
+        let mut lines = csv_text.lines();
+        assert_eq!(lines.next(), Some(CSV_HEADER));
+        assert_eq!(CSV_HEADER, "technique,sampler,spp,rmse,bias,seconds");
+        let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+        assert_eq!(
+            rows.len(),
+            (BRDF_SAMPLERS.len() + ENVMAP_SAMPLERS.len()) * 2
+        );
+        for (technique, names) in [
+            ("brdf", &BRDF_SAMPLERS[..]),
+            ("envmap", &ENVMAP_SAMPLERS[..]),
+        ] {
+            for name in names {
+                for spp in ["4", "16"] {
+                    let row = rows
+                        .iter()
+                        .find(|r| r[0] == technique && r[1] == *name && r[2] == spp)
+                        .unwrap_or_else(|| panic!("no row {technique},{name},{spp}"));
+                    let nums: Vec<f64> = row[3..].iter().map(|v| v.parse().unwrap()).collect();
+                    assert!(
+                        nums[0] > 0.0
+                            && nums[0].is_finite()
+                            && nums[1].is_finite()
+                            && nums[2] >= 0.0,
+                        "{row:?}"
+                    );
+                    for sub in ["images", "errors"] {
+                        let f = out.join(sub).join(format!("{technique}-{name}-{spp}.png"));
+                        assert!(f.is_file(), "{}", f.display());
+                    }
+                }
+            }
+        }
+        for f in [
+            "render-summary.md",
+            "reference.png",
+            "fig8-brdf.png",
+            "fig8-envmap.png",
+            "fig8-brdf-errors.png",
+            "fig8-envmap-errors.png",
+            "brdf-n4/brdf.nuld",
+            "brdf-n16/brdf.nuld",
+        ] {
+            assert!(out.join(f).is_file(), "{f}");
+        }
+        let png = image::open(out.join("images/brdf-owen-sobol-4.png")).unwrap();
+        assert_eq!((png.width(), png.height()), (32, 24));
+        let leftovers: Vec<_> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .filter(|n| n.contains(".tmp-"))
+            .collect();
+        assert!(leftovers.is_empty(), "{leftovers:?}");
+
+        let second = render(&config, &out).unwrap();
+        assert_eq!(second.reference_seconds, 0.0, "the reference is reused");
+        for (a, b) in first.rows.iter().zip(&second.rows) {
+            assert_eq!(
+                (a.rmse.to_bits(), a.bias.to_bits()),
+                (b.rmse.to_bits(), b.bias.to_bits()),
+                "{}",
+                a.sampler
+            );
+        }
+        std::fs::remove_dir_all(&out).unwrap();
+    }
+
+    #[test]
+    fn bad_input_is_a_one_line_error_before_anything_is_written() {
+        let out = std::env::temp_dir().join(format!("nuld-render-bad-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&out);
+        let missing = RenderConfig::quick(PathBuf::from("/nonexistent/map.hdr"));
+        let e = format!("{:#}", render(&missing, &out).unwrap_err());
+        assert!(
+            e.contains("cannot read environment map /nonexistent/map.hdr") && !e.contains('\n'),
+            "{e}"
+        );
+        for spp in [vec![], vec![0], vec![4, 70_000]] {
+            let bad = RenderConfig {
+                spp,
+                ..RenderConfig::quick(PathBuf::from("x.hdr"))
+            };
+            assert!(format!("{:#}", render(&bad, &out).unwrap_err()).contains("--spp"));
+        }
+        assert!(!out.exists(), "nothing written for bad input");
+    }
+}

@@ -1,0 +1,107 @@
+//! The one interface every sampler of the evaluation implements: for a shading
+//! point, a pixel's key and a count `n`, the `n` directions of the pixel's set and
+//! their estimator weights.
+//!
+//! Estimator (one per pixel, direct lighting from the environment only): with the
+//! samples `(l_i, w_i)` of a pixel's set,
+//! `I ≈ (1/n) Σ w_i L(l_i) V(x, l_i)`, where `L` is the map's radiance and `V` the
+//! visibility. The weight carries what the sampler knows of the rest:
+//! * BRDF sampling: `w = f(wo, l) cos / p(l)` for the renderer's warp, and the
+//!   stored albedo `A(roughness, theta_o)` for ours (`∫ L f cos ≈ (A/n) Σ L(l_i)`);
+//! * environment sampling: `w = f(wo, l) cos / pdf_env(l)`.
+
+use super::frame::Frame;
+use crate::seeding::{derive_seed, mix64};
+use glam::DVec3;
+
+/// One sample: a unit world direction and its estimator weight (see the module
+/// docs; finite, `>= 0`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// Unit direction in the world frame.
+    pub direction: DVec3,
+    /// Estimator weight.
+    pub weight: f64,
+}
+
+/// What a sampler may know of the point being shaded.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadingPoint {
+    /// The local frame (`z` = the geometric normal).
+    pub frame: Frame,
+    /// Unit view direction (towards the camera) in the local frame, `z > 0`.
+    pub wo: DVec3,
+    /// glTF roughness of the surface.
+    pub roughness: f64,
+}
+
+impl ShadingPoint {
+    /// The cosine-weighted glTF BRDF `f(wo, l) max(n.l, 0)` for the world
+    /// direction `l` ([`nuld_core::brdf::cosine_weighted`]).
+    pub fn cosine_weighted(&self, l: DVec3) -> f64 {
+        nuld_core::brdf::cosine_weighted(self.wo, self.frame.to_local(l), self.roughness)
+    }
+
+    /// `θo` in degrees, the view angle of the BRDF's condition.
+    pub fn theta_o_deg(&self) -> f64 {
+        self.wo.z.clamp(0.0, 1.0).acos().to_degrees()
+    }
+}
+
+/// Which integral a sampler importance-samples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Technique {
+    /// The cosine-weighted BRDF.
+    Brdf,
+    /// The environment map.
+    Envmap,
+}
+
+impl Technique {
+    /// `brdf` or `envmap` (the `technique` column of `render.csv`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Technique::Brdf => "brdf",
+            Technique::Envmap => "envmap",
+        }
+    }
+}
+
+/// A pixel's key: a hash of `(seed, pixel index)` from which every sampler derives
+/// the pixel's scramble, instance or set, so pixels are decorrelated and the image
+/// does not depend on the order pixels are rendered in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PixelKey(pub u64);
+
+/// Stream of [`derive_seed`] for the pixel keys.
+const PIXEL_STREAM: u64 = 0x9e4d;
+
+impl PixelKey {
+    /// The key of pixel `index` (`y * width + x`) under `seed`.
+    pub fn new(seed: u64, index: u64) -> Self {
+        Self(mix64(derive_seed(seed, PIXEL_STREAM) ^ index))
+    }
+
+    /// The key's high 32 bits: the instance of a conditional sampler.
+    pub fn instance(self) -> u32 {
+        (self.0 >> 32) as u32
+    }
+
+    /// The key's low 32 bits: an Owen scramble seed.
+    pub fn scramble(self) -> u32 {
+        self.0 as u32
+    }
+}
+
+/// A sampler of directions for the evaluation (see the module docs).
+pub trait DirectionSampler: Sync {
+    /// The integral it importance-samples.
+    fn technique(&self) -> Technique;
+
+    /// Its name in `render.csv` (`nuld-table`, `owen-sobol`, ...).
+    fn name(&self) -> &'static str;
+
+    /// The `n` samples of the set of the pixel with key `key` at `at`, into `out`
+    /// (cleared first). Deterministic in `(at, key, n)`.
+    fn samples(&self, at: &ShadingPoint, key: PixelKey, n: u32, out: &mut Vec<Sample>);
+}
