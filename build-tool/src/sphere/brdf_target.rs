@@ -258,16 +258,15 @@ impl BrdfTarget {
                 rule.push((wi, q / p));
             }
         };
+        // A jittered point per stratum, not the midpoint: midpoints of a regular grid
+        // land on a few rings of equal `z` under the concentric maps, and a cap whose
+        // rim runs along a ring (any cap about the normal, every cap near the
+        // horizon) then gains or loses a whole ring's mass at once.
+        let jitter = |bits: u64| (bits as u32 as f64 + 0.5) / 4_294_967_296.0;
         for (m, spec) in [(ms, true), (mc, false)] {
             for j in 0..m {
                 for i in 0..m {
-                    // A jittered point per stratum, not the midpoint: midpoints of a
-                    // regular grid land on a few rings of equal `z` under the
-                    // concentric maps, and a cap whose rim runs along a ring (any cap
-                    // about the normal, every cap near the horizon) then gains or
-                    // loses a whole ring's mass at once.
                     let h = mix64(RULE_JITTER_SEED ^ ((spec as u64) << 62) ^ ((j * m + i) as u64));
-                    let jitter = |bits: u64| (bits as u32 as f64 + 0.5) / 4_294_967_296.0;
                     let u = DVec2::new(
                         (i as f64 + jitter(h)) / m as f64,
                         (j as f64 + jitter(h >> 32)) / m as f64,
