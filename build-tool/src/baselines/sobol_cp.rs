@@ -66,8 +66,14 @@ pub fn sobol_cranley_patterson(n: usize, seed: u64) -> Vec<DVec2> {
     let s = DVec2::new(r.random::<f64>(), r.random::<f64>());
     sobol_points(n)
         .into_iter()
-        .map(|p| DVec2::new(toroidal_add(p.x, s.x), toroidal_add(p.y, s.y)))
+        .map(|p| toroidal_shift(p, s))
         .collect()
+}
+
+/// `p + shift` modulo 1 in each coordinate (a Cranley–Patterson rotation), for
+/// `p, shift in [0,1)^2`; always in `[0,1)^2`.
+pub(crate) fn toroidal_shift(p: DVec2, shift: DVec2) -> DVec2 {
+    DVec2::new(toroidal_add(p.x, shift.x), toroidal_add(p.y, shift.y))
 }
 
 /// `frac(a + b)` for `a, b in [0,1)`, always in `[0,1)`.

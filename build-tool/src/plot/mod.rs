@@ -53,7 +53,14 @@ pub(crate) fn write_png(
         draw(&root)?;
         root.present().map_err(err)?;
     }
-    let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| anyhow!("plot buffer size"))?;
+    write_rgb_png(path, (w, h), buf)
+}
+
+/// Writes `rgb` (8-bit RGB, row-major, `3 w h` bytes) as PNG to `path`
+/// atomically; an error if the length does not match `w x h`.
+pub(crate) fn write_rgb_png(path: &Path, (w, h): (u32, u32), rgb: Vec<u8>) -> Result<()> {
+    let img = image::RgbImage::from_raw(w, h, rgb)
+        .ok_or_else(|| anyhow!("picture buffer does not match {w}x{h}"))?;
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
     crate::output::write_atomic(path, &png)

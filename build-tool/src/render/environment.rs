@@ -15,8 +15,9 @@
 //! * **hierarchical warping** ([`Environment::sample_hierarchical`], Clarberg et
 //!   al. 2005, [`HierarchicalWarp`]) over the grid of pixel masses.
 //!
-//! Both place the point inside its pixel uniformly in `z = cos theta` and `phi`, so
-//! their density is the same piecewise-constant [`Environment::pdf`].
+//! Both place the point inside its pixel uniformly in `z = cos theta` and `phi`
+//! ([`EnvmapDensity::pixel_direction`]), so their density is the same
+//! piecewise-constant [`Environment::pdf`].
 
 use crate::baselines::HierarchicalWarp;
 use crate::density::image::{load_luminance, LuminanceImage};
@@ -113,21 +114,17 @@ impl Environment {
 
     /// The direction of `u` in `[0,1)^2` by hierarchical warping: the quadtree picks
     /// a pixel with its mass and a point in it, which is spread uniformly in `z` and
-    /// `phi` within the pixel.
+    /// `phi` within the pixel ([`EnvmapDensity::pixel_direction`]).
     pub fn sample_hierarchical(&self, u: DVec2) -> DVec3 {
         let p = self.hierarchical.warp(u);
         let (w, h) = (self.density.width(), self.density.height());
         let (x, y) = (p.x * w as f64, p.y * h as f64);
         let (c, r) = ((x as usize).min(w - 1), (y as usize).min(h - 1));
-        let (fx, fy) = (
+        let f = DVec2::new(
             (x - c as f64).clamp(0.0, 1.0),
             (y - r as f64).clamp(0.0, 1.0),
         );
-        let (lo, hi) = self.density.row_z_range(r);
-        let z = hi - fy * (hi - lo);
-        let phi = TAU * (c as f64 + fx) / w as f64;
-        let s = (1.0 - z * z).max(0.0).sqrt();
-        DVec3::new(s * phi.cos(), s * phi.sin(), z)
+        self.density.pixel_direction(c, r, f)
     }
 }
 

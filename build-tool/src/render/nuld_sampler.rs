@@ -7,8 +7,6 @@
 //! bits) and the index. The weight is the sample's own (the albedo `A`).
 
 use super::sampler::{DirectionSampler, PixelKey, Sample, ShadingPoint, Technique};
-use glam::DVec3;
-use nuld_runtime::glam::Vec3;
 use nuld_runtime::{Blob, BlobError, BlobKind, ConditionalSampler, ConditionalTarget};
 
 /// Table mode or network mode.
@@ -85,7 +83,7 @@ impl DirectionSampler for NuldSampler<'_> {
     /// evaluation (indices wrap modulo `N` otherwise).
     fn samples(&self, at: &ShadingPoint, key: PixelKey, n: u32, out: &mut Vec<Sample>) {
         out.clear();
-        let wo = Vec3::new(at.wo.x as f32, at.wo.y as f32, at.wo.z as f32);
+        let wo = at.wo.as_vec3();
         let r = at.roughness as f32;
         let k = key.instance();
         out.extend((0..n).map(|i| {
@@ -94,13 +92,8 @@ impl DirectionSampler for NuldSampler<'_> {
                 NuldMode::Network => self.sampler.sample_brdf_network(wo, r, k, i),
             };
             // The runtime's directions are unit to f32 rounding; used as they come.
-            let d = DVec3::new(
-                s.direction.x as f64,
-                s.direction.y as f64,
-                s.direction.z as f64,
-            );
             Sample {
-                direction: at.frame.to_world(d),
+                direction: at.frame.to_world(s.direction.as_dvec3()),
                 weight: s.weight as f64,
             }
         }));
@@ -112,6 +105,7 @@ mod tests {
     use super::*;
     use crate::render::blobs::tiny_blob;
     use crate::render::frame::Frame;
+    use glam::{DVec3, Vec3};
 
     /// Ours is the runtime and nothing else: on the same blob bytes, the samples
     /// equal direct `nuld_runtime` calls bit for bit (local frame = world frame

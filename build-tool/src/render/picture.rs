@@ -2,8 +2,8 @@
 //! as 8-bit sRGB PNG written atomically.
 
 use super::integrator::Image;
-use crate::output::write_atomic;
-use anyhow::{anyhow, Result};
+use crate::plot::write_rgb_png;
+use anyhow::Result;
 use std::path::Path;
 
 /// An 8-bit RGB picture, row-major, row 0 at the top.
@@ -92,18 +92,7 @@ pub fn error_map(image: &Image, reference: &Image, scale: f64) -> Picture {
 impl Picture {
     /// Writes the picture as PNG to `path`, atomically.
     pub fn write_png(&self, path: &Path) -> Result<()> {
-        let img = image::RgbImage::from_raw(self.width, self.height, self.rgb.clone()).ok_or_else(
-            || {
-                anyhow!(
-                    "picture buffer does not match {}x{}",
-                    self.width,
-                    self.height
-                )
-            },
-        )?;
-        let mut png = Vec::new();
-        img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
-        write_atomic(path, &png)
+        write_rgb_png(path, (self.width, self.height), self.rgb.clone())
     }
 }
 

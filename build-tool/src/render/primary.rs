@@ -19,7 +19,7 @@
 
 use crate::baselines::{
     gaussian_blue_noise, owen_sobol, random, scrambled_halton, sliced_optimal_transport,
-    GBN_DEFAULT_ITERATIONS, SOT_DEFAULT_ITERATIONS,
+    toroidal_shift, GBN_DEFAULT_ITERATIONS, SOT_DEFAULT_ITERATIONS,
 };
 use crate::seeding::derive_seed;
 use glam::DVec2;
@@ -112,19 +112,6 @@ impl PrimaryPoints {
             }
         }
     }
-}
-
-/// `p + shift` modulo 1 in each coordinate, in `[0,1)`.
-fn toroidal_shift(p: DVec2, shift: DVec2) -> DVec2 {
-    let wrap = |v: f64| {
-        let f = v - v.floor();
-        if f >= 1.0 {
-            0.0
-        } else {
-            f
-        }
-    };
-    DVec2::new(wrap(p.x + shift.x), wrap(p.y + shift.y))
 }
 
 #[cfg(test)]

@@ -81,15 +81,14 @@ impl Reference {
         let bytes =
             std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?;
         let n = (width * height) as usize;
-        if bytes.len() != 24 + 16 * n || &bytes[..8] != MAGIC {
-            bail!(
-                "{} is not a reference of this render; delete it to recompute",
-                path.display()
-            );
-        }
         let word =
             |k: usize| u64::from_le_bytes(bytes[8 * k..8 * k + 8].try_into().unwrap_or([0; 8]));
-        if word(1) != key || word(2) != ((width as u64) << 32 | height as u64) {
+        // The length is checked first: it guarantees the header words exist.
+        if bytes.len() != 24 + 16 * n
+            || &bytes[..8] != MAGIC
+            || word(1) != key
+            || word(2) != ((width as u64) << 32 | height as u64)
+        {
             bail!(
                 "{} is not a reference of this render; delete it to recompute",
                 path.display()

@@ -193,8 +193,10 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
         (per_spp * config.spp.len()) as u64 * h as u64,
         "row",
     );
-    let mut rows = Vec::new();
-    let mut images: Vec<(Row, Image)> = Vec::new();
+    // Parallel: the row, image and tone-mapped picture of each render.
+    let mut rows: Vec<Row> = Vec::new();
+    let mut images: Vec<Image> = Vec::new();
+    let mut pictures: Vec<Picture> = Vec::new();
     for &n in &config.spp {
         let (blob_path, bytes) = blobs
             .get(n)
@@ -219,16 +221,18 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
                 bias,
                 seconds,
             };
-            tone_map(&image, exposure).write_png(&out.join("images").join(file_name(&row)))?;
-            rows.push(row.clone());
-            images.push((row, image));
+            let picture = tone_map(&image, exposure);
+            picture.write_png(&out.join("images").join(file_name(&row)))?;
+            rows.push(row);
+            images.push(image);
+            pictures.push(picture);
         }
     }
     progress.finish();
 
     // Error maps, white at twice Owen-Sobol's RMSE of the same technique and spp.
     let mut errors_of = Vec::new();
-    for (row, image) in &images {
+    for (row, image) in rows.iter().zip(&images) {
         let scale = rows
             .iter()
             .find(|r| r.technique == row.technique && r.spp == row.spp && r.sampler == "owen-sobol")
@@ -237,10 +241,9 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
         pic.write_png(&out.join("errors").join(file_name(row)))?;
         errors_of.push(pic);
     }
-    let tone_mapped: Vec<Picture> = images.iter().map(|(_, i)| tone_map(i, exposure)).collect();
     for technique in [Technique::Brdf, Technique::Envmap] {
-        for (suffix, pictures) in [("", &tone_mapped), ("-errors", &errors_of)] {
-            let composite = composite(technique, &config.spp, &images, pictures, suffix);
+        for (suffix, pictures) in [("", &pictures), ("-errors", &errors_of)] {
+            let composite = composite(technique, &config.spp, &rows, pictures, suffix);
             render_composite(
                 &out.join(format!("fig8-{}{suffix}.png", technique.name())),
                 &composite,
@@ -264,11 +267,12 @@ fn file_name(row: &Row) -> String {
     format!("{}-{}-{}.png", row.technique, row.sampler, row.spp)
 }
 
-/// The Fig. 8 grid of one technique: rows = its samplers, columns = `spp`.
+/// The Fig. 8 grid of one technique: rows = its samplers, columns = `spp`;
+/// `pictures[i]` shows `rows[i]`.
 fn composite<'a>(
     technique: Technique,
     spp: &[u32],
-    images: &[(Row, Image)],
+    rows: &[Row],
     pictures: &'a [Picture],
     suffix: &str,
 ) -> Composite<'a> {
@@ -281,13 +285,12 @@ fn composite<'a>(
         .map(|name| {
             spp.iter()
                 .map(|&n| {
-                    images
-                        .iter()
+                    rows.iter()
                         .zip(pictures)
-                        .find(|((r, _), _)| {
+                        .find(|(r, _)| {
                             r.technique == technique.name() && r.sampler == *name && r.spp == n
                         })
-                        .map(|((r, _), p)| Tile {
+                        .map(|(r, p)| Tile {
                             width: p.width,
                             height: p.height,
                             rgb: &p.rgb,

@@ -403,6 +403,17 @@ impl EnvmapDensity {
         sum.clamp(0.0, 1.0)
     }
 
+    /// The direction at `f` in `[0,1]^2` of pixel `(c, r)`, uniform in `z = cos
+    /// theta` and `phi` within the pixel: `phi = 2 pi (c + f.x) / W`, `z` from the
+    /// row's top (`f.y = 0`) to its bottom (`f.y = 1`). A uniform `f` gives a
+    /// direction uniform in the pixel's solid angle.
+    pub fn pixel_direction(&self, c: usize, r: usize, f: DVec2) -> DVec3 {
+        let z = self.z_hi[r] - f.y * (self.z_hi[r] - self.z_lo[r]);
+        let phi = TAU * (c as f64 + f.x) / self.width as f64;
+        let s = (1.0 - z * z).max(0.0).sqrt();
+        DVec3::new(s * phi.cos(), s * phi.sin(), z)
+    }
+
     /// Direction of the centre of pixel `(c, r)`.
     fn pixel_center(&self, c: usize, r: usize) -> DVec3 {
         let z = 0.5 * (self.z_lo[r] + self.z_hi[r]);
@@ -465,10 +476,7 @@ impl DirectionDensity for EnvmapDensity {
         let base = r * (self.width + 1);
         let row = &self.col_cum[base..base + self.width + 1];
         let (c, rx) = pick(row, u.x.clamp(0.0, 1.0) * row[self.width]);
-        let z = self.z_hi[r] - ry * (self.z_hi[r] - self.z_lo[r]);
-        let phi = TAU * (c as f64 + rx) / self.width as f64;
-        let s = (1.0 - z * z).max(0.0).sqrt();
-        DVec3::new(s * phi.cos(), s * phi.sin(), z)
+        self.pixel_direction(c, r, DVec2::new(rx, ry))
     }
 
     fn notes(&self) -> Vec<String> {
