@@ -166,6 +166,16 @@ fn nuld_is_finite(x: f32) -> bool {
     return (bitcast<u32>(x) & 0x7f800000u) != 0x7f800000u;
 }
 
+// Rust: `f32::max(x, 0).min(1)`, NaN as 0 (the unit clamps of `brdf_mixture_real`,
+// `AxisCell::locate` and `condition_features`): `x` clamped into `[0, 1]` (WGSL's
+// `clamp` leaves NaN to the driver).
+fn nuld_clamp01(x: f32) -> f32 {
+    if nuld_is_nan(x) {
+        return 0.0;
+    }
+    return clamp(x, 0.0, 1.0);
+}
+
 // Rust: `f32::copysign`: the magnitude of `x` with the sign bit of `s`.
 fn nuld_copysign(x: f32, s: f32) -> f32 {
     return bitcast<f32>((bitcast<u32>(x) & 0x7fffffffu) | (bitcast<u32>(s) & 0x80000000u));
@@ -231,15 +241,6 @@ fn nuld_to_direction(domain: u32, p: vec2<f32>) -> vec3<f32> {
 }
 
 // ---- The renderer's BRDF mixture warp (core/src/warp.rs, core/src/brdf.rs) -----
-
-// Rust: `f32::max(x, 0).min(1)`: `x` clamped into `[0, 1]`, NaN as 0 (WGSL's
-// `clamp` leaves NaN to the driver).
-fn nuld_clamp01(x: f32) -> f32 {
-    if nuld_is_nan(x) {
-        return 0.0;
-    }
-    return clamp(x, 0.0, 1.0);
-}
 
 // Rust: `normalize_real`: `x * (1 / |x|)`, in its order of operations.
 fn nuld_normalize3(x: vec3<f32>) -> vec3<f32> {
@@ -462,11 +463,7 @@ fn nuld_locate(u: vec2<f32>, nodes: vec2<u32>) -> NuldGridCell {
         cell.j0[a] = 0u;
         cell.t[a] = 0.0;
         if nodes[a] >= 2u {
-            var x = 0.0;
-            if !nuld_is_nan(u[a]) {
-                x = clamp(u[a], 0.0, 1.0);
-            }
-            let s = x * f32(nodes[a] - 1u);
+            let s = nuld_clamp01(u[a]) * f32(nodes[a] - 1u);
             let j0 = min(u32(s), nodes[a] - 2u);
             cell.j0[a] = j0;
             cell.t[a] = s - f32(j0);
@@ -630,14 +627,8 @@ fn nuld_input_features(info: NuldConditionalInfo, c: vec2<f32>, k: u32, i: u32) 
     let lz = l + z;
     let p = lz - floor(lz);
     // `condition_features`: `(u, v, u v, u^2, v^2)` of the clamped condition.
-    var cu = vec2<f32>(0.0, 0.0);
-    for (var a = 0u; a < 2u; a++) {
-        if !nuld_is_nan(c[a]) {
-            cu[a] = min(max(c[a], 0.0), 1.0);
-        }
-    }
-    let u = cu.x;
-    let v = cu.y;
+    let u = nuld_clamp01(c.x);
+    let v = nuld_clamp01(c.y);
     return array<f32, 11>(
         2.0 * u - 1.0,
         2.0 * v - 1.0,
