@@ -17,7 +17,7 @@ use nuld_core::network::{
     Activation, DOT_LANES, INPUTS, LATTICE_LOGIT_EPS, MAX_HIDDEN_LAYERS, MAX_WIDTH, OUTPUTS,
 };
 use nuld_core::quantize::{f16_decode_finite, UNORM16_CELLS};
-use nuld_runtime::shader::{KernelParams, KERNEL_WORKGROUP_SIZE, SAMPLE_STRIDE};
+use nuld_runtime::shader::{KernelMode, KernelParams, KERNEL_WORKGROUP_SIZE, SAMPLE_STRIDE};
 use std::mem::{offset_of, size_of};
 
 /// A value the shader assumes and the Rust definition it must equal (`f32`
@@ -146,6 +146,10 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_ACOS_Q_S1", libm_literal("-7.0662963390e-01")),
         ("NULD_F16_SUBNORMAL", f(f16_decode_finite(1))),
         ("NULD_WORKGROUP_SIZE", KERNEL_WORKGROUP_SIZE as u64),
+        ("NULD_MODE_TABLE", KernelMode::Table as u64),
+        ("NULD_MODE_NETWORK", KernelMode::Network as u64),
+        ("NULD_MODE_BRDF_TABLE", KernelMode::BrdfTable as u64),
+        ("NULD_MODE_BRDF_NETWORK", KernelMode::BrdfNetwork as u64),
     ]
 }
 
