@@ -142,25 +142,7 @@ impl Gpu {
     }
 }
 
-/// The README's compute shader (`shader_sample.wgsl` after
-/// [`nuld_runtime::shader::WGSL`]) over `blob`, a conditional blob of `n` points per
-/// set, for `pixels` pixels: `n` samples per pixel, pixel-major, each a direction
-/// `xyz` and its weight.
-#[allow(dead_code)] // shader_bench includes this file for `Gpu` alone
-pub fn sample_pixels(gpu: &Gpu, blob: &[u8], pixels: u32, n: u32) -> Vec<[f32; 4]> {
-    let source = [
-        nuld_runtime::shader::WGSL,
-        include_str!("shader_sample.wgsl"),
-    ]
-    .concat();
-    let pipeline = gpu.pipeline(&source, "main");
-    let samples = pixels * n;
-    // One invocation per sample, `@workgroup_size(64)`.
-    let groups = [samples.div_ceil(64), 1, 1];
-    gpu.run(&pipeline, blob, None, samples as u64, groups, 1).0
-}
-
-#[allow(dead_code)] // the tests include this file for `Gpu` and `sample_pixels`
+#[allow(dead_code)] // the tests include this file for `Gpu` alone
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let bytes = match std::env::args().nth(1) {
         Some(path) => AlignedBuf::read(path)?,
@@ -168,8 +150,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     // Validate on the CPU first: the shader trusts what `Blob::parse` checks.
     let n = Blob::parse(bytes.as_bytes())?.conditional()?.len();
+    let source = [
+        nuld_runtime::shader::WGSL,
+        include_str!("shader_sample.wgsl"),
+    ]
+    .concat();
     let gpu = Gpu::new().ok_or("no GPU adapter (on Linux, install mesa-vulkan-drivers)")?;
-    let out = sample_pixels(&gpu, bytes.as_bytes(), 4, n);
+    let pixels = 4;
+    let samples = pixels * n;
+    let groups = [samples.div_ceil(64), 1, 1];
+    let pipeline = gpu.pipeline(&source, "main");
+    let (out, _) = gpu.run(&pipeline, bytes.as_bytes(), None, samples as u64, groups, 1);
     println!("adapter: {}", gpu.adapter);
     for (e, s) in out.iter().enumerate() {
         println!(

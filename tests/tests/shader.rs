@@ -404,7 +404,21 @@ fn shader_readme_example_gives_the_runtime_samples() {
     let Some(kernel) = kernel() else { return };
     let bytes = nuld_runtime::doc_example_conditional_blob();
     let cs = Blob::parse(&bytes.0).unwrap().conditional().unwrap();
-    let out = shader_sample::sample_pixels(&kernel.gpu, &bytes.0, 5, cs.len());
+    let source = [
+        nuld_runtime::shader::WGSL,
+        include_str!("../examples/shader_sample.wgsl"),
+    ]
+    .concat();
+    let pipeline = kernel.gpu.pipeline(&source, "main");
+    let count = 5 * cs.len();
+    let (out, _) = kernel.gpu.run(
+        &pipeline,
+        &bytes.0,
+        None,
+        count as u64,
+        [count.div_ceil(64), 1, 1],
+        1,
+    );
     let wo = Vec3::new(0.3, 0.4, 0.866).normalize();
     let mut worst = 0.0f32;
     for (e, got) in out.iter().enumerate() {
