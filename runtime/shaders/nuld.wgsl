@@ -155,6 +155,12 @@ fn nuld_unorm16_decode(q: u32) -> f32 {
     return (f32(q) + 0.5) * NULD_UNORM16_SCALE;
 }
 
+// Rust: `unpack_point` (core/src/conditional.rs): the u16 codes
+// `(w & 0xffff, w >> 16)` of a word holding a point (its two little-endian u16).
+fn nuld_unpack_point(w: u32) -> vec2<u32> {
+    return vec2<u32>(w & 0xffffu, w >> 16u);
+}
+
 // Rust: `f32::is_nan`, on the bits: a driver may assume that no float is NaN and
 // fold `x != x` away, but not an integer test.
 fn nuld_is_nan(x: f32) -> bool {
@@ -164,6 +170,16 @@ fn nuld_is_nan(x: f32) -> bool {
 // Rust: `f32::is_finite`, on the bits.
 fn nuld_is_finite(x: f32) -> bool {
     return (bitcast<u32>(x) & 0x7f800000u) != 0x7f800000u;
+}
+
+// Rust: `f32::max(x, 0).min(1)`, NaN as 0 (the unit clamps of `brdf_mixture_real`,
+// `AxisCell::locate` and `condition_features`): `x` clamped into `[0, 1]` (WGSL's
+// `clamp` leaves NaN to the driver).
+fn nuld_clamp01(x: f32) -> f32 {
+    if nuld_is_nan(x) {
+        return 0.0;
+    }
+    return clamp(x, 0.0, 1.0);
 }
 
 // Rust: `f32::copysign`: the magnitude of `x` with the sign bit of `s`.
@@ -231,15 +247,6 @@ fn nuld_to_direction(domain: u32, p: vec2<f32>) -> vec3<f32> {
 }
 
 // ---- The renderer's BRDF mixture warp (core/src/warp.rs, core/src/brdf.rs) -----
-
-// Rust: `f32::max(x, 0).min(1)`: `x` clamped into `[0, 1]`, NaN as 0 (WGSL's
-// `clamp` leaves NaN to the driver).
-fn nuld_clamp01(x: f32) -> f32 {
-    if nuld_is_nan(x) {
-        return 0.0;
-    }
-    return clamp(x, 0.0, 1.0);
-}
 
 // Rust: `normalize_real`: `x * (1 / |x|)`, in its order of operations.
 fn nuld_normalize3(x: vec3<f32>) -> vec3<f32> {
@@ -340,7 +347,7 @@ fn nuld_raw(set_index: u32, i: u32) -> vec2<u32> {
     let len = nuld_u32(info + NULD_POINT_SET_LEN);
     let sets = nuld_u32(info + NULD_POINT_SET_COUNT);
     let w = nuld_u32(nuld_section(NULD_TAG_POINTS) + 4u * ((set_index % sets) * len + i % len));
-    return vec2<u32>(w & 0xffffu, w >> 16u);
+    return nuld_unpack_point(w);
 }
 
 // Rust: `PointSet2D::point` (also `DirectionSet::square_point`): point `i` of set
@@ -445,6 +452,14 @@ fn nuld_normalize(info: NuldConditionalInfo, c: vec2<f32>) -> vec2<f32> {
     return u;
 }
 
+// Rust: `ConditionalInfo::denormalize`: the condition (blob units) of the
+// normalized `u`, `cond_min + u (cond_max - cond_min)` per axis.
+fn nuld_denormalize(info: NuldConditionalInfo, u: vec2<f32>) -> vec2<f32> {
+    let lo = info.cond_min;
+    let hi = info.cond_max;
+    return vec2<f32>(lo.x + u.x * (hi.x - lo.x), lo.y + u.y * (hi.y - lo.y));
+}
+
 // Rust: `GridCell` (`AxisCell` per axis): the lower corner node `j0` and the
 // fraction `t` within the cell.
 struct NuldGridCell {
@@ -462,11 +477,7 @@ fn nuld_locate(u: vec2<f32>, nodes: vec2<u32>) -> NuldGridCell {
         cell.j0[a] = 0u;
         cell.t[a] = 0.0;
         if nodes[a] >= 2u {
-            var x = 0.0;
-            if !nuld_is_nan(u[a]) {
-                x = clamp(u[a], 0.0, 1.0);
-            }
-            let s = x * f32(nodes[a] - 1u);
+            let s = nuld_clamp01(u[a]) * f32(nodes[a] - 1u);
             let j0 = min(u32(s), nodes[a] - 2u);
             cell.j0[a] = j0;
             cell.t[a] = s - f32(j0);
@@ -521,31 +532,31 @@ fn nuld_square_point(cond: vec2<f32>, instance: u32, i: u32) -> vec2<f32> {
 
 // `nuld_square_point` at the normalized condition `u` of the sampler `cs`.
 fn nuld_square_point_of(cs: NuldConditional, u: vec2<f32>, instance: u32, i: u32) -> vec2<f32> {
-    let info = cs.info;
-    let cell = nuld_locate(u, info.grid);
-    let table = cs.table;
-    let k = instance % info.instances;
-    let j = i % info.n;
-    // `ConditionalInfo::point_table_index`: layout [node][instance][index].
-    let q00 = nuld_u32(table + 4u * ((nuld_node(cell, 0u, 0u) * info.instances + k) * info.n + j));
-    let q10 = nuld_u32(table + 4u * ((nuld_node(cell, 1u, 0u) * info.instances + k) * info.n + j));
-    let q01 = nuld_u32(table + 4u * ((nuld_node(cell, 0u, 1u) * info.instances + k) * info.n + j));
-    let q11 = nuld_u32(table + 4u * ((nuld_node(cell, 1u, 1u) * info.instances + k) * info.n + j));
-    let x = nuld_lerp(
-        cell,
-        nuld_unorm16_decode(q00 & 0xffffu),
-        nuld_unorm16_decode(q10 & 0xffffu),
-        nuld_unorm16_decode(q01 & 0xffffu),
-        nuld_unorm16_decode(q11 & 0xffffu),
+    let cell = nuld_locate(u, cs.info.grid);
+    let k = instance % cs.info.instances;
+    let j = i % cs.info.n;
+    let p00 = nuld_corner_point(cs, cell, 0u, 0u, k, j);
+    let p10 = nuld_corner_point(cs, cell, 1u, 0u, k, j);
+    let p01 = nuld_corner_point(cs, cell, 0u, 1u, k, j);
+    let p11 = nuld_corner_point(cs, cell, 1u, 1u, k, j);
+    return vec2<f32>(
+        nuld_lerp(cell, p00.x, p10.x, p01.x, p11.x),
+        nuld_lerp(cell, p00.y, p10.y, p01.y, p11.y),
     );
-    let y = nuld_lerp(
-        cell,
-        nuld_unorm16_decode(q00 >> 16u),
-        nuld_unorm16_decode(q10 >> 16u),
-        nuld_unorm16_decode(q01 >> 16u),
-        nuld_unorm16_decode(q11 >> 16u),
-    );
-    return vec2<f32>(x, y);
+}
+
+// Rust: `ConditionalInfo::point_table_index`: the entry of `(node, instance, i)` in
+// the point table, laid out `[node][instance][index]`.
+fn nuld_point_table_index(info: NuldConditionalInfo, node: u32, instance: u32, i: u32) -> u32 {
+    return (node * info.instances + instance) * info.n + i;
+}
+
+// Rust: the `code` closure of `ConditionalSampler::square_point_at`, decoded: the
+// point stored at corner `(dx, dy)` of `cell` for instance `k`, index `j`.
+fn nuld_corner_point(cs: NuldConditional, cell: NuldGridCell, dx: u32, dy: u32, k: u32, j: u32) -> vec2<f32> {
+    let at = nuld_point_table_index(cs.info, nuld_node(cell, dx, dy), k, j);
+    let q = nuld_unpack_point(nuld_u32(cs.table + 4u * at));
+    return vec2<f32>(nuld_unorm16_decode(q.x), nuld_unorm16_decode(q.y));
 }
 
 // ---- Network mode (core/src/network.rs) ----------------------------------------
@@ -630,14 +641,8 @@ fn nuld_input_features(info: NuldConditionalInfo, c: vec2<f32>, k: u32, i: u32) 
     let lz = l + z;
     let p = lz - floor(lz);
     // `condition_features`: `(u, v, u v, u^2, v^2)` of the clamped condition.
-    var cu = vec2<f32>(0.0, 0.0);
-    for (var a = 0u; a < 2u; a++) {
-        if !nuld_is_nan(c[a]) {
-            cu[a] = min(max(c[a], 0.0), 1.0);
-        }
-    }
-    let u = cu.x;
-    let v = cu.y;
+    let u = nuld_clamp01(c.x);
+    let v = nuld_clamp01(c.y);
     return array<f32, 11>(
         2.0 * u - 1.0,
         2.0 * v - 1.0,
@@ -810,9 +815,7 @@ fn nuld_mapped(cs: NuldConditional, p: vec2<f32>, u: vec2<f32>) -> NuldSample {
     let cell = nuld_locate(u, cs.info.weight_grid);
     var direction: vec3<f32>;
     if cs.info.warp == NULD_WARP_BRDF_MIXTURE {
-        let lo = cs.info.cond_min;
-        let hi = cs.info.cond_max;
-        let c = vec2<f32>(lo.x + u.x * (hi.x - lo.x), lo.y + u.y * (hi.y - lo.y));
+        let c = nuld_denormalize(cs.info, u);
         direction = nuld_brdf_mixture(c, nuld_weight_table_lerp(cs, cell, 1u), p);
     } else {
         direction = nuld_to_direction(cs.info.domain, p);

@@ -16,7 +16,7 @@
 // invocation past the total returns.
 //
 // What a sample is depends on the blob's kind and `mode`:
-//   kind 3, mode 0: `nuld_sample` (table mode);
+//   kind 3, mode 0 (and any unknown code): `nuld_sample` (table mode);
 //   kind 3, mode 1: `nuld_sample_network` (network mode);
 //   kind 3, mode 2: `nuld_sample_brdf` at the view `view.xyz`, roughness = the
 //                   condition's x (its y unused);
@@ -42,8 +42,14 @@ struct NuldKernelParams {
     view: vec4<f32>,
 }
 
-// Invocations per workgroup (`KernelParams::WORKGROUP_SIZE` in Rust).
+// Invocations per workgroup (`KERNEL_WORKGROUP_SIZE` in Rust).
 const NULD_WORKGROUP_SIZE: u32 = 64u;
+
+// `KernelMode` codes (`NuldKernelParams::mode`).
+const NULD_MODE_TABLE: u32 = 0u;
+const NULD_MODE_NETWORK: u32 = 1u;
+const NULD_MODE_BRDF_TABLE: u32 = 2u;
+const NULD_MODE_BRDF_NETWORK: u32 = 3u;
 
 // Rust: `KernelParams::sample_count`.
 fn nuld_kernel_sample_count(p: NuldKernelParams) -> u32 {
@@ -74,13 +80,14 @@ fn nuld_fill(
     var out: NuldSample;
     let kind = nuld_kind();
     if kind == NULD_KIND_CONDITIONAL {
-        if p.mode == 1u {
+        if p.mode == NULD_MODE_NETWORK {
             out = nuld_sample_network(cond, instance, index);
-        } else if p.mode == 2u {
+        } else if p.mode == NULD_MODE_BRDF_TABLE {
             out = nuld_sample_brdf(p.view.xyz, cond.x, instance, index);
-        } else if p.mode == 3u {
+        } else if p.mode == NULD_MODE_BRDF_NETWORK {
             out = nuld_sample_brdf_network(p.view.xyz, cond.x, instance, index);
         } else {
+            // NULD_MODE_TABLE, and any other code.
             out = nuld_sample(cond, instance, index);
         }
     } else if kind == NULD_KIND_DIRECTION_SET {

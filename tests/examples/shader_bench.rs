@@ -31,39 +31,34 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "{:<44} {:>10} {:>12} {:>12}",
         "mode", "samples", "seconds", "samples/s"
     );
-    let cases: [(&str, &[u32], Activation, KernelMode, u32); 4] = [
-        (
-            "table: nuld_sample",
-            &[32, 32],
-            Activation::Relu,
-            KernelMode::Table,
-            1 << 8,
-        ),
+    // The table modes read no network: they run on the [32, 32] blob.
+    let blob = |hidden: &[u32], act| {
+        conditional_parts(64, hidden, act, 16, [10, 9], PointWarp::BrdfMixture, 2).to_blob(&META)
+    };
+    let relu = blob(&[32, 32], Activation::Relu)?;
+    let silu = blob(&[64, 64], Activation::Silu)?;
+    let cases = [
+        ("table: nuld_sample", &relu, KernelMode::Table, 1 << 8),
         (
             "table: nuld_sample_brdf",
-            &[32, 32],
-            Activation::Relu,
+            &relu,
             KernelMode::BrdfTable,
             1 << 8,
         ),
         (
             "network [32,32] relu: nuld_sample_network",
-            &[32, 32],
-            Activation::Relu,
+            &relu,
             KernelMode::Network,
             1 << 4,
         ),
         (
             "network [64,64] silu: nuld_sample_network",
-            &[64, 64],
-            Activation::Silu,
+            &silu,
             KernelMode::Network,
             1 << 2,
         ),
     ];
-    for (label, hidden, act, mode, instances) in cases {
-        let bytes = conditional_parts(64, hidden, act, 16, [10, 9], PointWarp::BrdfMixture, 2)
-            .to_blob(&META)?;
+    for (label, bytes, mode, instances) in cases {
         // 16 x 16 conditions over the blob's range, `instances` instances, 64 indices.
         let mut p = KernelParams::new(mode, [0.1, 0.0], [0.06, 5.9], [16, 16], 0..instances, 0..64);
         p.view = [0.3, 0.4, 0.866, 0.0];

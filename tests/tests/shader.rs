@@ -215,6 +215,66 @@ impl Worst {
         self.scaled = self.scaled.max(gap / gain);
         self.raw = self.raw.max(gap);
     }
+
+    fn merge(&mut self, other: Worst) {
+        self.scaled = self.scaled.max(other.scaled);
+        self.raw = self.raw.max(other.raw);
+    }
+}
+
+/// The runtime's sample `(c, k, i)` of `p` in its mode (the BRDF modes at the view
+/// `p.view`, roughness `c.x`) and the warp's gain there ([`warp_gain`]). The BRDF
+/// modes' rotation to the view's azimuth keeps lengths: their gain is the set's at
+/// (roughness, theta_o).
+fn runtime_sample(cs: &ConditionalSampler, p: &KernelParams, e: u32) -> (Sample, f32) {
+    let (c, k, i) = sample_of(p, e);
+    let wo = Vec3::new(p.view[0], p.view[1], p.view[2]);
+    let brdf_cond = || Vec2::new(c.x, view_theta_deg(wo) as f32);
+    let mode = [
+        KernelMode::Table,
+        KernelMode::Network,
+        KernelMode::BrdfTable,
+        KernelMode::BrdfNetwork,
+    ]
+    .into_iter()
+    .find(|&m| m as u32 == p.mode)
+    .expect("a kernel mode");
+    let (want, cond, point) = match mode {
+        KernelMode::Table => (cs.sample(c, k, i), c, cs.square_point(c, k, i)),
+        KernelMode::Network => (
+            cs.sample_network(c, k, i),
+            c,
+            cs.network_square_point(c, k, i),
+        ),
+        KernelMode::BrdfTable => {
+            let cond = brdf_cond();
+            (
+                cs.sample_brdf(wo, c.x, k, i),
+                cond,
+                cs.square_point(cond, k, i),
+            )
+        }
+        KernelMode::BrdfNetwork => {
+            let cond = brdf_cond();
+            (
+                cs.sample_brdf_network(wo, c.x, k, i),
+                cond,
+                cs.network_square_point(cond, k, i),
+            )
+        }
+    };
+    (want, warp_gain(cs, cond, point))
+}
+
+/// The kernel's samples of `p` over `bytes` against the runtime's
+/// ([`runtime_sample`]).
+fn compare(kernel: &Kernel, bytes: &[u8], cs: &ConditionalSampler, p: &KernelParams) -> Worst {
+    let mut worst = Worst::default();
+    for (e, got) in kernel.run(bytes, p).iter().enumerate() {
+        let (want, gain) = runtime_sample(cs, p, e as u32);
+        worst.add(gap(got, want), gain);
+    }
+    worst
 }
 
 /// Compares the kernel with the runtime in table and network mode on a grid of
@@ -236,22 +296,8 @@ fn check_conditional(kernel: &Kernel, bytes: &[u8], label: &str) {
             0..cs.len() + 3,
         )
     };
-    let table = grid(KernelMode::Table);
-    let out = kernel.run(bytes, &table);
-    let mut worst_table = Worst::default();
-    for (e, got) in out.iter().enumerate() {
-        let (c, k, i) = sample_of(&table, e as u32);
-        let gain = warp_gain(&cs, c, cs.square_point(c, k, i));
-        worst_table.add(gap(got, cs.sample(c, k, i)), gain);
-    }
-    let network = grid(KernelMode::Network);
-    let out = kernel.run(bytes, &network);
-    let mut worst_network = Worst::default();
-    for (e, got) in out.iter().enumerate() {
-        let (c, k, i) = sample_of(&network, e as u32);
-        let gain = warp_gain(&cs, c, cs.network_square_point(c, k, i));
-        worst_network.add(gap(got, cs.sample_network(c, k, i)), gain);
-    }
+    let worst_table = compare(kernel, bytes, &cs, &grid(KernelMode::Table));
+    let worst_network = compare(kernel, bytes, &cs, &grid(KernelMode::Network));
     // Views: generic, along z, grazing, below the horizon, zero, huge, tiny, NaN.
     let views = [
         Vec3::new(0.3, 0.4, 0.866),
@@ -281,23 +327,7 @@ fn check_conditional(kernel: &Kernel, bytes: &[u8], label: &str) {
                 0..cs.len(),
             );
             p.view = [wo.x, wo.y, wo.z, 0.0];
-            let out = kernel.run(bytes, &p);
-            for (e, got) in out.iter().enumerate() {
-                let (c, k, i) = sample_of(&p, e as u32);
-                // The rotation to the view's azimuth keeps lengths: the gain is
-                // the set's at (roughness, theta_o).
-                let cond = Vec2::new(c.x, view_theta_deg(wo) as f32);
-                let (want, point) = match mode {
-                    KernelMode::BrdfTable => {
-                        (cs.sample_brdf(wo, c.x, k, i), cs.square_point(cond, k, i))
-                    }
-                    _ => (
-                        cs.sample_brdf_network(wo, c.x, k, i),
-                        cs.network_square_point(cond, k, i),
-                    ),
-                };
-                worst.add(gap(got, want), warp_gain(&cs, cond, point));
-            }
+            worst.merge(compare(kernel, bytes, &cs, &p));
         }
     }
     println!(

@@ -17,7 +17,7 @@ use nuld_core::network::{
     Activation, DOT_LANES, INPUTS, LATTICE_LOGIT_EPS, MAX_HIDDEN_LAYERS, MAX_WIDTH, OUTPUTS,
 };
 use nuld_core::quantize::{f16_decode_finite, UNORM16_CELLS};
-use nuld_runtime::shader::{KernelParams, KERNEL_WORKGROUP_SIZE, SAMPLE_STRIDE};
+use nuld_runtime::shader::{KernelMode, KernelParams, KERNEL_WORKGROUP_SIZE, SAMPLE_STRIDE};
 use std::mem::{offset_of, size_of};
 
 /// A value the shader assumes and the Rust definition it must equal (`f32`
@@ -32,22 +32,91 @@ pub struct Assumption {
     pub rust: u64,
 }
 
+/// `offset_of!` as the `u64` an [`Assumption`] holds.
+macro_rules! at {
+    ($t:ty, $field:ident) => {
+        offset_of!($t, $field) as u64
+    };
+}
+
+/// Each [`ConditionalInfo`] field: the WGSL constant `nuld_info` reads it at, the
+/// `NuldConditionalInfo` member it lands in, and its Rust offset (the two WGSL
+/// names of one offset, listed once).
+fn info_fields() -> [(&'static str, &'static str, u64); 12] {
+    [
+        (
+            "NULD_INFO_N",
+            "NuldConditionalInfo.n",
+            at!(ConditionalInfo, n),
+        ),
+        (
+            "NULD_INFO_INSTANCES",
+            "NuldConditionalInfo.instances",
+            at!(ConditionalInfo, instances),
+        ),
+        (
+            "NULD_INFO_DOMAIN",
+            "NuldConditionalInfo.domain",
+            at!(ConditionalInfo, domain),
+        ),
+        (
+            "NULD_INFO_TARGET",
+            "NuldConditionalInfo.target_code",
+            at!(ConditionalInfo, target),
+        ),
+        (
+            "NULD_INFO_GRID",
+            "NuldConditionalInfo.grid",
+            at!(ConditionalInfo, grid),
+        ),
+        (
+            "NULD_INFO_WEIGHT_GRID",
+            "NuldConditionalInfo.weight_grid",
+            at!(ConditionalInfo, weight_grid),
+        ),
+        (
+            "NULD_INFO_COND_MIN",
+            "NuldConditionalInfo.cond_min",
+            at!(ConditionalInfo, cond_min),
+        ),
+        (
+            "NULD_INFO_COND_MAX",
+            "NuldConditionalInfo.cond_max",
+            at!(ConditionalInfo, cond_max),
+        ),
+        (
+            "NULD_INFO_HIDDEN",
+            "NuldConditionalInfo.hidden",
+            at!(ConditionalInfo, hidden),
+        ),
+        (
+            "NULD_INFO_ACTIVATION",
+            "NuldConditionalInfo.activation",
+            at!(ConditionalInfo, activation),
+        ),
+        (
+            "NULD_INFO_LATTICE_GENERATOR",
+            "NuldConditionalInfo.lattice_generator",
+            at!(ConditionalInfo, lattice_generator),
+        ),
+        (
+            "NULD_INFO_WARP",
+            "NuldConditionalInfo.warp",
+            at!(ConditionalInfo, warp),
+        ),
+    ]
+}
+
 /// The value of each `NULD_*` constant the shader must share with Rust.
 fn rust_constants() -> Vec<(&'static str, u64)> {
     let f = |x: f32| x.to_bits() as u64;
-    vec![
-        ("NULD_HEADER_KIND", offset_of!(Header, kind) as u64),
-        (
-            "NULD_HEADER_SECTION_COUNT",
-            offset_of!(Header, section_count) as u64,
-        ),
+    let mut constants = vec![
+        ("NULD_HEADER_KIND", at!(Header, kind)),
+        ("NULD_HEADER_SECTION_COUNT", at!(Header, section_count)),
         ("NULD_HEADER_LEN", HEADER_LEN as u64),
         ("NULD_SECTION_ENTRY_LEN", SECTION_ENTRY_LEN as u64),
-        ("NULD_SECTION_TAG", offset_of!(SectionEntry, tag) as u64),
-        (
-            "NULD_SECTION_OFFSET",
-            offset_of!(SectionEntry, offset) as u64,
-        ),
+        ("NULD_SECTION_TAG", at!(SectionEntry, tag)),
+        ("NULD_SECTION_OFFSET", at!(SectionEntry, offset)),
         ("NULD_MAX_SECTIONS", MAX_SECTIONS as u64),
         ("NULD_KIND_POINT_SET_2D", BlobKind::PointSet2D as u64),
         ("NULD_KIND_DIRECTION_SET", BlobKind::DirectionSet as u64),
@@ -64,54 +133,9 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_DOMAIN_SQUARE", Domain::Square as u64),
         ("NULD_DOMAIN_SPHERE", Domain::Sphere as u64),
         ("NULD_DOMAIN_HEMISPHERE", Domain::Hemisphere as u64),
-        ("NULD_POINT_SET_LEN", offset_of!(PointSetInfo, len) as u64),
-        (
-            "NULD_POINT_SET_COUNT",
-            offset_of!(PointSetInfo, set_count) as u64,
-        ),
-        (
-            "NULD_POINT_SET_DOMAIN",
-            offset_of!(PointSetInfo, domain) as u64,
-        ),
-        ("NULD_INFO_N", offset_of!(ConditionalInfo, n) as u64),
-        (
-            "NULD_INFO_INSTANCES",
-            offset_of!(ConditionalInfo, instances) as u64,
-        ),
-        (
-            "NULD_INFO_DOMAIN",
-            offset_of!(ConditionalInfo, domain) as u64,
-        ),
-        (
-            "NULD_INFO_TARGET",
-            offset_of!(ConditionalInfo, target) as u64,
-        ),
-        ("NULD_INFO_GRID", offset_of!(ConditionalInfo, grid) as u64),
-        (
-            "NULD_INFO_WEIGHT_GRID",
-            offset_of!(ConditionalInfo, weight_grid) as u64,
-        ),
-        (
-            "NULD_INFO_COND_MIN",
-            offset_of!(ConditionalInfo, cond_min) as u64,
-        ),
-        (
-            "NULD_INFO_COND_MAX",
-            offset_of!(ConditionalInfo, cond_max) as u64,
-        ),
-        (
-            "NULD_INFO_HIDDEN",
-            offset_of!(ConditionalInfo, hidden) as u64,
-        ),
-        (
-            "NULD_INFO_ACTIVATION",
-            offset_of!(ConditionalInfo, activation) as u64,
-        ),
-        (
-            "NULD_INFO_LATTICE_GENERATOR",
-            offset_of!(ConditionalInfo, lattice_generator) as u64,
-        ),
-        ("NULD_INFO_WARP", offset_of!(ConditionalInfo, warp) as u64),
+        ("NULD_POINT_SET_LEN", at!(PointSetInfo, len)),
+        ("NULD_POINT_SET_COUNT", at!(PointSetInfo, set_count)),
+        ("NULD_POINT_SET_DOMAIN", at!(PointSetInfo, domain)),
         ("NULD_WARP_EQUAL_AREA", PointWarp::EqualArea as u64),
         ("NULD_WARP_BRDF_MIXTURE", PointWarp::BrdfMixture as u64),
         ("NULD_INPUTS", INPUTS as u64),
@@ -146,7 +170,13 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_ACOS_Q_S1", libm_literal("-7.0662963390e-01")),
         ("NULD_F16_SUBNORMAL", f(f16_decode_finite(1))),
         ("NULD_WORKGROUP_SIZE", KERNEL_WORKGROUP_SIZE as u64),
-    ]
+        ("NULD_MODE_TABLE", KernelMode::Table as u64),
+        ("NULD_MODE_NETWORK", KernelMode::Network as u64),
+        ("NULD_MODE_BRDF_TABLE", KernelMode::BrdfTable as u64),
+        ("NULD_MODE_BRDF_NETWORK", KernelMode::BrdfNetwork as u64),
+    ];
+    constants.extend(info_fields().map(|(constant, _, offset)| (constant, offset)));
+    constants
 }
 
 /// The bits of an `f32` literal of libm's source (a NaN's bits if it does not parse, which
@@ -157,102 +187,38 @@ fn libm_literal(text: &str) -> u64 {
 
 /// Struct member offsets and sizes the shader's structs must share with Rust.
 fn rust_structs() -> Vec<(&'static str, u64)> {
-    vec![
-        ("NuldConditionalInfo", size_of::<ConditionalInfo>() as u64),
-        (
-            "NuldConditionalInfo.n",
-            offset_of!(ConditionalInfo, n) as u64,
-        ),
-        (
-            "NuldConditionalInfo.instances",
-            offset_of!(ConditionalInfo, instances) as u64,
-        ),
-        (
-            "NuldConditionalInfo.domain",
-            offset_of!(ConditionalInfo, domain) as u64,
-        ),
-        (
-            "NuldConditionalInfo.target_code",
-            offset_of!(ConditionalInfo, target) as u64,
-        ),
-        (
-            "NuldConditionalInfo.grid",
-            offset_of!(ConditionalInfo, grid) as u64,
-        ),
-        (
-            "NuldConditionalInfo.weight_grid",
-            offset_of!(ConditionalInfo, weight_grid) as u64,
-        ),
-        (
-            "NuldConditionalInfo.cond_min",
-            offset_of!(ConditionalInfo, cond_min) as u64,
-        ),
-        (
-            "NuldConditionalInfo.cond_max",
-            offset_of!(ConditionalInfo, cond_max) as u64,
-        ),
-        (
-            "NuldConditionalInfo.hidden",
-            offset_of!(ConditionalInfo, hidden) as u64,
-        ),
-        (
-            "NuldConditionalInfo.activation",
-            offset_of!(ConditionalInfo, activation) as u64,
-        ),
-        (
-            "NuldConditionalInfo.lattice_generator",
-            offset_of!(ConditionalInfo, lattice_generator) as u64,
-        ),
-        (
-            "NuldConditionalInfo.warp",
-            offset_of!(ConditionalInfo, warp) as u64,
-        ),
+    let mut structs = vec![("NuldConditionalInfo", size_of::<ConditionalInfo>() as u64)];
+    structs.extend(info_fields().map(|(_, member, offset)| (member, offset)));
+    structs.extend([
         ("NuldKernelParams", size_of::<KernelParams>() as u64),
-        (
-            "NuldKernelParams.cond_first",
-            offset_of!(KernelParams, cond_first) as u64,
-        ),
-        (
-            "NuldKernelParams.cond_step",
-            offset_of!(KernelParams, cond_step) as u64,
-        ),
-        (
-            "NuldKernelParams.cond_count",
-            offset_of!(KernelParams, cond_count) as u64,
-        ),
+        ("NuldKernelParams.cond_first", at!(KernelParams, cond_first)),
+        ("NuldKernelParams.cond_step", at!(KernelParams, cond_step)),
+        ("NuldKernelParams.cond_count", at!(KernelParams, cond_count)),
         (
             "NuldKernelParams.instance_first",
-            offset_of!(KernelParams, instance_first) as u64,
+            at!(KernelParams, instance_first),
         ),
         (
             "NuldKernelParams.instance_count",
-            offset_of!(KernelParams, instance_count) as u64,
+            at!(KernelParams, instance_count),
         ),
         (
             "NuldKernelParams.index_first",
-            offset_of!(KernelParams, index_first) as u64,
+            at!(KernelParams, index_first),
         ),
         (
             "NuldKernelParams.index_count",
-            offset_of!(KernelParams, index_count) as u64,
+            at!(KernelParams, index_count),
         ),
-        (
-            "NuldKernelParams.mode",
-            offset_of!(KernelParams, mode) as u64,
-        ),
-        (
-            "NuldKernelParams.reserved",
-            offset_of!(KernelParams, reserved) as u64,
-        ),
-        (
-            "NuldKernelParams.view",
-            offset_of!(KernelParams, view) as u64,
-        ),
+        ("NuldKernelParams.mode", at!(KernelParams, mode)),
+        ("NuldKernelParams.reserved", at!(KernelParams, reserved)),
+        ("NuldKernelParams.view", at!(KernelParams, view)),
         // Direction xyz then weight: one `[f32; 4]` per sample on the host.
         ("NuldSample", SAMPLE_STRIDE),
         ("NuldSample.direction", 0),
         ("NuldSample.weight", 3 * size_of::<f32>() as u64),
-    ]
+    ]);
+    structs
 }
 
 /// The value of a module constant that is a plain `u32`, `i32` or `f32` literal
