@@ -41,7 +41,7 @@ pub use poisson_disk::{poisson_disk_elimination, poisson_disk_max_radius};
 pub use random::random;
 pub(crate) use sobol_cp::toroidal_shift;
 pub use sobol_cp::{sobol_cranley_patterson, sobol_points, SOBOL_CP_MAX_POINTS};
-pub use sot::{sliced_optimal_transport, sliced_wasserstein, SOT_DEFAULT_ITERATIONS};
+pub use sot::{sliced_optimal_transport, sliced_wasserstein, SOT_BATCH, SOT_DEFAULT_ITERATIONS};
 pub use spherical_fibonacci::spherical_fibonacci;
 pub use warp::{cosine_hemisphere, hierarchical_warp, warp_inverse_cdf, HierarchicalWarp};
 pub use warped::{seeded_owen_sobol, warped_owen_sobol, warped_owen_sobol_directions};

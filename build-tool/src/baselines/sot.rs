@@ -17,12 +17,12 @@ use super::{clamp_unit, random, sobol_cranley_patterson, streams};
 use crate::density::Density2D;
 use crate::seeding::{derive_seed, rng};
 
-/// Default iteration count of [`sliced_optimal_transport`] (with [`BATCH`]
+/// Default iteration count of [`sliced_optimal_transport`] (with [`SOT_BATCH`]
 /// directions each); N = 4096 takes about 1.5 s uniform, about 8 s non-uniform
 /// (2 cores, opt-level 2).
 pub const SOT_DEFAULT_ITERATIONS: usize = 256;
-/// Directions per iteration.
-const BATCH: usize = 32;
+/// Random projection directions per iteration of [`sliced_optimal_transport`].
+pub const SOT_BATCH: usize = 32;
 /// Target samples per point for non-uniform targets.
 const TARGET_FACTOR: usize = 16;
 
@@ -139,7 +139,7 @@ fn optimize(points: &mut [DVec2], target: &Target, iterations: usize, seed: u64)
     let n = points.len();
     let mut r = rng(seed, streams::SOT);
     for _ in 0..iterations {
-        let dirs: Vec<DVec2> = (0..BATCH)
+        let dirs: Vec<DVec2> = (0..SOT_BATCH)
             .map(|_| DVec2::from_angle(r.random::<f64>() * std::f64::consts::PI))
             .collect();
         // One displacement vector per direction, summed in a fixed order so that the
@@ -155,13 +155,13 @@ fn optimize(points: &mut [DVec2], target: &Target, iterations: usize, seed: u64)
             }
         }
         for (p, s) in points.iter_mut().zip(step) {
-            *p = clamp_unit(*p + s / BATCH as f64);
+            *p = clamp_unit(*p + s / SOT_BATCH as f64);
         }
     }
 }
 
 /// `n` sliced-optimal-transport points in `[0,1)^2` for `target` (`None`: uniform),
-/// after `iterations` iterations of [`BATCH`] = 32 random directions each.
+/// after `iterations` iterations of [`SOT_BATCH`] = 32 random directions each.
 ///
 /// * Uniform: start from iid uniform points; the quantiles of a projection are
 ///   exact (the inverse CDF of `|cos| U1 + |sin| U2`, a trapezoidal law).

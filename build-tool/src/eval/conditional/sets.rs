@@ -64,8 +64,8 @@ impl<F: Fn(f64, f64, u32, u32) -> DVec3 + Sync> ConditionalSets for SampleFnSets
 /// Independent Owen-scrambled Sobol sets, one scramble per instance
 /// (`seeded_owen_sobol(n, derive_seed(seed, instance))`), warped by the renderer's
 /// mixture warp ([`brdf_mixture_direction`]: VNDF with probability
-/// `p_s = A_spec / A`, else cosine; what [`crate::sphere::BrdfTarget::sample`]
-/// does): what a renderer does today, as a [`ConditionalSets`].
+/// `p_s = A_spec / A`, else cosine; what the `brdf:` target's
+/// [`DirectionDensity::sample`](crate::sphere::DirectionDensity::sample) does): what a renderer does today, as a [`ConditionalSets`].
 ///
 /// It is the calibration sampler of the report: its instances are independent
 /// randomizations, so the diversity figures come out near their independent values
