@@ -122,7 +122,7 @@ fn ns_per_sample(count: u32, mut f: impl FnMut(u32)) -> f64 {
 /// mode): the incumbent (direction only, and with its estimator weight
 /// `f cos / p` as a renderer needs it), table mode (`sample` and `sample_brdf`),
 /// and network mode at n 64 with hidden [32, 32] ReLU and [64, 64] SiLU. Every
-/// method cycles through the same [`CONDITIONS`] conditions, instance `s / n` and
+/// method cycles through the same fixed set of conditions, instance `s / n` and
 /// index `s mod n` for sample `s`; the incumbent's per-condition setup (its
 /// [`BrdfTarget`], albedos included) is done before timing, which favours it.
 pub fn measure(samples: u32) -> Result<RuntimeTimings> {

@@ -12,7 +12,7 @@
 //! itself read as zero bytes, so any single changed byte anywhere is detected.
 //!
 //! [`Layout::read`] validates a byte slice against this layout without allocating;
-//! [`write`] fills a caller-provided buffer of [`encoded_len`] bytes. Both halves of
+//! [`write()`] fills a caller-provided buffer of [`encoded_len`] bytes. Both halves of
 //! the project go through these two functions, so the layout is defined once.
 
 use bytemuck::{Pod, Zeroable};
@@ -152,7 +152,7 @@ pub struct Metadata<'a> {
 /// Everything that can be wrong with a blob: one variant per failed check, carrying
 /// the numbers that failed it. [`Layout::read`] produces the variants up to
 /// [`BlobError::SectionsOverlap`]; the kind, metadata, point-set and conditional
-/// variants come from the runtime's `Blob::parse`, the last two from [`write`].
+/// variants come from the runtime's `Blob::parse`, the last two from [`write()`].
 ///
 /// `Display` writes one line; the type implements [`core::error::Error`], so `?`
 /// converts it into `Box<dyn std::error::Error>` or `anyhow::Error`.
@@ -185,7 +185,7 @@ pub enum BlobError {
         /// Value computed from the bytes.
         computed: u64,
     },
-    /// More sections than [`MAX_SECTIONS`] (in a header, or given to [`write`]).
+    /// More sections than [`MAX_SECTIONS`] (in a header, or given to [`write()`]).
     TooManySections {
         /// Sections declared or given.
         count: u64,
@@ -406,9 +406,9 @@ pub enum BlobError {
         /// The kind the blob holds.
         found: BlobKind,
     },
-    /// The sizes given to [`write`] overflow the blob's `u64` length.
+    /// The sizes given to [`write()`] overflow the blob's `u64` length.
     SizeOverflow,
-    /// The output buffer passed to [`write`] has the wrong size.
+    /// The output buffer passed to [`write()`] has the wrong size.
     BufferSize {
         /// Bytes needed.
         needed: u64,
@@ -636,8 +636,8 @@ pub struct SectionSpec<'s> {
     pub bytes: &'s [u8],
 }
 
-/// Offsets of everything [`write`] places, computed once for both [`encoded_len`] and
-/// [`write`].
+/// Offsets of everything [`write()`] places, computed once for both [`encoded_len`] and
+/// [`write()`].
 fn plan(meta_len: usize, sections: &[SectionSpec<'_>]) -> Option<(u64, u64)> {
     let table_end = HEADER_LEN as u64 + (sections.len() * SECTION_ENTRY_LEN) as u64;
     let meta_end = table_end.checked_add(meta_len as u64)?;
@@ -648,7 +648,7 @@ fn plan(meta_len: usize, sections: &[SectionSpec<'_>]) -> Option<(u64, u64)> {
     Some((table_end, align_up(end)?))
 }
 
-/// Number of bytes [`write`] needs for this metadata and these sections.
+/// Number of bytes [`write()`] needs for this metadata and these sections.
 pub fn encoded_len(meta: &[u8], sections: &[SectionSpec<'_>]) -> usize {
     plan(meta.len(), sections).map_or(usize::MAX, |(_, total)| total as usize)
 }

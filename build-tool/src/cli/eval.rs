@@ -37,7 +37,7 @@ pub struct EvalArgs {
     /// Which figure.
     #[arg(value_enum)]
     pub fig: FigArg,
-    /// Output directory: figN.csv, figN.json, figN-<target>-<metric>.png, cache/
+    /// Output directory: figN.csv, figN.json, figN-TARGET-METRIC.png, cache/
     /// (conditional: conditional.json, conditional.csv, conditional-*.png).
     #[arg(long)]
     pub out: PathBuf,

@@ -13,7 +13,7 @@ use super::sum::sum;
 ///            + (1/N^2) sum_i sum_k prod_j (1 - max(x_ij, x_kj))`,
 ///
 /// i.e. `∫_{[0,1]^2} (#{x_i <= a}/N - a_x a_y)^2 da`. Exact in `O(N log N)` (the
-/// point–point term by [`l2_star_pair_term`](super::l2_star_pair_term)); deterministic.
+/// point–point term by [`super::l2_star_pair_term`]); deterministic.
 /// Clamped at 0 against rounding. Panics if `points` is empty.
 pub fn l2_star_uniform_squared(points: &[DVec2]) -> f64 {
     let n = non_empty(points);
@@ -38,7 +38,7 @@ pub fn l2_star_uniform(points: &[DVec2]) -> f64 {
 ///
 /// i.e. `E_{u,c}[(#{x_i in B(u,c)}/N - |B(u,c)|)^2]` over `u ~ U[0,1]^2` and the four
 /// corners `c`. Exact in `O(N log N)` (the point–point term by
-/// [`asd_pair_term`](super::asd_pair_term)); deterministic. Clamped at 0 against
+/// [`super::asd_pair_term`]); deterministic. Clamped at 0 against
 /// rounding. Panics if `points` is empty.
 pub fn asd_uniform_squared(points: &[DVec2]) -> f64 {
     let n = non_empty(points);

@@ -1,5 +1,5 @@
 //! The trainable side of the conditional sampler's network (paper §4): flat `f64`
-//! parameters of a [`Shape`], their initialization, the backward pass of
+//! parameters of a [`nuld_core::network::Shape`], their initialization, the backward pass of
 //! [`nuld_core::network::Network::forward`], and rounding to the f16 that ships.
 //!
 //! The forward pass is [`nuld_core::network`]'s, written once for the trainer and

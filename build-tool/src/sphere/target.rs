@@ -40,7 +40,7 @@ pub trait DirectionDensity: Send + Sync {
     /// The standard warp of `u` in `[0,1)^2` to a direction that baselines use.
     /// For `uniform`, `cosine` and `envmap` it is distributed exactly by
     /// [`DirectionDensity::pdf`] when `u` is uniform; for `brdf` it is the usual
-    /// importance-sampling mixture, *not* exact (see [`BrdfTarget::sample`]).
+    /// importance-sampling mixture, *not* exact (see the `brdf:` target, [`super::BrdfTarget`]).
     fn sample(&self, u: DVec2) -> DVec3;
 
     /// Density per unit solid angle of [`DirectionDensity::sample`]'s directions

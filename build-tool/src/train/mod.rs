@@ -16,7 +16,7 @@
 //! condition to be different sets that together follow the target, as
 //! independently scrambled sets do; without it a network learns to ignore the
 //! instance. Gradients flow back through the hemisphere map, the sigmoid and the
-//! network ([`crate::network::backward`]); Adam with cosine decay; the sigmoid
+//! network ([`crate::network::backward()`]); Adam with cosine decay; the sigmoid
 //! sharpness ramps linearly in units of each loss's point spacing.
 //!
 //! Deterministic: every random draw of step `t` comes from `(seed, t)`, conditions

@@ -19,7 +19,7 @@
 //! local discrepancy found ([`cap_star_estimate_screened`], a lower bound of the cap
 //! star discrepancy). The target's cap measures are computed once per condition
 //! and shared by every set. Scores are means over `instances` instances; ratios are
-//! the sampler's mean over a reference's mean. [`diversity`] measures whether the
+//! the sampler's mean over a reference's mean. [`diversity()`] measures whether the
 //! instances are different sets.
 //!
 //! Deterministic for a seed whatever the thread count: every random stream is
@@ -79,7 +79,7 @@ pub struct ConditionalSettings {
     pub conditions: Vec<[f64; 2]>,
     /// Instances scored per (condition, method); scores are their means.
     pub instances: usize,
-    /// Instances whose union and pairs measure [`diversity`] (at least 2).
+    /// Instances whose union and pairs measure [`diversity()`] (at least 2).
     pub union_instances: usize,
     /// Random caps of the cap L2 estimate (theta-uniform).
     pub cap_l2_caps: usize,
