@@ -117,80 +117,84 @@ pub fn markdown(rows: &[Row]) -> String {
         if samplers.is_empty() {
             continue;
         }
-        let head = |what: &str| {
-            let mut s = format!("\n## {technique}: {what}\n\n| sampler |");
-            for n in &spp {
-                let _ = write!(s, " {n} |");
-            }
-            s.push_str("\n|---|");
-            s.push_str(&"---:|".repeat(spp.len()));
-            s.push('\n');
-            s
-        };
+        let at = |s: &str, n: u32| find(rows, technique, s, n);
         let best = |n: u32| {
             samplers
                 .iter()
-                .filter_map(|s| find(rows, technique, s, n).map(|r| r.rmse))
+                .filter_map(|s| at(s, n).map(|r| r.rmse))
                 .fold(f64::INFINITY, f64::min)
         };
-        out += &head("RMSE at equal sample count (spp)");
-        for s in &samplers {
-            let _ = write!(out, "| {s} |");
-            for &n in &spp {
-                match find(rows, technique, s, n) {
-                    Some(r) if r.rmse == best(n) => {
-                        let _ = write!(out, " **{:.4e}** |", r.rmse);
-                    }
-                    Some(r) => {
-                        let _ = write!(out, " {:.4e} |", r.rmse);
-                    }
-                    None => out.push_str(" – |"),
-                }
-            }
-            out.push('\n');
-        }
-        out += &head("bias (mean signed error) at equal sample count");
-        for s in &samplers {
-            let _ = write!(out, "| {s} |");
-            for &n in &spp {
-                match find(rows, technique, s, n) {
-                    Some(r) => {
-                        let _ = write!(out, " {:+.2e} |", r.bias);
-                    }
-                    None => out.push_str(" – |"),
-                }
-            }
-            out.push('\n');
-        }
+        let spp_columns: Vec<String> = spp.iter().map(|n| n.to_string()).collect();
+        table(
+            &mut out,
+            &format!("{technique}: RMSE at equal sample count (spp)"),
+            &spp_columns,
+            &samplers,
+            |s, c| {
+                let n = spp[c];
+                at(s, n).map(|r| match r.rmse == best(n) {
+                    true => format!("**{:.4e}**", r.rmse),
+                    false => format!("{:.4e}", r.rmse),
+                })
+            },
+        );
+        table(
+            &mut out,
+            &format!("{technique}: bias (mean signed error) at equal sample count"),
+            &spp_columns,
+            &samplers,
+            |s, c| at(s, spp[c]).map(|r| format!("{:+.2e}", r.bias)),
+        );
         let budgets: Vec<f64> = spp
             .iter()
-            .filter_map(|&n| find(rows, technique, "owen-sobol", n).map(|r| r.seconds))
+            .filter_map(|&n| at("owen-sobol", n).map(|r| r.seconds))
             .collect();
         if budgets.len() == spp.len() {
-            out += &format!(
-                "\n## {technique}: RMSE at equal time (the render times of owen-sobol)\n\n| sampler |"
+            let columns: Vec<String> = spp
+                .iter()
+                .zip(&budgets)
+                .map(|(n, t)| format!("{t:.3} s (= {n} spp)"))
+                .collect();
+            table(
+                &mut out,
+                &format!("{technique}: RMSE at equal time (the render times of owen-sobol)"),
+                &columns,
+                &samplers,
+                |s, c| rmse_at_time(rows, technique, s, budgets[c]).map(|e| format!("{e:.4e}")),
             );
-            for (n, t) in spp.iter().zip(&budgets) {
-                let _ = write!(out, " {t:.3} s (= {n} spp) |");
-            }
-            out.push_str("\n|---|");
-            out.push_str(&"---:|".repeat(spp.len()));
-            out.push('\n');
-            for s in &samplers {
-                let _ = write!(out, "| {s} |");
-                for &t in &budgets {
-                    match rmse_at_time(rows, technique, s, t) {
-                        Some(e) => {
-                            let _ = write!(out, " {e:.4e} |");
-                        }
-                        None => out.push_str(" – |"),
-                    }
-                }
-                out.push('\n');
-            }
         }
     }
     out
+}
+
+/// Appends a markdown section `## title` with a table: a `sampler` column, then
+/// `columns` (right-aligned); cell `(sampler, column)` from `cell`, `–` for `None`.
+fn table(
+    out: &mut String,
+    title: &str,
+    columns: &[String],
+    samplers: &[&str],
+    cell: impl Fn(&str, usize) -> Option<String>,
+) {
+    let _ = write!(out, "\n## {title}\n\n| sampler |");
+    for c in columns {
+        let _ = write!(out, " {c} |");
+    }
+    out.push_str("\n|---|");
+    out.push_str(&"---:|".repeat(columns.len()));
+    out.push('\n');
+    for s in samplers {
+        let _ = write!(out, "| {s} |");
+        for c in 0..columns.len() {
+            match cell(s, c) {
+                Some(v) => {
+                    let _ = write!(out, " {v} |");
+                }
+                None => out.push_str(" – |"),
+            }
+        }
+        out.push('\n');
+    }
 }
 
 #[cfg(test)]
