@@ -17,7 +17,7 @@ pub struct BakeArgs {
     /// Points per set.
     #[arg(long, default_value_t = TrainConfig::default().n as usize, allow_negative_numbers = true, value_parser = super::count)]
     pub n: usize,
-    /// Instances stored in the point table.
+    /// Instances stored in the point table (pixels sharing an instance share its error; the blob grows linearly).
     #[arg(long, default_value_t = BakeConfig::default().instances as usize, allow_negative_numbers = true, value_parser = super::count)]
     pub instances: usize,
     /// Point-table grid nodes: roughness,theta_o (each >= 2).

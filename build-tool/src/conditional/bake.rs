@@ -26,7 +26,10 @@ use std::time::{Duration, Instant};
 pub struct BakeConfig {
     /// The training run.
     pub train: TrainConfig,
-    /// Instances stored in the point table `S`.
+    /// Instances stored in the point table `S` (default 64). A renderer gives each
+    /// pixel an instance modulo `S`, so pixels sharing an instance share its error:
+    /// with 16, table-mode renders showed a mean signed error of up to 40% of the
+    /// mean pixel (4 spp) that 64 instances remove. Blob size grows linearly in `S`.
     pub instances: u32,
     /// Point-table grid nodes `(roughness, theta_o)`.
     pub grid: [u32; 2],
@@ -44,7 +47,7 @@ impl Default for BakeConfig {
     fn default() -> Self {
         Self {
             train: TrainConfig::default(),
-            instances: 16,
+            instances: 64,
             grid: [10, 12],
             weight_grid: [32, 32],
             quality_grid: 4,
