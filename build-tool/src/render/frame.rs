@@ -1,11 +1,12 @@
 //! The local shading frame of a surface point: `z` = the normal, as every BRDF
 //! function of [`nuld_core::brdf`] and every sampler expects.
 
+use crate::sphere::geometry::tangent_frame;
 use glam::DVec3;
 
-/// An orthonormal basis `(t, b, n)` around a unit normal `n` (Duff et al. 2017,
-/// "Building an Orthonormal Basis, Revisited": branchless, continuous except at
-/// `n.z = -1`'s sign switch).
+/// An orthonormal basis `(t, b, n)` around a unit normal `n`: `(t, b)` from
+/// [`tangent_frame`] (Duff et al. 2017, "Building an Orthonormal Basis, Revisited":
+/// branchless, continuous except at `n.z = -1`'s sign switch).
 #[derive(Clone, Copy, Debug)]
 pub struct Frame {
     t: DVec3,
@@ -16,14 +17,8 @@ pub struct Frame {
 impl Frame {
     /// The frame around the unit normal `n`.
     pub fn new(n: DVec3) -> Self {
-        let sign = 1f64.copysign(n.z);
-        let a = -1.0 / (sign + n.z);
-        let b = n.x * n.y * a;
-        Self {
-            t: DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
-            b: DVec3::new(b, sign + n.y * n.y * a, -n.y),
-            n,
-        }
+        let (t, b) = tangent_frame(n);
+        Self { t, b, n }
     }
 
     /// The normal.
