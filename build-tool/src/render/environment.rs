@@ -26,7 +26,6 @@ use crate::sphere::{DirectionDensity, EnvmapDensity};
 use anyhow::{Context, Result};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
-use std::f64::consts::TAU;
 use std::path::Path;
 
 /// An environment map: radiance lookup, density and the two warps.
@@ -34,8 +33,6 @@ use std::path::Path;
 pub struct Environment {
     density: EnvmapDensity,
     hierarchical: HierarchicalWarp,
-    /// `Φ = ∫ L dw` over the sphere.
-    power: f64,
 }
 
 impl Environment {
@@ -72,34 +69,21 @@ impl Environment {
             height: h,
             mass,
         });
-        // Φ = Σ L_p Ω_p with the pixel solid angles of the density, negatives as 0.
-        let dphi = TAU / w as f64;
-        let power = (0..h)
-            .map(|r| {
-                let (lo, hi) = density.row_z_range(r);
-                let row: f64 = img.values[r * w..(r + 1) * w]
-                    .iter()
-                    .map(|v| v.max(0.0))
-                    .sum();
-                row * dphi * (hi - lo)
-            })
-            .sum();
         Ok(Self {
             density,
             hierarchical,
-            power,
         })
     }
 
     /// `Φ = ∫ L(w) dw` over the sphere (luminance times steradians).
     pub fn power(&self) -> f64 {
-        self.power
+        self.density.integral()
     }
 
     /// Radiance (luminance) arriving from direction `w` (any length > 0): the
     /// pixel's value, `Φ pdf(w)`.
     pub fn radiance(&self, w: DVec3) -> f64 {
-        self.power * self.density.pdf(w)
+        self.power() * self.density.pdf(w)
     }
 
     /// Density per steradian of both warps at `w`: `L(w) / Φ`.
@@ -132,7 +116,9 @@ impl Environment {
 mod tests {
     use super::*;
     use crate::seeding::rng;
+    use crate::sphere::geometry::random_direction;
     use rand::Rng;
+    use std::f64::consts::TAU;
 
     /// A 16 x 8 map with one bright pixel and a gradient, in closed form.
     fn test_map() -> LuminanceImage {
@@ -172,14 +158,7 @@ mod tests {
         // Φ by Monte Carlo over uniform directions: 4π E[L].
         let mut g = rng(1, 2);
         let m = 400_000;
-        let sum: f64 = (0..m)
-            .map(|_| {
-                let z: f64 = g.random_range(-1.0..1.0);
-                let phi: f64 = g.random_range(0.0..TAU);
-                let s = (1.0 - z * z).sqrt();
-                env.radiance(DVec3::new(s * phi.cos(), s * phi.sin(), z))
-            })
-            .sum();
+        let sum: f64 = (0..m).map(|_| env.radiance(random_direction(&mut g))).sum();
         let mc = 4.0 * std::f64::consts::PI * sum / m as f64;
         assert!(
             (mc / env.power() - 1.0).abs() < 0.02,
@@ -195,17 +174,9 @@ mod tests {
         let g = |w: DVec3| env.radiance(w) * (w.x + 2.0);
         let mut r = rng(3, 4);
         let m = 200_000;
-        let uniform: f64 = (0..m)
-            .map(|_| {
-                let z: f64 = r.random_range(-1.0..1.0);
-                let phi: f64 = r.random_range(0.0..TAU);
-                let s = (1.0 - z * z).sqrt();
-                g(DVec3::new(s * phi.cos(), s * phi.sin(), z))
-            })
-            .sum::<f64>()
-            * 4.0
-            * std::f64::consts::PI
-            / m as f64;
+        let uniform: f64 =
+            (0..m).map(|_| g(random_direction(&mut r))).sum::<f64>() * 4.0 * std::f64::consts::PI
+                / m as f64;
         for warp in [
             Environment::sample_inverse_cdf,
             Environment::sample_hierarchical,

@@ -136,6 +136,8 @@ pub struct EnvmapDensity {
     z_hi: Vec<f64>,
     /// Row-major pixel masses, summing to 1.
     mass: Vec<f64>,
+    /// `∫ L dw` over the domain: the masses' sum before normalization.
+    integral: f64,
     /// Per row, `W + 1` cumulative masses (`col_cum[r * (W+1) + c]`).
     col_cum: Vec<f64>,
     /// `H + 1` cumulative row masses.
@@ -235,6 +237,7 @@ impl EnvmapDensity {
             z_lo,
             z_hi,
             mass,
+            integral: total,
             col_cum,
             row_cdf,
             bright_cols,
@@ -243,6 +246,13 @@ impl EnvmapDensity {
         };
         d.profile_rule = d.quadrature(PROFILE_POINTS);
         Ok(d)
+    }
+
+    /// `∫ L(w) dw` over the domain (luminance times steradians, negative pixels as
+    /// 0): `Σ L_p Ω_p` over the pixels, `Ω_p = (2 pi / W) (z_hi - z_lo)`, the factor
+    /// that normalizes the map into this density.
+    pub fn integral(&self) -> f64 {
+        self.integral
     }
 
     /// The negative pixels that were set to 0 when the map was loaded.
