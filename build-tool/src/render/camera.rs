@@ -57,6 +57,12 @@ impl Camera {
         self.height
     }
 
+    /// Row-major index of pixel `(x, y)`, `y width + x`: its place in an image and
+    /// the stream of its random numbers.
+    pub fn pixel_index(&self, x: u32, y: u32) -> u64 {
+        y as u64 * self.width as u64 + x as u64
+    }
+
     /// The ray through the centre of pixel `(x, y)` (`y = 0` the top row).
     pub fn ray(&self, x: u32, y: u32) -> Ray {
         let aspect = self.width as f64 / self.height as f64;

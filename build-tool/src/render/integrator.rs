@@ -99,26 +99,41 @@ impl Setup<'_> {
         seed: u64,
         on_row: &(dyn Fn() + Sync),
     ) -> Image {
+        let values = self.per_pixel(
+            || Vec::with_capacity(n as usize),
+            |buf: &mut Vec<Sample>, x, y| {
+                let key = PixelKey::new(seed, self.camera.pixel_index(x, y));
+                self.pixel(sampler, n, x, y, key, buf)
+            },
+            on_row,
+        );
+        Image {
+            width: self.camera.width(),
+            height: self.camera.height(),
+            values,
+        }
+    }
+
+    /// `pixel(state, x, y)` for every pixel of the camera, row-major: rows in
+    /// parallel, each with its own `state()` (scratch reused along the row), and
+    /// `on_row` after each row. The result does not depend on the thread count.
+    pub fn per_pixel<S, T: Send>(
+        &self,
+        state: impl Fn() -> S + Sync,
+        pixel: impl Fn(&mut S, u32, u32) -> T + Sync,
+        on_row: &(dyn Fn() + Sync),
+    ) -> Vec<T> {
         let (w, h) = (self.camera.width(), self.camera.height());
-        let rows: Vec<Vec<f64>> = (0..h)
+        let rows: Vec<Vec<T>> = (0..h)
             .into_par_iter()
             .map(|y| {
-                let mut buf: Vec<Sample> = Vec::with_capacity(n as usize);
-                let row = (0..w)
-                    .map(|x| {
-                        let key = PixelKey::new(seed, y as u64 * w as u64 + x as u64);
-                        self.pixel(sampler, n, x, y, key, &mut buf)
-                    })
-                    .collect();
+                let mut s = state();
+                let row = (0..w).map(|x| pixel(&mut s, x, y)).collect();
                 on_row();
                 row
             })
             .collect();
-        Image {
-            width: w,
-            height: h,
-            values: rows.concat(),
-        }
+        rows.into_iter().flatten().collect()
     }
 
     /// One pixel's estimate.
@@ -243,7 +258,7 @@ mod tests {
             camera: &camera,
             env: &env,
         };
-        let lobes = LobeTable::new(&[0.1, 0.25, 0.4, 0.7, 1.0, 0.8]);
+        let lobes = LobeTable::new(&scene.roughnesses());
         let blob = tiny_blob(4);
         let ours = NuldSampler::new(blob.as_slice(), NuldMode::Network).unwrap();
         let sobol = MixtureSampler::new(PrimaryPoints::new(Generator::Gbn, 4, 1), &lobes);

@@ -23,7 +23,6 @@ use glam::DVec3;
 use nuld_core::brdf::alpha;
 use nuld_core::warp::{brdf_mixture_pdf, brdf_mixture_real};
 use rand::Rng;
-use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// A reference image and the standard error of each pixel.
@@ -51,20 +50,11 @@ impl Reference {
         seed: u64,
         on_row: &(dyn Fn() + Sync),
     ) -> Reference {
-        let (w, h) = (setup.camera.width(), setup.camera.height());
-        let rows: Vec<Vec<(f64, f64)>> = (0..h)
-            .into_par_iter()
-            .map(|y| {
-                let row = (0..w).map(|x| pixel(setup, lobes, m, seed, x, y)).collect();
-                on_row();
-                row
-            })
-            .collect();
-        let all: Vec<(f64, f64)> = rows.concat();
+        let all = setup.per_pixel(|| (), |_, x, y| pixel(setup, lobes, m, seed, x, y), on_row);
         Reference {
             image: Image {
-                width: w,
-                height: h,
+                width: setup.camera.width(),
+                height: setup.camera.height(),
                 values: all.iter().map(|p| p.0).collect(),
             },
             stderr: all.iter().map(|p| p.1).collect(),
@@ -138,8 +128,7 @@ fn pixel(setup: &Setup<'_>, lobes: &LobeTable, m: u32, seed: u64, x: u32, y: u32
         Primary::Background(l) => return (l, 0.0),
         Primary::Surface { position, at } => (position, at),
     };
-    let index = y as u64 * setup.camera.width() as u64 + x as u64;
-    let mut g = rng(seed, REFERENCE_STREAM + index);
+    let mut g = rng(seed, REFERENCE_STREAM + setup.camera.pixel_index(x, y));
     let a = alpha(at.roughness);
     let p_s = lobes.lobe_probability(at.roughness, at.theta_o_deg());
     let normal = at.frame.normal();
@@ -243,7 +232,7 @@ mod tests {
             camera: &camera,
             env: &env,
         };
-        let lobes = LobeTable::new(&[0.1, 0.25, 0.4, 0.7, 1.0, 0.8]);
+        let lobes = LobeTable::new(&scene.roughnesses());
         let a = Reference::render(&setup, &lobes, 256, 1, &|| {});
         let b = Reference::render(&setup, &lobes, 256, 2, &|| {});
         let (mean, mean_sq, k) = z_stats(&a.image.values, &a.stderr, &b.image.values, &b.stderr);

@@ -139,9 +139,7 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
         camera: &camera,
         env: &env,
     };
-    let mut roughnesses: Vec<f64> = scene.spheres.iter().map(|s| s.roughness).collect();
-    roughnesses.extend(scene.ground_roughness);
-    let lobes = LobeTable::new(&roughnesses);
+    let lobes = LobeTable::new(&scene.roughnesses());
 
     // The reference, cached by everything it depends on.
     let key = content_hash(
@@ -171,10 +169,11 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
             (r, t.elapsed().as_secs_f64())
         }
     };
-    let mask: Vec<bool> = (0..h)
-        .flat_map(|y| (0..w).map(move |x| (x, y)))
-        .map(|(x, y)| matches!(setup.primary(x, y), Primary::Surface { .. }))
-        .collect();
+    let mask = setup.per_pixel(
+        || (),
+        |_, x, y| matches!(setup.primary(x, y), Primary::Surface { .. }),
+        &|| {},
+    );
     let surface = mask.iter().filter(|m| **m).count().max(1);
     let reference_stderr = reference
         .stderr

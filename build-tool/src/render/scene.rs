@@ -79,6 +79,13 @@ impl Scene {
         }
     }
 
+    /// Every roughness in the scene: the spheres', then the ground's (what a
+    /// renderer tabulates its per-material lobe probabilities for).
+    pub fn roughnesses(&self) -> Vec<f64> {
+        let spheres = self.spheres.iter().map(|s| s.roughness);
+        spheres.chain(self.ground_roughness).collect()
+    }
+
     /// The closest hit of `ray` with `t > 0`, if any. `O(spheres)`.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let mut best: Option<(f64, DVec3, f64)> = None;
@@ -173,6 +180,7 @@ mod tests {
         };
         let hit = scene.intersect(&gap).unwrap();
         assert!((hit.t - 10.0).abs() < 1e-12 && hit.roughness == 0.8);
+        assert_eq!(scene.roughnesses(), [0.1, 0.25, 0.4, 0.7, 1.0, 0.8]);
         let floating = Scene {
             ground_roughness: None,
             ..scene.clone()
