@@ -24,3 +24,13 @@ pub fn rng(seed: u64, stream: u64) -> Pcg64Mcg {
         derive_seed(seed, stream) as u128 | 1 | ((derive_seed(seed, !stream) as u128) << 64),
     )
 }
+
+/// A 64-bit hash of `bytes` (for cache keys; not cryptographic): FNV-1a folded
+/// through [`mix64`].
+pub fn content_hash(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h = (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    mix64(h)
+}

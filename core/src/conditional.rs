@@ -32,6 +32,15 @@ pub enum ConditionalTarget {
     /// degrees)`, view in the xz-plane on the `+x` side, directions on the upper
     /// hemisphere, weight = directional albedo.
     GltfBrdf = 1,
+    /// An environment map lit through a cosine, `q(l | n) ∝ L(l) max(0, n.l)` (`L`
+    /// the map's luminance): condition = the unit normal `n` as its point of the
+    /// equal-area octahedral square ([`crate::sphere::sphere_to_square`]) in
+    /// `[0,1]^2`, directions on the whole sphere in the map's (world) frame, weight
+    /// = the irradiance `E(n) = ∫ L(l) max(0, n.l) dl`. Table mode interpolates the
+    /// four corners' *directions* ([`GridCell::nlerp`]): a set's point may sit on
+    /// opposite sides of an octahedral fold at neighbouring nodes, where square
+    /// coordinates would jump.
+    EnvmapNormal = 2,
 }
 
 impl ConditionalTarget {
@@ -39,7 +48,17 @@ impl ConditionalTarget {
     pub fn from_code(code: u32) -> Option<Self> {
         match code {
             1 => Some(Self::GltfBrdf),
+            2 => Some(Self::EnvmapNormal),
             _ => None,
+        }
+    }
+
+    /// Where the target's directions live: the upper hemisphere of the local frame
+    /// for the BRDF, the whole sphere for an environment map.
+    pub fn domain(self) -> Domain {
+        match self {
+            Self::GltfBrdf => Domain::Hemisphere,
+            Self::EnvmapNormal => Domain::Sphere,
         }
     }
 }
@@ -235,6 +254,22 @@ impl GridCell {
         let a = v00 + (v10 - v00) * t0;
         let b = v01 + (v11 - v01) * t0;
         a + (b - a) * t1
+    }
+
+    /// Normalized bilinear interpolation of the corner unit vectors `d00, d10,
+    /// d01, d11` (order as [`Self::lerp`]): [`Self::lerp`] per component, then
+    /// divided by its length. If the blend has no usable length (opposite corners
+    /// cancelling, which the blend of one set's neighbouring points does not do),
+    /// `d00`. Unit to `f32` rounding; never panics.
+    #[inline]
+    pub fn nlerp(&self, d00: [f32; 3], d10: [f32; 3], d01: [f32; 3], d11: [f32; 3]) -> [f32; 3] {
+        let m: [f32; 3] = core::array::from_fn(|c| self.lerp(d00[c], d10[c], d01[c], d11[c]));
+        let len = libm::sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+        if len > 1e-6 && len.is_finite() {
+            m.map(|x| x / len)
+        } else {
+            d00
+        }
     }
 }
 
@@ -476,6 +511,40 @@ mod tests {
         assert!((v - f(0.25, 0.6)).abs() < 1e-6);
         assert_eq!(cell.node(0, 0), 2 * 3);
         assert_eq!(cell.node(1, 1), 3 * 3 + 1);
+    }
+
+    /// `nlerp` returns the corners at the corners, unit vectors in between, the
+    /// bilinear blend's direction, and `d00` when the blend vanishes.
+    #[test]
+    fn nlerp_blends_directions_and_stays_unit() {
+        let d = [
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.6, 0.0, 0.8],
+        ];
+        let at = |u: [f32; 2]| GridCell::locate(u, [2, 2]).nlerp(d[0], d[1], d[2], d[3]);
+        assert_eq!(at([0.0, 0.0]), d[0]);
+        assert_eq!(at([1.0, 1.0]), d[3]);
+        let m = at([0.5, 0.0]);
+        let h = core::f32::consts::FRAC_1_SQRT_2;
+        assert!((m[0] - h).abs() < 1e-6 && (m[1] - h).abs() < 1e-6 && m[2] == 0.0);
+        let c = at([0.3, 0.7]);
+        assert!((c.iter().map(|x| x * x).sum::<f32>() - 1.0).abs() < 1e-6);
+        let flat = GridCell::locate([0.5, 0.0], [2, 2]);
+        let x = [1.0, 0.0, 0.0];
+        assert_eq!(flat.nlerp(x, [-1.0, 0.0, 0.0], x, x), x);
+    }
+
+    #[test]
+    fn targets_have_their_domains() {
+        assert_eq!(
+            ConditionalTarget::from_code(2),
+            Some(ConditionalTarget::EnvmapNormal)
+        );
+        assert_eq!(ConditionalTarget::EnvmapNormal.domain(), Domain::Sphere);
+        assert_eq!(ConditionalTarget::GltfBrdf.domain(), Domain::Hemisphere);
+        assert_eq!(ConditionalTarget::from_code(3), None);
     }
 
     #[test]

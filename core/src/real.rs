@@ -46,6 +46,8 @@ pub trait Real:
     fn cos(self) -> Self;
     /// `sin` of an angle in radians.
     fn sin(self) -> Self;
+    /// `atan`, in radians in `[-pi/2, pi/2]`.
+    fn atan(self) -> Self;
     /// Rounded towards negative infinity.
     fn floor(self) -> Self;
     /// `e^self`.
@@ -98,6 +100,10 @@ impl Real for f64 {
     #[inline]
     fn sin(self) -> Self {
         libm::sin(self)
+    }
+    #[inline]
+    fn atan(self) -> Self {
+        libm::atan(self)
     }
     #[inline]
     fn floor(self) -> Self {
@@ -160,6 +166,10 @@ impl Real for f32 {
     #[inline]
     fn sin(self) -> Self {
         libm::sinf(self)
+    }
+    #[inline]
+    fn atan(self) -> Self {
+        libm::atanf(self)
     }
     #[inline]
     fn floor(self) -> Self {

@@ -91,6 +91,8 @@ const NULD_ACTIVATION_SILU: u32 = 1u;
 // `PointWarp` codes (core/src/conditional.rs).
 const NULD_WARP_EQUAL_AREA: u32 = 0u;
 const NULD_WARP_BRDF_MIXTURE: u32 = 1u;
+// `ConditionalTarget::EnvmapNormal`: table mode interpolates directions.
+const NULD_TARGET_ENVMAP_NORMAL: u32 = 2u;
 
 // `f32` constants written as the runtime's `f32` values (a decimal literal would be
 // rounded from the exact value, which is not always the same `f32`).
@@ -796,7 +798,33 @@ struct NuldSample {
 fn nuld_sample(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
     let cs = nuld_conditional();
     let u = nuld_normalize(cs.info, cond);
+    if cs.info.target_code == NULD_TARGET_ENVMAP_NORMAL {
+        let weight = nuld_weight_table_lerp(cs, nuld_locate(u, cs.info.weight_grid), 0u);
+        return NuldSample(nuld_table_direction_of(cs, u, instance, i), weight);
+    }
     return nuld_mapped(cs, nuld_square_point_of(cs, u, instance, i), u);
+}
+
+// Rust: `ConditionalSampler::table_direction_at` (environment samplers): the four
+// corners' points through the equal-area map, blended by `GridCell::nlerp`.
+fn nuld_table_direction_of(cs: NuldConditional, u: vec2<f32>, instance: u32, i: u32) -> vec3<f32> {
+    let cell = nuld_locate(u, cs.info.grid);
+    let k = instance % cs.info.instances;
+    let j = i % cs.info.n;
+    let d00 = nuld_to_direction(cs.info.domain, nuld_corner_point(cs, cell, 0u, 0u, k, j));
+    let d10 = nuld_to_direction(cs.info.domain, nuld_corner_point(cs, cell, 1u, 0u, k, j));
+    let d01 = nuld_to_direction(cs.info.domain, nuld_corner_point(cs, cell, 0u, 1u, k, j));
+    let d11 = nuld_to_direction(cs.info.domain, nuld_corner_point(cs, cell, 1u, 1u, k, j));
+    let m = vec3<f32>(
+        nuld_lerp(cell, d00.x, d10.x, d01.x, d11.x),
+        nuld_lerp(cell, d00.y, d10.y, d01.y, d11.y),
+        nuld_lerp(cell, d00.z, d10.z, d01.z, d11.z),
+    );
+    let len = sqrt(m.x * m.x + m.y * m.y + m.z * m.z);
+    if len > 1e-6 && nuld_is_finite(len) {
+        return m / len;
+    }
+    return d00;
 }
 
 // Rust: `ConditionalSampler::sample_network` (network mode): as `nuld_sample`, every

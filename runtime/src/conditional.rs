@@ -41,6 +41,7 @@ pub struct ConditionalSampler<'a> {
     info: ConditionalInfo,
     shape: Shape,
     domain: Domain,
+    target: ConditionalTarget,
     warp: PointWarp,
     params: &'a [u16],
     table: &'a [u32],
@@ -92,6 +93,9 @@ impl<'a> ConditionalSampler<'a> {
         let Some(target) = ConditionalTarget::from_code(info.target) else {
             return Err(BlobError::UnknownConditionalTarget(info.target));
         };
+        if domain != target.domain() {
+            return Err(BlobError::ConditionalDomain(info.domain));
+        }
         let warp = match info.point_warp() {
             Some(PointWarp::BrdfMixture)
                 if !(target == ConditionalTarget::GltfBrdf && domain == Domain::Hemisphere) =>
@@ -170,6 +174,7 @@ impl<'a> ConditionalSampler<'a> {
             info,
             shape,
             domain,
+            target,
             warp,
             params,
             table,
@@ -232,6 +237,11 @@ impl<'a> ConditionalSampler<'a> {
     /// Where the directions live: [`Domain::Hemisphere`] or [`Domain::Sphere`].
     pub fn domain(&self) -> Domain {
         self.domain
+    }
+
+    /// What the condition means ([`ConditionalTarget`]).
+    pub fn target(&self) -> ConditionalTarget {
+        self.target
     }
 
     /// The estimator weight at condition `cond` (blob units): the weight table
@@ -349,10 +359,71 @@ impl<'a> ConditionalSampler<'a> {
     /// assert_eq!(cs.sample(Vec2::new(f32::NAN, -5.0), 0, 0), cs.sample(cs.info().cond_min.into(), 0, 0));
     /// # Ok::<(), nuld_runtime::BlobError>(())
     /// ```
+    ///
+    /// An environment sampler ([`ConditionalTarget::EnvmapNormal`]) interpolates
+    /// directions instead: each corner's stored point through the map, the four
+    /// unit vectors blended by [`GridCell::nlerp`] with the cell's bilinear weights
+    /// ([`Self::sample_envmap`] takes a normal).
     #[inline]
     pub fn sample(&self, cond: Vec2, instance: u32, i: u32) -> Sample {
         let u = self.info.normalize(cond.to_array());
+        if self.target == ConditionalTarget::EnvmapNormal {
+            return Sample {
+                direction: Vec3::from_array(self.table_direction_at(u, instance, i)),
+                weight: self.weight_table_lerp(&self.weight_cell_at(u), 0),
+            };
+        }
         self.mapped(self.square_point_at(u, instance, i), u)
+    }
+
+    /// Table mode's direction for an environment sampler: the four corners'
+    /// stored square points decoded by `(q + 0.5) / 65536`, each through the
+    /// domain's equal-area map in `f32`, then [`GridCell::nlerp`].
+    #[inline]
+    fn table_direction_at(&self, u: [f32; 2], instance: u32, i: u32) -> [f32; 3] {
+        let info = &self.info;
+        let cell = GridCell::locate(u, info.grid);
+        let k = instance.checked_rem(info.instances).unwrap_or(0);
+        let j = i.checked_rem(info.n).unwrap_or(0);
+        let corner = |dx, dy| {
+            let at = info.point_table_index(cell.node(dx, dy), k, j);
+            let q = self
+                .table
+                .get(at)
+                .map_or([CENTRE_CODE; 2], |&w| unpack_point(w));
+            self.domain
+                .to_direction_real([unorm16_decode(q[0]), unorm16_decode(q[1])])
+        };
+        cell.nlerp(corner(0, 0), corner(1, 0), corner(0, 1), corner(1, 1))
+    }
+
+    /// Table mode for an environment sampler ([`ConditionalTarget::EnvmapNormal`])
+    /// at the surface normal `normal` (world frame, the map's `+z` up; any length):
+    /// [`Self::sample`] at the condition `sphere_to_square(normal / |normal|)`
+    /// ([`nuld_core::sphere::sphere_to_square_real`] in `f32`). A zero, infinite or
+    /// NaN normal reads as `+z`. The direction is in the world frame; the weight
+    /// is the irradiance `E(n)` of the weight table, so that
+    /// `∫ L f max(0, n.l) ≈ (E / N) Σ f(l_i)`. O(1), never panics.
+    ///
+    /// ```
+    /// # let bytes = nuld_runtime::doc_example_conditional_blob();
+    /// use nuld_runtime::glam::{Vec2, Vec3};
+    /// let cs = nuld_runtime::Blob::parse(&bytes.0)?.conditional()?;
+    /// // A BRDF blob reads the normal's square point as its condition, clamped.
+    /// let s = cs.sample_envmap(Vec3::Z, 3, 1);
+    /// assert_eq!(s, cs.sample(Vec2::new(0.5, 0.5), 3, 1));
+    /// # Ok::<(), nuld_runtime::BlobError>(())
+    /// ```
+    #[inline]
+    pub fn sample_envmap(&self, normal: Vec3, instance: u32, i: u32) -> Sample {
+        self.sample(normal_condition(normal), instance, i)
+    }
+
+    /// Network mode for an environment sampler: as [`Self::sample_envmap`] with
+    /// [`Self::sample_network`]. `O(multiply_adds)`, never panics.
+    #[inline]
+    pub fn sample_envmap_network(&self, normal: Vec3, instance: u32, i: u32) -> Sample {
+        self.sample_network(normal_condition(normal), instance, i)
     }
 
     /// Network mode: as [`Self::sample`] with [`Self::network_square_point`]; every
@@ -471,6 +542,20 @@ fn view_condition(wo: Vec3, roughness: f32) -> (Vec2, Vec2) {
         Vec2::X
     };
     (Vec2::new(roughness, theta), azimuth)
+}
+
+/// The condition of a normal: its equal-area octahedral square point; a
+/// degenerate normal reads as `+z`.
+#[inline]
+fn normal_condition(n: Vec3) -> Vec2 {
+    let m = n.abs().max_element();
+    let d = if n.is_finite() && m > 0.0 {
+        let w = n / m;
+        w / w.length()
+    } else {
+        Vec3::Z
+    };
+    Vec2::from_array(nuld_core::sphere::sphere_to_square_real(d.to_array()))
 }
 
 /// The sample turned about `z` by the azimuth `(cos phi, sin phi)`.
@@ -605,6 +690,85 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// An environment sampler's parts: `parts()` on the sphere, conditions the
+    /// octahedral square.
+    fn envmap_parts() -> Parts {
+        let mut p = parts();
+        p.info.domain = Domain::Sphere as u32;
+        p.info.target = ConditionalTarget::EnvmapNormal as u32;
+        p.info.cond_min = [0.0; 2];
+        p.info.cond_max = [1.0; 2];
+        p
+    }
+
+    /// Table mode of an environment sampler: at a node the stored point's
+    /// direction (nlerp of one corner), between nodes the normalized bilinear
+    /// blend of the corners' directions (not of their square points), and
+    /// `sample_envmap` reads a normal as its octahedral square point.
+    #[test]
+    fn envmap_tables_interpolate_directions() {
+        let p = envmap_parts();
+        let bytes = encode(&p);
+        let cs = Blob::parse(bytes.get()).unwrap().conditional().unwrap();
+        assert_eq!(cs.target(), ConditionalTarget::EnvmapNormal);
+        let info = p.info;
+        let stored = |node: u32, k: u32, i: u32| {
+            let q = unpack_point(p.table[info.point_table_index(node as usize, k, i)]);
+            Domain::Sphere.to_direction_real([unorm16_decode(q[0]), unorm16_decode(q[1])])
+        };
+        for j1 in 0..info.grid[1] {
+            for j0 in 0..info.grid[0] {
+                let c = info.grid_condition([j0, j1]).map(|x| x as f32);
+                let node = j1 * info.grid[0] + j0;
+                let got = cs.sample(Vec2::from(c), 2, 4).direction.to_array();
+                let want = stored(node, 2, 4);
+                for a in 0..3 {
+                    assert!(
+                        (got[a] - want[a]).abs() < 1e-6,
+                        "{j0} {j1}: {got:?} {want:?}"
+                    );
+                }
+            }
+        }
+        // Between nodes (0,0), (1,0), (0,1), (1,1) of the 5 x 3 grid.
+        let u = [0.1f32, 0.3];
+        let (t0, t1) = (u[0] * 4.0, u[1] * 2.0);
+        let corners = [
+            stored(0, 1, 3),
+            stored(1, 1, 3),
+            stored(5, 1, 3),
+            stored(6, 1, 3),
+        ];
+        let want: [f32; 3] = core::array::from_fn(|a| {
+            let lo = corners[0][a] + (corners[1][a] - corners[0][a]) * t0;
+            let hi = corners[2][a] + (corners[3][a] - corners[2][a]) * t0;
+            lo + (hi - lo) * t1
+        });
+        let len = want.iter().map(|x| x * x).sum::<f32>().sqrt();
+        let got = cs.sample(Vec2::from(u), 1, 3);
+        let want = Vec3::from_array(want) / len;
+        assert!((got.direction - want).length() < 1e-6, "{got:?} {want}");
+        assert!((got.direction.length() - 1.0).abs() < 1e-6);
+        assert_eq!(got.weight, cs.weight(Vec2::from(u)));
+        // A normal is read through the octahedral map, at any length; degenerate
+        // normals read as +z.
+        let n = Vec3::new(0.2, -0.7, 0.4);
+        let c = nuld_core::sphere::sphere_to_square_real(n.normalize().to_array());
+        assert_eq!(
+            cs.sample_envmap(n * 3.0, 7, 2),
+            cs.sample(Vec2::from(c), 7, 2)
+        );
+        assert_eq!(
+            cs.sample_envmap_network(n, 9, 1),
+            cs.sample_network(Vec2::from(c), 9, 1)
+        );
+        for bad in [Vec3::ZERO, Vec3::NAN, Vec3::new(f32::INFINITY, 0.0, 1.0)] {
+            assert_eq!(cs.sample_envmap(bad, 0, 0), cs.sample_envmap(Vec3::Z, 0, 0));
+        }
+        let d = cs.sample_network(Vec2::new(0.7, 0.2), 5, 4).direction;
+        assert!((d.length() - 1.0).abs() < 1e-5);
     }
 
     #[test]
@@ -750,7 +914,7 @@ mod tests {
     fn each_validation_failure_has_its_error() {
         assert_eq!(with(|_| {}), Ok(()));
         type Change = fn(&mut Parts);
-        let cases: [(Change, BlobError); 24] = [
+        let cases: [(Change, BlobError); 26] = [
             (|p| p.info.n = 0, BlobError::ConditionalNoPoints),
             (|p| p.info.instances = 0, BlobError::ConditionalNoInstances),
             (|p| p.info.domain = 0, BlobError::ConditionalDomain(0)),
@@ -812,9 +976,19 @@ mod tests {
             (
                 |p| {
                     p.info.warp = 1;
+                    p.info.target = 2;
                     p.info.domain = 1;
                 },
                 BlobError::UnknownPointWarp(1),
+            ),
+            // Each target has its domain: the BRDF the hemisphere, maps the sphere.
+            (|p| p.info.domain = 1, BlobError::ConditionalDomain(1)),
+            (
+                |p| {
+                    p.info.warp = 0;
+                    p.info.target = 2;
+                },
+                BlobError::ConditionalDomain(2),
             ),
             (
                 |p| {

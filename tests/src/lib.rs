@@ -68,9 +68,15 @@ pub fn distilled_parts(
         caps_per_step: 64,
         ..TrainConfig::default()
     };
-    let mut trainer = Trainer::new(config, None);
+    let mut trainer = Trainer::new(config, None).expect("the BRDF pool reads no file");
     while !trainer.done() {
         trainer.step();
     }
-    nuld_build_tool::conditional::distill::distill(&trainer.params(), instances, grid, weight_grid)
+    nuld_build_tool::conditional::distill::distill(
+        &trainer.params(),
+        &trainer.pool.target,
+        instances,
+        grid,
+        weight_grid,
+    )
 }

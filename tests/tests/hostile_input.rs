@@ -59,6 +59,8 @@ fn parse_and_touch(bytes: &[u8]) -> Result<(), BlobError> {
                     check_sample(cs.sample_network(c, k, i));
                     check_sample(cs.sample_brdf(wo, c.x, k, i));
                     check_sample(cs.sample_brdf_network(wo, c.x, k, i));
+                    check_sample(cs.sample_envmap(wo, k, i));
+                    check_sample(cs.sample_envmap_network(wo, k, i));
                 }
             }
         }
@@ -89,6 +91,25 @@ fn conditional_blob() -> AlignedBytes {
     .unwrap()
 }
 
+/// [`conditional_blob`]'s shape as an environment sampler (sphere, condition
+/// the octahedral square, the equal-area output).
+fn envmap_blob() -> AlignedBytes {
+    let mut parts = conditional_parts(
+        4,
+        &[3, 2],
+        Activation::Relu,
+        2,
+        [3, 2],
+        PointWarp::EqualArea,
+        6,
+    );
+    parts.info.domain = Domain::Sphere as u32;
+    parts.info.target = nuld_core::conditional::ConditionalTarget::EnvmapNormal as u32;
+    parts.info.cond_min = [0.0; 2];
+    parts.info.cond_max = [1.0; 2];
+    parts.to_blob(&META).unwrap()
+}
+
 fn valid_blobs() -> Vec<AlignedBytes> {
     vec![
         sobol_blob(Domain::Square, 5, 2, 1).1,
@@ -96,6 +117,7 @@ fn valid_blobs() -> Vec<AlignedBytes> {
         sobol_blob(Domain::Hemisphere, 3, 3, 3).1,
         sobol_blob(Domain::Square, 200, 1, 4).1,
         conditional_blob(),
+        envmap_blob(),
     ]
 }
 

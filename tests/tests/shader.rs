@@ -385,9 +385,10 @@ fn shader_random_samplers_of_every_shape_match_the_runtime() {
             // 64-bit-free `(i g) mod n`.
             parts.info.lattice_generator = g;
             if s == 2 && warp == PointWarp::EqualArea {
-                // The sphere map (BRDF samplers use the hemisphere, as the mixture
-                // warp requires).
+                // The sphere map: an environment sampler (whose table mode blends
+                // the corners' directions); BRDF samplers use the hemisphere.
                 parts.info.domain = Domain::Sphere as u32;
+                parts.info.target = nuld_core::conditional::ConditionalTarget::EnvmapNormal as u32;
             }
             let bytes = parts.to_blob(&META).unwrap();
             check_conditional(kernel, bytes.as_slice(), &format!("random {s} {warp:?}"));

@@ -1,8 +1,8 @@
-//! `build-tool bake --brdf`: train the conditional BRDF sampler and write its blob,
-//! report and pictures (library: [`crate::conditional::bake`]).
+//! `build-tool bake --brdf` / `bake --envmap MAP`: train a conditional sampler and
+//! write its blob, report and pictures (library: [`crate::conditional::bake`]).
 
 use crate::conditional::bake::{bake, BakeConfig};
-use crate::train::TrainConfig;
+use crate::train::{TrainConfig, TrainTarget};
 use anyhow::{ensure, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -12,19 +12,23 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct BakeArgs {
     /// Bake the glTF 2.0 BRDF sampler (condition: roughness, view angle).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "envmap")]
     pub brdf: bool,
+    /// Bake the environment-map sampler of this map (HDR, EXR; equirectangular, +z
+    /// up): q(l | n) proportional to L(l) max(0, n.l), condition: the surface
+    /// normal, weight: the irradiance E(n). Writes DIR/envmap.nuld.
+    #[arg(long, value_name = "MAP")]
+    pub envmap: Option<PathBuf>,
     /// Points per set.
     #[arg(long, default_value_t = TrainConfig::default().n as usize, allow_negative_numbers = true, value_parser = super::count)]
     pub n: usize,
     /// Instances stored in the point table (pixels sharing an instance share its error; the blob grows linearly).
     #[arg(long, default_value_t = BakeConfig::default().instances as usize, allow_negative_numbers = true, value_parser = super::count)]
     pub instances: usize,
-    /// Point-table grid nodes: roughness,theta_o (each >= 2).
-    #[arg(long, value_delimiter = ',', default_values_t = BakeConfig::default().grid,
-        hide_default_value = true,
-        help = with_list_default("Point-table grid nodes: roughness,theta_o (each >= 2)", &BakeConfig::default().grid))]
-    pub grid: Vec<u32>,
+    /// Point-table grid nodes per axis (each >= 2): roughness,theta_o for --brdf
+    /// [default: 10,12]; the normal's octahedral square u,v for --envmap [default: 13,13].
+    #[arg(long, value_delimiter = ',')]
+    pub grid: Option<Vec<u32>>,
     /// Training steps after the pretraining on the warp (the default takes about 7
     /// min on 2 cores).
     #[arg(long, default_value_t = TrainConfig::default().steps, allow_negative_numbers = true, value_parser = super::count)]
@@ -66,7 +70,15 @@ fn with_list_default(help: &str, default: &[u32]) -> String {
 
 /// Runs `build-tool bake`.
 pub fn run(a: BakeArgs) -> Result<()> {
-    ensure!(a.brdf, "bake needs a target: --brdf");
+    ensure!(
+        a.brdf || a.envmap.is_some(),
+        "bake needs a target: --brdf or --envmap MAP"
+    );
+    let defaults = match &a.envmap {
+        Some(map) => BakeConfig::envmap(TrainTarget::envmap(map)?),
+        None => BakeConfig::default(),
+    };
+    let grid = a.grid.unwrap_or(defaults.grid.to_vec());
     ensure!(
         a.n >= 1 && a.n <= 1 << 16,
         "--n must be in 1..=65536, got {}",
@@ -78,7 +90,7 @@ pub fn run(a: BakeArgs) -> Result<()> {
         a.instances
     );
     ensure!(
-        a.grid.len() == 2 && a.grid.iter().all(|&g| (2..=256).contains(&g)),
+        grid.len() == 2 && grid.iter().all(|&g| (2..=256).contains(&g)),
         "--grid must be two node counts in 2..=256, like 10,12"
     );
     ensure!(a.steps >= 1, "--steps must be at least 1");
@@ -98,20 +110,20 @@ pub fn run(a: BakeArgs) -> Result<()> {
         union_weight: a.union_weight,
         learning_rate: a.lr,
         seed: a.seed,
-        ..TrainConfig::default()
+        ..defaults.train.clone()
     };
     let config = BakeConfig {
         train,
         instances: a.instances as u32,
-        grid: [a.grid[0], a.grid[1]],
+        grid: [grid[0], grid[1]],
         quality_grid: a.quality_grid,
         resume: a.resume,
-        ..BakeConfig::default()
+        ..defaults
     };
     let report = bake(&config, &a.out)?;
     let mut line = format!(
         "wrote {} ({} bytes, {} parameters) in {:.1} s",
-        a.out.join("brdf.nuld").display(),
+        a.out.join(config.blob_name()).display(),
         report.blob_bytes,
         report.parameters,
         report.timings.total_s

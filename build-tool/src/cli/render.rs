@@ -28,9 +28,11 @@ pub struct RenderArgs {
     /// several; counts without one are baked into DIR/brdf-nN/.
     #[arg(long)]
     pub brdf_blob: Vec<PathBuf>,
-    /// An environment-map sampler blob (not implemented yet: an error).
+    /// A baked environment sampler blob of the same map (`bake --envmap`); serves
+    /// the spp equal to its N. Repeat for several; counts without one are baked
+    /// into DIR/envmap-nN/.
     #[arg(long)]
-    pub envmap_blob: Option<PathBuf>,
+    pub envmap_blob: Vec<PathBuf>,
     /// Seed; fixes every image bit for bit whatever the thread count.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -57,9 +59,6 @@ fn size(s: &str) -> Result<(u32, u32), String> {
 
 /// Runs `build-tool render`.
 pub fn run(a: RenderArgs) -> Result<()> {
-    if a.envmap_blob.is_some() {
-        bail!("envmap samplers are not implemented yet (--envmap-blob)");
-    }
     let mut config = if a.quick {
         RenderConfig::quick(a.envmap)
     } else {
@@ -78,6 +77,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         config.reference_samples = m as u32;
     }
     config.brdf_blobs = a.brdf_blob;
+    config.envmap_blobs = a.envmap_blob;
     config.seed = a.seed;
     let report = render(&config, &a.out)?;
     println!("{}", report.summary);
@@ -106,19 +106,34 @@ mod tests {
     }
 
     #[test]
-    fn an_envmap_blob_is_refused_until_envmap_samplers_exist() {
+    fn a_brdf_blob_given_as_the_environment_sampler_is_refused_by_name() {
+        let dir = std::env::temp_dir().join(format!("nuld-render-cli-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let map = dir.join("sky.png");
+        image::RgbImage::from_pixel(16, 8, image::Rgb([200, 180, 160]))
+            .save(&map)
+            .unwrap();
+        let blob = dir.join("brdf.nuld");
+        std::fs::write(&blob, nuld_runtime::doc_example_conditional_blob().0).unwrap();
         let a = RenderArgs {
-            envmap: PathBuf::from("map.hdr"),
+            envmap: map,
             spp: vec![],
             quick: true,
             size: None,
             reference_spp: None,
             brdf_blob: vec![],
-            envmap_blob: Some(PathBuf::from("env.nuld")),
+            envmap_blob: vec![blob],
             seed: 0,
-            out: std::env::temp_dir().join("nuld-render-cli-never-written"),
+            out: dir.join("never-written"),
         };
         let e = run(a).unwrap_err().to_string();
-        assert!(e.contains("envmap samplers are not implemented yet"), "{e}");
+        assert!(
+            e.contains("environment blob")
+                && e.contains("brdf.nuld")
+                && e.contains("not an environment map"),
+            "{e}"
+        );
+        assert!(!dir.join("never-written").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

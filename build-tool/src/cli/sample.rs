@@ -2,10 +2,10 @@
 //! read through the runtime so that the CSV shows exactly what a renderer gets.
 
 use crate::pointset::AlignedBytes;
-use anyhow::{anyhow, Result};
+use anyhow::{anyhow, bail, Result};
 use clap::{Args, ValueEnum};
-use nuld_runtime::glam::Vec2;
-use nuld_runtime::Blob;
+use nuld_runtime::glam::{Vec2, Vec3};
+use nuld_runtime::{Blob, ConditionalTarget};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -16,8 +16,13 @@ pub struct SampleArgs {
     pub file: PathBuf,
     /// The condition in the blob's units, `ROUGHNESS,THETA_O_DEG` for BRDF samplers
     /// (view in the xz-plane, +x side); values outside the blob's range clamp.
-    #[arg(long, value_parser = parse_condition, allow_hyphen_values = true)]
-    pub cond: Condition,
+    #[arg(long, value_parser = parse_condition, allow_hyphen_values = true,
+        required_unless_present = "normal", conflicts_with = "normal")]
+    pub cond: Option<Condition>,
+    /// For environment samplers: the surface normal `X,Y,Z` (world frame, +z up; any
+    /// length), placed on the condition grid by its octahedral square point.
+    #[arg(long, value_parser = parse_normal, allow_hyphen_values = true)]
+    pub normal: Option<Normal>,
     /// The instance (table mode wraps it modulo the stored instances).
     #[arg(long, default_value_t = 0)]
     pub instance: u32,
@@ -29,6 +34,19 @@ pub struct SampleArgs {
 /// A parsed `--cond`: two finite numbers.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Condition(pub [f32; 2]);
+
+/// A parsed `--normal`: three finite numbers, not all zero.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Normal(pub [f32; 3]);
+
+/// Where `sample` reads the blob: a condition in its units, or a normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum At {
+    /// `--cond`.
+    Condition(Condition),
+    /// `--normal` ([`nuld_runtime::ConditionalSampler::sample_envmap`]).
+    Normal(Normal),
+}
 
 /// `--mode` values.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -49,24 +67,49 @@ fn parse_condition(s: &str) -> Result<Condition, String> {
     }
 }
 
+fn parse_normal(s: &str) -> Result<Normal, String> {
+    let bad = || format!("{s:?} is not X,Y,Z (three finite numbers, not all zero)");
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|v| v.trim().parse::<f32>().ok().filter(|x| x.is_finite()))
+        .collect::<Option<_>>()
+        .ok_or_else(bad)?;
+    match v[..] {
+        [x, y, z] if x != 0.0 || y != 0.0 || z != 0.0 => Ok(Normal([x, y, z])),
+        _ => Err(bad()),
+    }
+}
+
 /// Writes the CSV `index,x,y,z,weight` of every index `0..n` of instance `instance`
-/// at condition `cond` to `out`: values as the runtime returns them (f32, shortest
-/// round-trip decimal). Fails for a blob that is not a conditional sampler.
+/// at `at` to `out`: values as the runtime returns them (f32, shortest round-trip
+/// decimal). Fails for a blob that is not a conditional sampler, or a normal given
+/// to a sampler whose condition is not one.
 pub fn write_csv(
     bytes: &[u8],
-    cond: Condition,
+    at: At,
     instance: u32,
     mode: SampleMode,
     out: &mut impl Write,
 ) -> Result<()> {
     let blob = Blob::parse(bytes).map_err(|e| anyhow!("{e}"))?;
     let cs = blob.conditional().map_err(|e| anyhow!("{e}"))?;
-    let c = Vec2::from(cond.0);
+    let envmap = cs.target() == ConditionalTarget::EnvmapNormal;
+    let c = match at {
+        At::Condition(c) => Vec2::from(c.0),
+        At::Normal(_) if !envmap => {
+            bail!("--normal needs an environment sampler; this blob's condition is --cond ROUGHNESS,THETA_O_DEG")
+        }
+        At::Normal(_) => Vec2::ZERO,
+    };
     writeln!(out, "index,x,y,z,weight")?;
     for i in 0..cs.len() {
-        let s = match mode {
-            SampleMode::Table => cs.sample(c, instance, i),
-            SampleMode::Network => cs.sample_network(c, instance, i),
+        let s = match (at, mode) {
+            (At::Normal(n), SampleMode::Table) => cs.sample_envmap(Vec3::from(n.0), instance, i),
+            (At::Normal(n), SampleMode::Network) => {
+                cs.sample_envmap_network(Vec3::from(n.0), instance, i)
+            }
+            (At::Condition(_), SampleMode::Table) => cs.sample(c, instance, i),
+            (At::Condition(_), SampleMode::Network) => cs.sample_network(c, instance, i),
         };
         let d = s.direction;
         writeln!(out, "{i},{},{},{},{}", d.x, d.y, d.z, s.weight)?;
@@ -80,10 +123,56 @@ pub fn run(a: SampleArgs) -> Result<()> {
     let bytes = AlignedBytes::read(&a.file)?;
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
-    let written = write_csv(bytes.as_slice(), a.cond, a.instance, a.mode, &mut out)
+    let at = match (a.cond, a.normal) {
+        (Some(c), _) => At::Condition(c),
+        (None, Some(n)) => At::Normal(n),
+        (None, None) => bail!("sample needs --cond ROUGHNESS,THETA_O_DEG or --normal X,Y,Z"),
+    };
+    let written = write_csv(bytes.as_slice(), at, a.instance, a.mode, &mut out)
         .and_then(|()| Ok(out.flush()?));
     match written {
         Err(e) if super::export::is_broken_pipe(&e) => Ok(()),
         other => other.map_err(|e| anyhow!("{}: {e}", a.file.display())),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normals_parse_or_say_why_not() {
+        assert_eq!(parse_normal("0, -1.5,2"), Ok(Normal([0.0, -1.5, 2.0])));
+        for bad in ["0,0,0", "1,2", "1,2,3,4", "1,x,2", "nan,0,1"] {
+            assert!(parse_normal(bad).unwrap_err().contains("X,Y,Z"), "{bad}");
+        }
+    }
+
+    /// `--normal` rows are the runtime's `sample_envmap`; a BRDF blob refuses a
+    /// normal with a one-line error.
+    #[test]
+    fn a_normal_reads_an_environment_blob_and_is_refused_by_a_brdf_blob() {
+        let dir = std::env::temp_dir().join(format!("nuld-sample-cli-{}", std::process::id()));
+        let map = crate::render::blobs::tiny_map(&dir);
+        let blob = crate::render::blobs::tiny_envmap_blob(4, &map);
+        let at = At::Normal(Normal([0.2, 0.9, -0.3]));
+        let mut out = Vec::new();
+        write_csv(blob.as_slice(), at, 3, SampleMode::Network, &mut out).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let cs = Blob::parse(blob.as_slice()).unwrap().conditional().unwrap();
+        let rows: Vec<&str> = text.lines().collect();
+        assert_eq!(rows[0], "index,x,y,z,weight");
+        for i in 0..4u32 {
+            let s = cs.sample_envmap_network(Vec3::new(0.2, 0.9, -0.3), 3, i);
+            let d = s.direction;
+            let want = format!("{i},{},{},{},{}", d.x, d.y, d.z, s.weight);
+            assert_eq!(rows[1 + i as usize], want);
+        }
+        let brdf = nuld_runtime::doc_example_conditional_blob();
+        let e = write_csv(&brdf.0, at, 0, SampleMode::Table, &mut Vec::new())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("--normal needs an environment sampler"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -1,10 +1,12 @@
-//! `bake --brdf`: train the conditional BRDF sampler, distill it into a blob, and
-//! report on it (paper §4).
+//! `bake --brdf` and `bake --envmap`: train a conditional sampler, distill it into
+//! a blob, and report on it (paper §4).
 //!
-//! Writes into the output directory `brdf.nuld` (the blob), `report.json`
+//! Writes into the output directory `brdf.nuld` or `envmap.nuld` (the blob,
+//! [`BakeConfig::blob_name`]), `report.json`
 //! (settings, timings, the loss curve and [`quality`](super::quality) at
 //! held-out conditions), `loss.png` (the loss curve), `sets.png` (instance 0 at a
-//! few conditions over the target, in the equal-area square), and while training
+//! few conditions over the target, in the equal-area square; for a map, at a few
+//! normals over the sphere's square), and while training
 //! `checkpoint.bin` (every [`BakeConfig::checkpoint_every`], and at the end), from
 //! which `resume` continues bit for bit. Every file is written atomically.
 
@@ -12,11 +14,13 @@ use super::distill::distill;
 use super::quality::{evaluate, instance_directions, Quality, QualityConfig};
 use crate::plot::{render_loglog, render_square_panels, Series, SquarePanel};
 use crate::progress::Progress;
-use crate::sphere::{BrdfTarget, DirectionDensity};
-use crate::train::{Checkpoint, TrainConfig, Trainer};
+use crate::sphere::{BrdfTarget, DirectionDensity, EnvmapDensity};
+use crate::train::target::LoadedTarget;
+use crate::train::{Checkpoint, TrainConfig, TrainTarget, Trainer};
 use anyhow::{bail, Context, Result};
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 use nuld_core::blob::{Domain, Metadata};
+use nuld_core::sphere::sphere_to_square;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -94,6 +98,49 @@ pub struct BakeReport {
     pub quality: Option<Quality>,
 }
 
+/// Point-table grid of an environment sampler: 13 x 13 normals on the octahedral
+/// square (about 15 degrees apart).
+pub const ENVMAP_GRID: [u32; 2] = [13, 13];
+
+/// Weight-table grid of an environment sampler: the irradiance has a kink where a
+/// sun crosses the normal's horizon, so it is tabulated finer than the points.
+pub const ENVMAP_WEIGHT_GRID: [u32; 2] = [64, 64];
+
+impl BakeConfig {
+    /// The defaults of an environment sampler of `target`: [`ENVMAP_GRID`],
+    /// [`ENVMAP_WEIGHT_GRID`], otherwise [`BakeConfig::default`] through
+    /// [`Self::with_envmap`].
+    pub fn envmap(target: TrainTarget) -> Self {
+        Self {
+            grid: ENVMAP_GRID,
+            weight_grid: ENVMAP_WEIGHT_GRID,
+            ..Self::default()
+        }
+        .with_envmap(target)
+    }
+
+    /// These settings for an environment sampler of `target`, with the equal-area
+    /// output (the mixture prior is a warp of the BRDF's primary space).
+    pub fn with_envmap(self, target: TrainTarget) -> Self {
+        Self {
+            train: TrainConfig {
+                target,
+                mixture_prior: false,
+                ..self.train
+            },
+            ..self
+        }
+    }
+
+    /// The blob's file name: `brdf.nuld` or `envmap.nuld`.
+    pub fn blob_name(&self) -> &'static str {
+        match self.train.target {
+            TrainTarget::GltfBrdf => "brdf.nuld",
+            TrainTarget::Envmap { .. } => "envmap.nuld",
+        }
+    }
+}
+
 /// The checkpoint's path in `dir`.
 pub fn checkpoint_path(dir: &Path) -> PathBuf {
     dir.join("checkpoint.bin")
@@ -124,7 +171,7 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     };
     let mut timings = Timings::default();
     let t = Instant::now();
-    let mut trainer = Trainer::new(config.train.clone(), resume);
+    let mut trainer = Trainer::new(config.train.clone(), resume)?;
     timings.pool_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -149,16 +196,27 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
 
     let t = Instant::now();
     let params = trainer.params();
-    let parts = distill(&params, config.instances, config.grid, config.weight_grid);
+    let target = &trainer.pool.target;
+    let parts = distill(
+        &params,
+        target,
+        config.instances,
+        config.grid,
+        config.weight_grid,
+    );
     let blob = parts.to_blob(&Metadata {
         generator: "bake",
-        target: "brdf",
+        target: match target {
+            LoadedTarget::GltfBrdf => "brdf",
+            LoadedTarget::Envmap(_) => "envmap",
+        },
         seed: config.train.seed,
     })?;
     timings.distill_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let quality = (config.quality_grid > 0).then(|| {
+    let brdf = matches!(target, LoadedTarget::GltfBrdf);
+    let quality = (brdf && config.quality_grid > 0).then(|| {
         evaluate(
             &params,
             &QualityConfig::held_out(config.quality_grid, 0x9a11),
@@ -182,14 +240,21 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     };
     render_loglog(
         &out.join("loss.png"),
-        "bake --brdf: training loss",
+        if brdf {
+            "bake --brdf: training loss"
+        } else {
+            "bake --envmap: training loss"
+        },
         "step",
         "loss",
         &[series],
         (800, 500),
     )?;
-    render_sets(&out.join("sets.png"), &params)?;
-    crate::output::write_atomic(&out.join("brdf.nuld"), blob.as_slice())?;
+    match target {
+        LoadedTarget::GltfBrdf => render_sets(&out.join("sets.png"), &params)?,
+        LoadedTarget::Envmap(map) => render_envmap_sets(&out.join("sets.png"), &params, map)?,
+    }
+    crate::output::write_atomic(&out.join(config.blob_name()), blob.as_slice())?;
     timings.total_s = started.elapsed().as_secs_f64();
     let report = BakeReport {
         config: config.clone(),
@@ -239,15 +304,55 @@ fn render_sets(path: &Path, params: &crate::network::Params) -> Result<()> {
     render_square_panels(path, &panels, 450)
 }
 
+/// Instance 0 at four normals, each over its target `L max(0, n.l)` in the
+/// sphere's equal-area square.
+fn render_envmap_sets(
+    path: &Path,
+    params: &crate::network::Params,
+    map: &EnvmapDensity,
+) -> Result<()> {
+    let shipped = params.rounded_to_f16();
+    let normals = [
+        ("+z (up)", DVec3::Z),
+        ("+x", DVec3::X),
+        ("tilted (1, -1, 1)", DVec3::new(1.0, -1.0, 1.0).normalize()),
+        ("-z (down)", DVec3::NEG_Z),
+    ];
+    let lit: Vec<EnvmapDensity> = normals
+        .iter()
+        .map(|(_, n)| map.cosine_weighted(*n))
+        .collect::<Result<_, _>>()?;
+    let densities: Vec<Box<dyn Fn(DVec2) -> f64 + '_>> = lit
+        .iter()
+        .map(|t| {
+            Box::new(move |p| t.pdf(Domain::Sphere.to_direction(p))) as Box<dyn Fn(DVec2) -> f64>
+        })
+        .collect();
+    let panels: Vec<SquarePanel<'_>> = normals
+        .iter()
+        .zip(&densities)
+        .map(|((name, n), d)| {
+            let u = sphere_to_square(*n).to_array();
+            SquarePanel {
+                caption: format!("normal {name}"),
+                density: d.as_ref(),
+                points: (0..shipped.shape.n())
+                    .map(|i| DVec2::from(shipped.square_point(u, 0, i)))
+                    .collect(),
+            }
+        })
+        .collect();
+    render_square_panels(path, &panels, 450)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use nuld_core::blob::{BlobKind, Layout, SectionTag};
 
-    #[test]
-    fn a_tiny_bake_writes_a_blob_whose_sections_match_its_counts() {
-        let dir = std::env::temp_dir().join(format!("nuld-bake-tiny-{}", std::process::id()));
-        let config = BakeConfig {
+    /// A bake of a few steps of a tiny network: checks the files, not quality.
+    fn tiny() -> BakeConfig {
+        BakeConfig {
             train: TrainConfig {
                 n: 8,
                 hidden: vec![6],
@@ -261,10 +366,18 @@ mod tests {
                 ..TrainConfig::default()
             },
             instances: 3,
-            grid: [2, 3],
-            weight_grid: [4, 2],
             quality_grid: 0,
             ..BakeConfig::default()
+        }
+    }
+
+    #[test]
+    fn a_tiny_bake_writes_a_blob_whose_sections_match_its_counts() {
+        let dir = std::env::temp_dir().join(format!("nuld-bake-tiny-{}", std::process::id()));
+        let config = BakeConfig {
+            grid: [2, 3],
+            weight_grid: [4, 2],
+            ..tiny()
         };
         let report = bake(&config, &dir).unwrap();
         let blob = crate::pointset::AlignedBytes::read(&dir.join("brdf.nuld")).unwrap();
@@ -295,6 +408,77 @@ mod tests {
             std::fs::read(dir.join("brdf.nuld")).unwrap(),
             bytes.to_vec()
         );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// An environment bake of a constant sky: its weight table is the irradiance
+    /// of a constant map, `pi L` at every normal (the closed form; the pixel-centre
+    /// cosine sum is within 1e-3 of it), sets serve through `sample_envmap`, and a
+    /// resumed finished run writes the same blob.
+    #[test]
+    fn an_envmap_bake_tabulates_pi_l_for_a_constant_sky_and_resumes() {
+        let dir = std::env::temp_dir().join(format!("nuld-bake-envmap-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let map = dir.join("grey.hdr");
+        let lum = 0.75f32;
+        let img = image::Rgb32FImage::from_pixel(128, 64, image::Rgb([lum; 3]));
+        image::DynamicImage::ImageRgb32F(img).save(&map).unwrap();
+        let config = BakeConfig {
+            grid: [3, 3],
+            weight_grid: [5, 4],
+            ..tiny()
+        }
+        .with_envmap(TrainTarget::envmap(&map).unwrap());
+        assert_eq!(config.blob_name(), "envmap.nuld");
+        let out = dir.join("out");
+        let report = bake(&config, &out).unwrap();
+        let blob = crate::pointset::AlignedBytes::read(&out.join("envmap.nuld")).unwrap();
+        assert_eq!(blob.as_slice().len(), report.blob_bytes);
+        let cs = nuld_runtime::Blob::parse(blob.as_slice())
+            .unwrap()
+            .conditional()
+            .unwrap();
+        assert_eq!(cs.domain(), Domain::Sphere);
+        let pi_l = std::f64::consts::PI * lum as f64;
+        for n in [
+            DVec3::Z,
+            DVec3::NEG_Z,
+            DVec3::new(0.3, -0.8, 0.1).normalize(),
+        ] {
+            let s = cs.sample_envmap(n.as_vec3(), 1, 2);
+            assert!(
+                (s.weight as f64 / pi_l - 1.0).abs() < 1e-3,
+                "{n}: {}",
+                s.weight
+            );
+            assert!((s.direction.length() - 1.0).abs() < 1e-5);
+        }
+        for f in ["report.json", "loss.png", "sets.png", "checkpoint.bin"] {
+            assert!(out.join(f).is_file(), "{f}");
+        }
+        let again = bake(
+            &BakeConfig {
+                resume: true,
+                ..config
+            },
+            &out,
+        )
+        .unwrap();
+        assert_eq!(again.blob_bytes, report.blob_bytes);
+        assert_eq!(
+            std::fs::read(out.join("envmap.nuld")).unwrap(),
+            blob.as_slice().to_vec()
+        );
+        // Another map under the same directory is refused on resume.
+        std::fs::write(&map, b"not a map any more").unwrap();
+        let other = BakeConfig {
+            resume: true,
+            ..BakeConfig::default().with_envmap(TrainTarget::Envmap {
+                path: map.clone(),
+                content_hash: 1,
+            })
+        };
+        assert!(bake(&other, &out).is_err());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

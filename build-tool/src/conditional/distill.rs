@@ -9,16 +9,22 @@
 //!   ([`directional_albedo`]), followed for a [`PointWarp::BrdfMixture`] sampler by
 //!   the lobe probability `p_s = A_spec / A` at the same nodes (what
 //!   [`crate::sphere::brdf_albedo::lobe_probability`] computes, from the same
-//!   quadrature).
+//!   quadrature); for an environment sampler ([`ConditionalTarget::EnvmapNormal`])
+//!   the irradiance `E(n)` of the map at every node's normal
+//!   ([`EnvmapDensity::irradiance`]).
 
 use super::ConditionalParts;
 use crate::network::Params;
 use crate::sphere::brdf_albedo::directional_albedo;
+use crate::sphere::EnvmapDensity;
+use crate::train::target::LoadedTarget;
+use glam::DVec2;
 use nuld_core::blob::Domain;
 use nuld_core::brdf::{BrdfModel, BrdfParts, CONDITION_MAX, CONDITION_MIN};
 use nuld_core::conditional::{pack_point, ConditionalInfo, ConditionalTarget, PointWarp};
 use nuld_core::network::{Shape, MAX_HIDDEN_LAYERS};
 use nuld_core::quantize::unorm16_encode;
+use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
 
 /// The info record of a glTF BRDF sampler over the condition range
@@ -50,15 +56,38 @@ pub fn brdf_info(
     }
 }
 
-/// The blob's parts for `params` (see the module docs). Parallel over grid nodes;
-/// identical for any thread count.
+/// The info record of an environment sampler: condition = the normal's octahedral
+/// square point over `[0,1]^2`, directions on the sphere, the equal-area output,
+/// otherwise as [`brdf_info`].
+pub fn envmap_info(
+    shape: &Shape,
+    instances: u32,
+    grid: [u32; 2],
+    weight_grid: [u32; 2],
+) -> ConditionalInfo {
+    ConditionalInfo {
+        domain: Domain::Sphere as u32,
+        target: ConditionalTarget::EnvmapNormal as u32,
+        cond_min: [0.0; 2],
+        cond_max: [1.0; 2],
+        warp: PointWarp::EqualArea as u32,
+        ..brdf_info(shape, instances, grid, weight_grid)
+    }
+}
+
+/// The blob's parts for `params` trained on `target` (see the module docs).
+/// Parallel over grid nodes; identical for any thread count.
 pub fn distill(
     params: &Params,
+    target: &LoadedTarget,
     instances: u32,
     grid: [u32; 2],
     weight_grid: [u32; 2],
 ) -> ConditionalParts {
-    let info = brdf_info(&params.shape, instances, grid, weight_grid);
+    let info = match target {
+        LoadedTarget::GltfBrdf => brdf_info(&params.shape, instances, grid, weight_grid),
+        LoadedTarget::Envmap(_) => envmap_info(&params.shape, instances, grid, weight_grid),
+    };
     let shipped = params.rounded_to_f16();
     let n = info.n;
     let nodes = (grid[0] * grid[1]) as usize;
@@ -80,6 +109,38 @@ pub fn distill(
             })
         })
         .collect();
+    let weights = match target {
+        LoadedTarget::GltfBrdf => brdf_weights(&info),
+        LoadedTarget::Envmap(map) => envmap_weights(&info, map),
+    };
+    ConditionalParts {
+        info,
+        params: params.to_f16_bits(),
+        table,
+        weights,
+    }
+}
+
+/// The irradiance `E(n)` at every weight-grid node's normal, in parallel chunks
+/// of nodes (each value the same sum whatever the thread count).
+fn envmap_weights(info: &ConditionalInfo, map: &EnvmapDensity) -> Vec<f32> {
+    let g = info.weight_grid;
+    let normals: Vec<_> = (0..g[0] * g[1])
+        .map(|node| {
+            let u = info.weight_grid_condition([node % g[0], node / g[0]]);
+            square_to_sphere(DVec2::from(u))
+        })
+        .collect();
+    normals
+        .par_chunks(64)
+        .flat_map_iter(|chunk| map.irradiances(chunk))
+        .map(|e| e as f32)
+        .collect()
+}
+
+/// The albedo `A`, then for the mixture warp `p_s`, at every weight-grid node.
+fn brdf_weights(info: &ConditionalInfo) -> Vec<f32> {
+    let weight_grid = info.weight_grid;
     let weight_nodes = weight_grid[0] * weight_grid[1];
     // One quadrature per node gives both tables: `A` and `p_s = A_spec / A`.
     let albedos: Vec<BrdfParts<f64>> = (0..weight_nodes)
@@ -93,12 +154,7 @@ pub fn distill(
     if info.weight_tables() > 1 {
         weights.extend(albedos.iter().map(|a| (a.specular / a.total()) as f32));
     }
-    ConditionalParts {
-        info,
-        params: params.to_f16_bits(),
-        table,
-        weights,
-    }
+    weights
 }
 
 #[cfg(test)]
@@ -112,7 +168,7 @@ mod tests {
     fn table_holds_the_shipped_network_and_weights_the_albedo() {
         let shape = Shape::new(5, &[6], Activation::Relu, 2).unwrap();
         let params = Params::init(shape, 4);
-        let parts = distill(&params, 3, [3, 2], [4, 3]);
+        let parts = distill(&params, &LoadedTarget::GltfBrdf, 3, [3, 2], [4, 3]);
         assert_eq!(parts.table.len(), 3 * 2 * 3 * 5);
         assert_eq!(parts.weights.len(), 12);
         // Entry (node (2, 1), instance 2, index 4) against the network evaluated by

@@ -1,14 +1,15 @@
-//! The BRDF sampler blobs a render needs: one per sample count, since a blob's
-//! sets have a fixed size `N` and the first `k < N` points of a set are not a
-//! good set of `k`. Given blobs serve the sample count equal to their `N`; for
-//! every other requested count the blob is baked into the output directory
-//! (`DIR/brdf-nN/brdf.nuld`, by [`crate::conditional::bake::bake`]) and reused
-//! when already there.
+//! The sampler blobs a render needs, BRDF and environment: one per sample count,
+//! since a blob's sets have a fixed size `N` and the first `k < N` points of a
+//! set are not a good set of `k`. Given blobs serve the sample count equal to
+//! their `N`; for every other requested count the blob is baked into the output
+//! directory (`DIR/brdf-nN/brdf.nuld`, `DIR/envmap-nN/envmap.nuld`, by
+//! [`crate::conditional::bake::bake`]) and reused when already there.
 //!
 //! This is the only part of the renderer that touches the tool's training code;
 //! the samplers read the resulting bytes through `nuld-runtime` alone
 //! ([`super::nuld_sampler`]).
 
+use super::environment::Environment;
 use super::nuld_sampler::{NuldMode, NuldSampler};
 use crate::conditional::bake::{bake, BakeConfig};
 use crate::pointset::AlignedBytes;
@@ -16,33 +17,65 @@ use anyhow::{anyhow, bail, Context, Result};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// Blob bytes by their set size `N`.
-#[derive(Debug, Default)]
-pub struct BrdfBlobs {
+/// Blob bytes by their set size `N`, of one family: BRDF samplers, or the
+/// environment samplers of one map.
+#[derive(Debug)]
+pub struct SamplerBlobs<'e> {
+    /// `None`: BRDF samplers; `Some(env)`: environment samplers of `env`.
+    env: Option<&'e Environment>,
     by_n: BTreeMap<u32, (PathBuf, AlignedBytes)>,
 }
 
-impl BrdfBlobs {
-    /// Reads each of `paths`; an error (one line, naming the file) for an
-    /// unreadable file, a blob that is not a conditional glTF-BRDF sampler, or two
-    /// blobs of the same `N`.
+/// BRDF sampler blobs.
+pub type BrdfBlobs = SamplerBlobs<'static>;
+
+impl<'e> SamplerBlobs<'e> {
+    /// Reads each of `paths` as BRDF samplers; an error (one line, naming the
+    /// file) for an unreadable file, a blob that is not a conditional glTF-BRDF
+    /// sampler, or two blobs of the same `N`.
     pub fn read(paths: &[PathBuf]) -> Result<Self> {
-        let mut blobs = Self::default();
+        Self::read_family(paths, None)
+    }
+
+    /// Reads each of `paths` as environment samplers of `env`; errors as
+    /// [`Self::read`], and for a blob baked for another map.
+    pub fn read_envmap(paths: &[PathBuf], env: &'e Environment) -> Result<Self> {
+        Self::read_family(paths, Some(env))
+    }
+
+    fn read_family(paths: &[PathBuf], env: Option<&'e Environment>) -> Result<Self> {
+        let mut blobs = Self {
+            env,
+            by_n: BTreeMap::new(),
+        };
         for path in paths {
             let bytes = std::fs::read(path)
-                .with_context(|| format!("cannot read BRDF blob {}", path.display()))?;
+                .with_context(|| format!("cannot read {} blob {}", blobs.what(), path.display()))?;
             blobs.insert(path.clone(), AlignedBytes::copy_from(&bytes))?;
         }
         Ok(blobs)
     }
 
+    /// `BRDF` or `environment`, for messages.
+    fn what(&self) -> &'static str {
+        match self.env {
+            None => "BRDF",
+            Some(_) => "environment",
+        }
+    }
+
     fn insert(&mut self, path: PathBuf, buf: AlignedBytes) -> Result<()> {
-        let n = NuldSampler::new(buf.as_slice(), NuldMode::Table)
-            .map_err(|e| anyhow!("BRDF blob {}: {e}", path.display()))?
+        let what = self.what();
+        let sampler = match self.env {
+            None => NuldSampler::new(buf.as_slice(), NuldMode::Table),
+            Some(env) => NuldSampler::envmap(buf.as_slice(), NuldMode::Table, env),
+        };
+        let n = sampler
+            .map_err(|e| anyhow!("{what} blob {}: {e}", path.display()))?
             .len();
         if let Some((other, _)) = self.by_n.get(&n) {
             bail!(
-                "BRDF blobs {} and {} both have N = {n}; give one blob per sample count",
+                "{what} blobs {} and {} both have N = {n}; give one blob per sample count",
                 other.display(),
                 path.display()
             );
@@ -51,26 +84,29 @@ impl BrdfBlobs {
         Ok(())
     }
 
-    /// Bakes (or reuses) a blob in `dir/brdf-nN/` for every count of `spp` that no
-    /// blob serves, with `template` at `N` points per set.
+    /// Bakes (or reuses) a blob in `dir/brdf-nN/` (`dir/envmap-nN/`) for every
+    /// count of `spp` that no blob serves, with `template` (whose target must be
+    /// this family's) at `N` points per set.
     pub fn complete(&mut self, spp: &[u32], dir: &Path, template: &BakeConfig) -> Result<()> {
+        let what = self.what();
+        let stem = template.blob_name().trim_end_matches(".nuld");
         for &n in spp {
             if self.by_n.contains_key(&n) {
                 continue;
             }
-            let sub = dir.join(format!("brdf-n{n}"));
-            let path = sub.join("brdf.nuld");
+            let sub = dir.join(format!("{stem}-n{n}"));
+            let path = sub.join(template.blob_name());
             if !path.is_file() {
                 let mut config = template.clone();
                 config.train.n = n;
                 eprintln!(
-                    "render: no BRDF blob with N = {n}; baking one into {}",
+                    "render: no {what} blob with N = {n}; baking one into {}",
                     sub.display()
                 );
                 bake(&config, &sub)?;
             }
             let bytes = std::fs::read(&path)
-                .with_context(|| format!("cannot read BRDF blob {}", path.display()))?;
+                .with_context(|| format!("cannot read {what} blob {}", path.display()))?;
             self.insert(path, AlignedBytes::copy_from(&bytes))?;
         }
         Ok(())
@@ -103,6 +139,48 @@ pub(crate) fn tiny_blob(n: u32) -> AlignedBytes {
     bytes
 }
 
+/// A small sky (a bright spot above a gradient, 32 x 16 pixels) written as PNG
+/// into `dir`, for tests that need a map file.
+#[cfg(test)]
+pub(crate) fn tiny_map(dir: &Path) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let path = dir.join("sky.png");
+    image::RgbImage::from_fn(32, 16, |x, y| {
+        let v = if (x, y) == (5, 3) {
+            255
+        } else {
+            (40 + 8 * (16 - y)) as u8
+        };
+        image::Rgb([v, v, v])
+    })
+    .save(&path)
+    .unwrap();
+    path
+}
+
+/// A tiny baked environment sampler of the map at `map` with `N = n` (the
+/// `--quick` bake), baked into a fresh temporary directory: barely trained.
+#[cfg(test)]
+pub(crate) fn tiny_envmap_blob(n: u32, map: &Path) -> AlignedBytes {
+    use crate::train::TrainTarget;
+    use std::sync::atomic::{AtomicU32, Ordering};
+    static COUNTER: AtomicU32 = AtomicU32::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "nuld-render-envblob-{}-{}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    let mut config = super::RenderConfig::quick(PathBuf::new())
+        .envmap_bake
+        .with_envmap(TrainTarget::envmap(map).unwrap());
+    config.train.n = n;
+    config.weight_grid = [16, 16];
+    bake(&config, &dir).unwrap();
+    let bytes = AlignedBytes::read(&dir.join("envmap.nuld")).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    bytes
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -118,7 +196,7 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            e.contains("points.nuld") && e.contains("not a conditional BRDF sampler"),
+            e.contains("points.nuld") && e.contains("not a conditional sampler"),
             "{e}"
         );
         let junk = dir.join("junk.nuld");
@@ -135,8 +213,28 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("both have N = 4"), "{e}");
-        let blobs = BrdfBlobs::read(&[blob]).unwrap();
+        let blobs = BrdfBlobs::read(std::slice::from_ref(&blob)).unwrap();
         assert!(blobs.get(4).is_some() && blobs.get(16).is_none());
+        // Environment samplers: a BRDF blob is the wrong target, a blob of
+        // another map is refused, the map's own blob is served.
+        let map = tiny_map(&dir);
+        let env = Environment::from_file(&map).unwrap();
+        let e = SamplerBlobs::read_envmap(&[blob], &env)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("environment blob") && e.contains("not an environment map"),
+            "{e}"
+        );
+        let own = dir.join("env.nuld");
+        std::fs::write(&own, tiny_envmap_blob(4, &map).as_slice()).unwrap();
+        let blobs = SamplerBlobs::read_envmap(std::slice::from_ref(&own), &env).unwrap();
+        assert!(blobs.get(4).is_some());
+        let brighter = Environment::constant(100.0).unwrap();
+        let e = SamplerBlobs::read_envmap(&[own], &brighter)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("baked for another map"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -86,6 +86,12 @@ impl Environment {
         self.power() * self.density.pdf(w)
     }
 
+    /// The irradiance `E(n) = ∫ L(l) max(0, n.l) dl` at a surface facing the unit
+    /// normal `n` ([`EnvmapDensity::irradiance`]).
+    pub fn irradiance(&self, n: DVec3) -> f64 {
+        self.density.irradiance(n)
+    }
+
     /// Density per steradian of both warps at `w`: `L(w) / Φ`.
     pub fn pdf(&self, w: DVec3) -> f64 {
         self.density.pdf(w)

@@ -17,15 +17,23 @@ pub const BRDF_SAMPLERS: [&str; 6] = [
     "gbn",
 ];
 /// The environment sampler names in table order.
-pub const ENVMAP_SAMPLERS: [&str; 3] = ["owen-sobol", "halton", "owen-sobol-hierarchical"];
+pub const ENVMAP_SAMPLERS: [&str; 5] = [
+    "nuld-table",
+    "nuld-network",
+    "owen-sobol",
+    "halton",
+    "owen-sobol-hierarchical",
+];
 
 /// Every sampler at `n` samples per pixel, BRDF then environment, named as
-/// [`BRDF_SAMPLERS`] and [`ENVMAP_SAMPLERS`]: ours from the blob `blob` (whose
-/// `N` should be `n`) in both modes; the baselines' points from `seed` (SOT and
-/// GBN generate their pools now). An error if `blob` is not a conditional BRDF
-/// sampler.
+/// [`BRDF_SAMPLERS`] and [`ENVMAP_SAMPLERS`]: ours from the blobs `blob` (BRDF)
+/// and `envmap_blob` (the environment sampler of `env`; without it ours is left
+/// out of the environment samplers), whose `N` should be `n`, in both modes; the
+/// baselines' points from `seed` (SOT and GBN generate their pools now). An
+/// error if a blob is not the sampler it should be.
 pub fn samplers<'a>(
     blob: &'a [u8],
+    envmap_blob: Option<&'a [u8]>,
     n: u32,
     seed: u64,
     lobes: &'a LobeTable,
@@ -34,31 +42,47 @@ pub fn samplers<'a>(
     let points = |g| PrimaryPoints::new(g, n, seed);
     let brdf = |g| Box::new(MixtureSampler::new(points(g), lobes));
     let envmap = |g, warp| Box::new(EnvmapSampler::new(points(g), warp, env));
-    Ok(vec![
+    let mut all: Vec<Box<dyn DirectionSampler + 'a>> = vec![
         Box::new(NuldSampler::new(blob, NuldMode::Table)?),
         Box::new(NuldSampler::new(blob, NuldMode::Network)?),
         brdf(Generator::OwenSobol),
         brdf(Generator::Random),
         brdf(Generator::Sot),
         brdf(Generator::Gbn),
-        envmap(Generator::OwenSobol, EnvWarp::InverseCdf),
-        envmap(Generator::Halton, EnvWarp::InverseCdf),
-        envmap(Generator::OwenSobol, EnvWarp::Hierarchical),
-    ])
+    ];
+    if let Some(e) = envmap_blob {
+        all.push(Box::new(NuldSampler::envmap(e, NuldMode::Table, env)?));
+        all.push(Box::new(NuldSampler::envmap(e, NuldMode::Network, env)?));
+    }
+    all.push(envmap(Generator::OwenSobol, EnvWarp::InverseCdf));
+    all.push(envmap(Generator::Halton, EnvWarp::InverseCdf));
+    all.push(envmap(Generator::OwenSobol, EnvWarp::Hierarchical));
+    Ok(all)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::blobs::tiny_blob;
+    use crate::render::blobs::{tiny_blob, tiny_envmap_blob, tiny_map};
     use crate::render::sampler::Technique;
 
     #[test]
     fn the_lineup_is_named_as_the_tables() {
         let blob = tiny_blob(4);
-        let env = Environment::constant(1.0).unwrap();
+        let dir = std::env::temp_dir().join(format!("nuld-lineup-{}", std::process::id()));
+        let map = tiny_map(&dir);
+        let env = Environment::from_file(&map).unwrap();
+        let env_blob = tiny_envmap_blob(4, &map);
         let lobes = LobeTable::new(&[0.5]);
-        let all = samplers(blob.as_slice(), 4, 0, &lobes, &env).unwrap();
+        let all = samplers(
+            blob.as_slice(),
+            Some(env_blob.as_slice()),
+            4,
+            0,
+            &lobes,
+            &env,
+        )
+        .unwrap();
         let names = |t| {
             all.iter()
                 .filter(|s| s.technique() == t)
@@ -67,6 +91,20 @@ mod tests {
         };
         assert_eq!(names(Technique::Brdf), BRDF_SAMPLERS);
         assert_eq!(names(Technique::Envmap), ENVMAP_SAMPLERS);
-        assert!(samplers(&[0u8; 16], 4, 0, &lobes, &env).is_err());
+        assert!(samplers(&[0u8; 16], Some(env_blob.as_slice()), 4, 0, &lobes, &env).is_err());
+        // The two blobs swapped: each is the wrong target.
+        let swapped = samplers(
+            env_blob.as_slice(),
+            Some(blob.as_slice()),
+            4,
+            0,
+            &lobes,
+            &env,
+        );
+        assert!(swapped.is_err());
+        assert!(samplers(blob.as_slice(), Some(blob.as_slice()), 4, 0, &lobes, &env).is_err());
+        let without = samplers(blob.as_slice(), None, 4, 0, &lobes, &env).unwrap();
+        assert_eq!(without.len(), all.len() - 2);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -1,12 +1,22 @@
-//! Ours: the conditional BRDF sampler of a baked blob, reached only through
+//! Ours: the conditional samplers of baked blobs, reached only through
 //! `nuld-runtime`'s public API on the blob's bytes, exactly as a renderer that
-//! links the runtime would: `Blob::parse(bytes)?.conditional()?` once, then
-//! [`ConditionalSampler::sample_brdf`] (table mode) or
-//! [`ConditionalSampler::sample_brdf_network`] (network mode) per sample, with the
-//! local view direction, the roughness, the pixel's instance (its key's high 32
-//! bits) and the index. The weight is the sample's own (the albedo `A`).
+//! links the runtime would: `Blob::parse(bytes)?.conditional()?` once, then per
+//! sample, with the pixel's instance (its key's high 32 bits) and the index:
+//!
+//! * BRDF sampling: [`ConditionalSampler::sample_brdf`] (table mode) or
+//!   [`ConditionalSampler::sample_brdf_network`] (network mode) at the local view
+//!   direction and the roughness; the weight is the sample's own (the albedo `A`);
+//! * environment sampling: [`ConditionalSampler::sample_envmap`] or
+//!   [`ConditionalSampler::sample_envmap_network`] at the world normal; the sample
+//!   weight is the irradiance `E(n)`, and since the set follows
+//!   `q(l) = L(l) max(0, n.l) / E(n)`, the estimator's weight is
+//!   `f(wo, l) cos / q(l) = f(wo, l) cos E(n) / (L(l) cos)` (0 where `L` or the
+//!   cosine is 0): the per-sample contribution is `E f`.
 
+use super::environment::Environment;
 use super::sampler::{DirectionSampler, PixelKey, Sample, ShadingPoint, Technique};
+use glam::DVec3;
+use nuld_runtime::glam::Vec3;
 use nuld_runtime::{Blob, BlobError, BlobKind, ConditionalSampler, ConditionalTarget};
 
 /// Table mode or network mode.
@@ -25,11 +35,26 @@ pub enum NuldBlobError {
     #[error("not a valid nuld blob: {0}")]
     Parse(BlobError),
     /// A valid blob of another kind.
-    #[error("a {0:?} blob, not a conditional BRDF sampler")]
+    #[error("a {0:?} blob, not a conditional sampler")]
     Kind(BlobKind),
     /// A conditional blob for another target.
-    #[error("a conditional sampler for target code {0}, not the glTF BRDF")]
-    Target(u32),
+    #[error("a conditional sampler for target code {0}, not {1}")]
+    Target(u32, &'static str),
+    /// An environment sampler whose irradiance table disagrees with the map.
+    #[error("an environment sampler baked for another map (irradiance {blob:.4e} in the blob, {map:.4e} from the map)")]
+    OtherMap {
+        /// Mean of the blob's `E` at the six axis normals.
+        blob: f64,
+        /// The same from the map.
+        map: f64,
+    },
+}
+
+/// What ours samples.
+#[derive(Clone, Copy, Debug)]
+enum Kind<'a> {
+    Brdf,
+    Envmap(&'a Environment),
 }
 
 /// Ours (see the module docs): a view on the blob's bytes.
@@ -37,23 +62,76 @@ pub enum NuldBlobError {
 pub struct NuldSampler<'a> {
     sampler: ConditionalSampler<'a>,
     mode: NuldMode,
+    kind: Kind<'a>,
+}
+
+/// The conditional sampler of `bytes` if it is one for `target`.
+fn conditional<'a>(
+    bytes: &'a [u8],
+    target: ConditionalTarget,
+    name: &'static str,
+) -> Result<ConditionalSampler<'a>, NuldBlobError> {
+    let blob = Blob::parse(bytes).map_err(NuldBlobError::Parse)?;
+    if blob.kind() != BlobKind::Conditional {
+        return Err(NuldBlobError::Kind(blob.kind()));
+    }
+    let sampler = blob.conditional().map_err(NuldBlobError::Parse)?;
+    if sampler.target() != target {
+        return Err(NuldBlobError::Target(sampler.info().target, name));
+    }
+    Ok(sampler)
 }
 
 impl<'a> NuldSampler<'a> {
-    /// The sampler of the blob `bytes` (16-byte aligned, e.g.
+    /// The BRDF sampler of the blob `bytes` (16-byte aligned, e.g.
     /// `nuld_runtime::AlignedBuf`) in `mode`; an error unless they hold a
     /// conditional glTF-BRDF sampler.
     pub fn new(bytes: &'a [u8], mode: NuldMode) -> Result<Self, NuldBlobError> {
-        let blob = Blob::parse(bytes).map_err(NuldBlobError::Parse)?;
-        if blob.kind() != BlobKind::Conditional {
-            return Err(NuldBlobError::Kind(blob.kind()));
+        let sampler = conditional(bytes, ConditionalTarget::GltfBrdf, "the glTF BRDF")?;
+        Ok(Self {
+            sampler,
+            mode,
+            kind: Kind::Brdf,
+        })
+    }
+
+    /// The environment sampler of the blob `bytes` for the map `env` in `mode`;
+    /// an error unless they hold one whose irradiance at the six axis normals
+    /// agrees with the map's within 10% (a blob of another map would not).
+    pub fn envmap(
+        bytes: &'a [u8],
+        mode: NuldMode,
+        env: &'a Environment,
+    ) -> Result<Self, NuldBlobError> {
+        let sampler = conditional(bytes, ConditionalTarget::EnvmapNormal, "an environment map")?;
+        let axes = [
+            Vec3::X,
+            Vec3::NEG_X,
+            Vec3::Y,
+            Vec3::NEG_Y,
+            Vec3::Z,
+            Vec3::NEG_Z,
+        ];
+        let blob = axes
+            .iter()
+            .map(|&n| sampler.sample_envmap(n, 0, 0).weight as f64)
+            .sum::<f64>()
+            / 6.0;
+        let map = axes
+            .iter()
+            .map(|n| env.irradiance(n.as_dvec3()))
+            .sum::<f64>()
+            / 6.0;
+        // NaN compares false: such a blob is refused too.
+        let agrees = (blob - map).abs() <= 0.1 * map;
+        if !agrees {
+            return Err(NuldBlobError::OtherMap { blob, map });
         }
-        let sampler = blob.conditional().map_err(NuldBlobError::Parse)?;
-        let target = sampler.info().target;
-        if ConditionalTarget::from_code(target) != Some(ConditionalTarget::GltfBrdf) {
-            return Err(NuldBlobError::Target(target));
-        }
-        Ok(Self { sampler, mode })
+        Ok(Self {
+            sampler,
+            mode,
+            kind: Kind::Envmap(env),
+        })
     }
 
     /// Points per set `N` of the blob.
@@ -69,7 +147,10 @@ impl<'a> NuldSampler<'a> {
 
 impl DirectionSampler for NuldSampler<'_> {
     fn technique(&self) -> Technique {
-        Technique::Brdf
+        match self.kind {
+            Kind::Brdf => Technique::Brdf,
+            Kind::Envmap(_) => Technique::Envmap,
+        }
     }
 
     fn name(&self) -> &'static str {
@@ -83,6 +164,28 @@ impl DirectionSampler for NuldSampler<'_> {
     /// evaluation (indices wrap modulo `N` otherwise).
     fn samples(&self, at: &ShadingPoint, key: PixelKey, n: u32, out: &mut Vec<Sample>) {
         out.clear();
+        if let Kind::Envmap(env) = self.kind {
+            let normal = at.frame.to_world(DVec3::Z);
+            let k = key.instance();
+            out.extend((0..n).map(|i| {
+                let s = match self.mode {
+                    NuldMode::Table => self.sampler.sample_envmap(normal.as_vec3(), k, i),
+                    NuldMode::Network => self.sampler.sample_envmap_network(normal.as_vec3(), k, i),
+                };
+                let l = s.direction.as_dvec3();
+                let (cos, radiance) = (normal.dot(l), env.radiance(l));
+                let weight = if cos > 0.0 && radiance > 0.0 {
+                    at.cosine_weighted(l) * s.weight as f64 / (radiance * cos)
+                } else {
+                    0.0
+                };
+                Sample {
+                    direction: l,
+                    weight,
+                }
+            }));
+            return;
+        }
         let wo = at.wo.as_vec3();
         let r = at.roughness as f32;
         let k = key.instance();
@@ -160,6 +263,59 @@ mod tests {
                 assert!(s.direction.dot(n) >= 0.0);
             }
         }
+    }
+
+    /// Ours for the environment is the runtime's `sample_envmap` at the world
+    /// normal, bit for bit, and each sample contributes `weight x L(l) = E(n)
+    /// f(wo, l)` (0 below the surface): the estimator of a set that follows
+    /// `L max(0, n.l) / E`.
+    #[test]
+    fn envmap_samples_are_the_runtimes_and_contribute_e_times_f() {
+        use crate::render::blobs::{tiny_envmap_blob, tiny_map};
+        use crate::render::environment::Environment;
+        let dir = std::env::temp_dir().join(format!("nuld-envsampler-{}", std::process::id()));
+        let map = tiny_map(&dir);
+        let env = Environment::from_file(&map).unwrap();
+        let blob = tiny_envmap_blob(8, &map);
+        let cs = Blob::parse(blob.as_slice()).unwrap().conditional().unwrap();
+        let n = DVec3::new(0.3, -0.5, 0.6).normalize();
+        let at = ShadingPoint {
+            frame: Frame::new(n),
+            wo: DVec3::new(0.4, 0.1, 0.8).normalize(),
+            roughness: 0.3,
+        };
+        let key = PixelKey(0x0fed_cba9_8765_4321);
+        let mut checked = 0;
+        for mode in [NuldMode::Table, NuldMode::Network] {
+            let ours = NuldSampler::envmap(blob.as_slice(), mode, &env).unwrap();
+            assert_eq!(ours.technique(), Technique::Envmap);
+            let mut out = Vec::new();
+            ours.samples(&at, key, 8, &mut out);
+            for (i, s) in out.iter().enumerate() {
+                let want = match mode {
+                    NuldMode::Table => cs.sample_envmap(n.as_vec3(), key.instance(), i as u32),
+                    NuldMode::Network => {
+                        cs.sample_envmap_network(n.as_vec3(), key.instance(), i as u32)
+                    }
+                };
+                assert_eq!(s.direction, want.direction.as_dvec3());
+                let l = s.direction;
+                let f = nuld_core::brdf::brdf(at.wo, at.frame.to_local(l), at.roughness);
+                let contribution = s.weight * env.radiance(l);
+                if n.dot(l) > 0.0 {
+                    let e = want.weight as f64;
+                    assert!(
+                        (contribution - e * f).abs() <= 1e-9 * e * f,
+                        "{contribution} {e} {f}"
+                    );
+                    checked += 1;
+                } else {
+                    assert_eq!(s.weight, 0.0);
+                }
+            }
+        }
+        assert!(checked > 0);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     /// The sampler path of the renderer reaches the sampler through

@@ -17,7 +17,7 @@
 use super::brdf_warp::LobeTable;
 use super::integrator::{Image, Primary, Setup};
 use crate::output::write_atomic;
-use crate::seeding::{mix64, rng};
+use crate::seeding::rng;
 use anyhow::{bail, Context, Result};
 use glam::DVec3;
 use nuld_core::brdf::alpha;
@@ -110,16 +110,6 @@ impl Reference {
     pub fn cache_path(dir: &Path, key: u64) -> PathBuf {
         dir.join(format!("reference-{key:016x}.bin"))
     }
-}
-
-/// A 64-bit hash of `bytes` (for cache keys; not cryptographic): FNV-1a folded
-/// through [`mix64`].
-pub fn content_hash(bytes: &[u8]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for &b in bytes {
-        h = (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    mix64(h)
 }
 
 /// The pixel's MIS estimate and its standard error.

@@ -7,24 +7,26 @@
 //! `errors/T-S-N.png` (absolute error against the reference, white at twice
 //! Owen-Sobol's RMSE of the same technique and spp), `fig8-brdf.png`,
 //! `fig8-envmap.png` (and `-errors` twins: rows = samplers, columns = spp), and
-//! the baked blobs `brdf-nN/` it needed. Every file is written atomically.
+//! the baked blobs `brdf-nN/` and `envmap-nN/` it needed. Every file is written
+//! atomically.
 
-use super::blobs::BrdfBlobs;
+use super::blobs::{BrdfBlobs, SamplerBlobs};
 use super::brdf_warp::LobeTable;
 use super::camera::Camera;
 use super::environment::Environment;
 use super::integrator::{Image, Primary, Setup};
 use super::lineup::{self, BRDF_SAMPLERS, ENVMAP_SAMPLERS};
 use super::picture::{error_map, exposure, tone_map, Picture};
-use super::reference::{content_hash, Reference};
+use super::reference::Reference;
 use super::sampler::Technique;
 use super::scene::Scene;
 use super::summary::{csv, errors, markdown, Row};
-use crate::conditional::bake::BakeConfig;
+use crate::conditional::bake::{BakeConfig, ENVMAP_GRID, ENVMAP_WEIGHT_GRID};
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render_composite, Composite, Tile};
 use crate::progress::Progress;
-use crate::train::TrainConfig;
+use crate::seeding::content_hash;
+use crate::train::{TrainConfig, TrainTarget};
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -44,8 +46,13 @@ pub struct RenderConfig {
     pub reference_samples: u32,
     /// Given BRDF sampler blobs (one per set size).
     pub brdf_blobs: Vec<PathBuf>,
-    /// How missing blobs are baked (`train.n` is set per sample count).
+    /// Given environment sampler blobs of the map (one per set size).
+    pub envmap_blobs: Vec<PathBuf>,
+    /// How missing BRDF blobs are baked (`train.n` is set per sample count).
     pub bake: BakeConfig,
+    /// How missing environment blobs are baked: these settings
+    /// [`with_envmap`](BakeConfig::with_envmap) the render's map.
+    pub envmap_bake: BakeConfig,
     /// Fixes every pixel key, pool set and reference sample.
     pub seed: u64,
 }
@@ -61,7 +68,13 @@ impl RenderConfig {
             height: 240,
             reference_samples: 4096,
             brdf_blobs: Vec::new(),
+            envmap_blobs: Vec::new(),
             bake: BakeConfig::default(),
+            envmap_bake: BakeConfig {
+                grid: ENVMAP_GRID,
+                weight_grid: ENVMAP_WEIGHT_GRID,
+                ..BakeConfig::default()
+            },
             seed: 0,
         }
     }
@@ -70,30 +83,32 @@ impl RenderConfig {
     /// samples per pixel, missing blobs baked in a few steps (a tiny network that
     /// is barely trained: it exercises the path, not the quality).
     pub fn quick(envmap: PathBuf) -> Self {
+        let bake = BakeConfig {
+            train: TrainConfig {
+                hidden: vec![8],
+                steps: 4,
+                pretrain_steps: 4,
+                conditions_per_step: 2,
+                instances_per_condition: 2,
+                pool_conditions: 4,
+                pool_caps: 64,
+                caps_per_step: 32,
+                ..TrainConfig::default()
+            },
+            instances: 4,
+            grid: [3, 3],
+            weight_grid: [8, 8],
+            quality_grid: 0,
+            checkpoint_every: Duration::from_secs(3600),
+            ..BakeConfig::default()
+        };
         Self {
             spp: vec![4, 16],
             width: 32,
             height: 24,
             reference_samples: 256,
-            bake: BakeConfig {
-                train: TrainConfig {
-                    hidden: vec![8],
-                    steps: 4,
-                    pretrain_steps: 4,
-                    conditions_per_step: 2,
-                    instances_per_condition: 2,
-                    pool_conditions: 4,
-                    pool_caps: 64,
-                    caps_per_step: 32,
-                    ..TrainConfig::default()
-                },
-                instances: 4,
-                grid: [3, 3],
-                weight_grid: [8, 8],
-                quality_grid: 0,
-                checkpoint_every: Duration::from_secs(3600),
-                ..BakeConfig::default()
-            },
+            envmap_bake: bake.clone(),
+            bake,
             ..Self::full(envmap)
         }
     }
@@ -127,10 +142,17 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
         .with_context(|| format!("cannot read environment map {}", config.envmap.display()))?;
     let env = Environment::from_file(&config.envmap)?;
     let mut blobs = BrdfBlobs::read(&config.brdf_blobs)?;
+    let mut envmap_blobs = SamplerBlobs::read_envmap(&config.envmap_blobs, &env)?;
     ensure_dir(out)?;
     ensure_dir(&out.join("images"))?;
     ensure_dir(&out.join("errors"))?;
     blobs.complete(&config.spp, out, &config.bake)?;
+    let map_target = TrainTarget::Envmap {
+        path: config.envmap.clone(),
+        content_hash: content_hash(&map_bytes),
+    };
+    let envmap_template = config.envmap_bake.clone().with_envmap(map_target);
+    envmap_blobs.complete(&config.spp, out, &envmap_template)?;
 
     let scene = Scene::spheres_on_ground();
     let camera = Camera::evaluation(config.width, config.height);
@@ -200,8 +222,17 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
         let (blob_path, bytes) = blobs
             .get(n)
             .with_context(|| format!("no BRDF blob with N = {n}"))?;
-        let samplers = lineup::samplers(bytes, n, config.seed, &lobes, &env)
-            .with_context(|| format!("BRDF blob {}", blob_path.display()))?;
+        let (envmap_path, envmap_bytes) = envmap_blobs
+            .get(n)
+            .with_context(|| format!("no environment blob with N = {n}"))?;
+        let samplers = lineup::samplers(bytes, Some(envmap_bytes), n, config.seed, &lobes, &env)
+            .with_context(|| {
+                format!(
+                    "blobs {} and {}",
+                    blob_path.display(),
+                    envmap_path.display()
+                )
+            })?;
         for sampler in &samplers {
             progress.set_context(format!(
                 "{} {} {n} spp",

@@ -12,7 +12,7 @@ use nuld_core::blob::{
     SECTION_ENTRY_LEN,
 };
 use nuld_core::brdf::{MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
-use nuld_core::conditional::{ConditionalInfo, PointWarp};
+use nuld_core::conditional::{ConditionalInfo, ConditionalTarget, PointWarp};
 use nuld_core::network::{
     Activation, DOT_LANES, INPUTS, LATTICE_LOGIT_EPS, MAX_HIDDEN_LAYERS, MAX_WIDTH, OUTPUTS,
 };
@@ -138,6 +138,10 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_POINT_SET_DOMAIN", at!(PointSetInfo, domain)),
         ("NULD_WARP_EQUAL_AREA", PointWarp::EqualArea as u64),
         ("NULD_WARP_BRDF_MIXTURE", PointWarp::BrdfMixture as u64),
+        (
+            "NULD_TARGET_ENVMAP_NORMAL",
+            ConditionalTarget::EnvmapNormal as u64,
+        ),
         ("NULD_INPUTS", INPUTS as u64),
         ("NULD_MAX_WIDTH", MAX_WIDTH as u64),
         ("NULD_MAX_HIDDEN_LAYERS", MAX_HIDDEN_LAYERS as u64),

@@ -27,9 +27,11 @@
 pub mod checkpoint;
 pub mod pool;
 pub mod speed;
+pub mod target;
 
 pub use checkpoint::Checkpoint;
 pub use pool::{ConditionPool, PoolCondition};
+pub use target::TrainTarget;
 
 use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use crate::discrepancy::GradientPath;
@@ -38,7 +40,6 @@ use crate::optimize::adam::Adam;
 use crate::optimize::epoch_schedule;
 use crate::seeding::rng;
 use glam::{DVec2, DVec3};
-use nuld_core::blob::Domain;
 use nuld_core::network::{Activation, Shape};
 use rand::Rng;
 use rayon::prelude::*;
@@ -47,6 +48,9 @@ use serde::{Deserialize, Serialize};
 /// Settings of a training run. Defaults chosen by measurement (README.md).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrainConfig {
+    /// What the sampler samples (the glTF BRDF unless given).
+    #[serde(default)]
+    pub target: TrainTarget,
     /// Points per set `N`.
     pub n: u32,
     /// Hidden widths.
@@ -91,6 +95,7 @@ pub struct TrainConfig {
 impl Default for TrainConfig {
     fn default() -> Self {
         Self {
+            target: TrainTarget::GltfBrdf,
             n: 64,
             hidden: vec![32, 32],
             silu: false,
@@ -186,20 +191,22 @@ pub struct Trainer {
 const TOURNAMENT: usize = 4;
 
 impl Trainer {
-    /// A fresh trainer (parameters from the seed) or one resuming `resume`.
+    /// A fresh trainer (parameters from the seed) or one resuming `resume`; an
+    /// error if the target's data cannot be read ([`ConditionPool::new`]).
     ///
     /// # Panics
     /// If the configuration's shape is invalid, or `resume` was written for another
     /// configuration.
-    pub fn new(config: TrainConfig, resume: Option<Checkpoint>) -> Self {
+    pub fn new(config: TrainConfig, resume: Option<Checkpoint>) -> anyhow::Result<Self> {
         let shape = config.shape().expect("valid network shape");
         let pool = ConditionPool::new(
+            &config.target,
             config.pool_conditions,
             config.pool_caps,
             config.caps_per_step,
             &shape,
             config.seed,
-        );
+        )?;
         let state = match resume {
             Some(c) => {
                 assert_eq!(c.config, config, "checkpoint of another configuration");
@@ -210,12 +217,12 @@ impl Trainer {
                 Checkpoint::fresh(config.clone(), params.values, pool.len())
             }
         };
-        Self {
+        Ok(Self {
             config,
             pool,
             state,
             shape,
-        }
+        })
     }
 
     /// The current parameters.
@@ -382,7 +389,7 @@ fn condition_step(
         }
     }
     let local: Vec<f64> = dirs.iter().map(|&x| pc.local_factor(x)).collect();
-    let spacing = |points: usize| (Domain::Hemisphere.area() / points as f64).sqrt();
+    let spacing = |points: usize| (pc.domain.area() / points as f64).sqrt();
     let mut grad3 = vec![DVec3::ZERO; s * n];
     let mut g = vec![DVec3::ZERO; s * n];
     let mut set_loss = 0.0;
@@ -458,7 +465,7 @@ mod tests {
             .build()
             .unwrap();
         pool.install(|| {
-            let mut t = Trainer::new(config.clone(), None);
+            let mut t = Trainer::new(config.clone(), None).unwrap();
             while !t.done() {
                 t.step();
             }
@@ -484,11 +491,11 @@ mod tests {
     #[test]
     fn a_resumed_run_continues_bit_identically() {
         let cfg = tiny();
-        let mut straight = Trainer::new(cfg.clone(), None);
+        let mut straight = Trainer::new(cfg.clone(), None).unwrap();
         while !straight.done() {
             straight.step();
         }
-        let mut first = Trainer::new(cfg.clone(), None);
+        let mut first = Trainer::new(cfg.clone(), None).unwrap();
         for _ in 0..4 {
             first.step();
         }
@@ -497,7 +504,7 @@ mod tests {
         let path = dir.join("checkpoint.bin");
         first.state.save(&path).unwrap();
         drop(first);
-        let mut resumed = Trainer::new(cfg, Some(Checkpoint::load(&path).unwrap()));
+        let mut resumed = Trainer::new(cfg, Some(Checkpoint::load(&path).unwrap())).unwrap();
         assert_eq!(resumed.state.step, 4);
         while !resumed.done() {
             resumed.step();
@@ -525,7 +532,7 @@ mod tests {
             mixture_prior: false,
             ..TrainConfig::default()
         };
-        let mut t = Trainer::new(cfg, None);
+        let mut t = Trainer::new(cfg, None).unwrap();
         let mut losses = Vec::new();
         while !t.done() {
             losses.push(t.step().loss);

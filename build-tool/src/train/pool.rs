@@ -9,21 +9,29 @@
 //! measures are computed once. A step picks conditions from the pool and a window
 //! of `M` of each one's caps. The caps are measured with a `2^14`-point rule
 //! ([`BrdfTarget::coarse`], [`POOL_RULE_POINTS`]): the pool is paid once, nothing per step.
+//!
+//! An environment sampler's pool ([`TrainTarget::Envmap`]) holds normals instead,
+//! spread uniformly over the sphere (the condition is the normal's equal-area
+//! octahedral square point), each with the caps of `q(l | n) ∝ L(l) max(0, n.l)`
+//! measured on the mass-adaptive rule of [`EnvmapDensity::cosine_weighted`].
 
+use super::target::{LoadedTarget, TrainTarget};
 use crate::baselines::warped_owen_sobol_directions;
 use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use crate::discrepancy::GradientPath;
 use crate::optimize::directions::map_jacobian;
 use crate::optimize::directions::{epoch_caps, local_factor};
 use crate::seeding::derive_seed;
-use crate::sphere::{BrdfTarget, DirectionDensity};
+use crate::sphere::{BrdfTarget, CapMeasureTable, DirectionDensity, EnvmapDensity};
+use anyhow::Result;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
 use nuld_core::brdf::{view_direction, BrdfModel, CONDITION_MAX, CONDITION_MIN};
 use nuld_core::conditional::PointWarp;
 use nuld_core::network::{instance_offset, shifted_lattice_point, Shape};
-use nuld_core::sphere::hemisphere_to_square;
+use nuld_core::sphere::{hemisphere_to_square, sphere_to_square, square_to_sphere};
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// Points of the rule that measures a pool condition's caps: `2^14`, 1/16 of a
 /// [`BrdfTarget::new`]'s, so that building the pool costs seconds, not minutes.
@@ -35,16 +43,37 @@ pub fn normalized(cond: [f64; 2]) -> [f64; 2] {
     core::array::from_fn(|a| (cond[a] - CONDITION_MIN[a]) / (CONDITION_MAX[a] - CONDITION_MIN[a]))
 }
 
+/// What a condition's target density is made of.
+pub enum ConditionDensity {
+    /// The glTF BRDF at a view.
+    Brdf {
+        /// View direction.
+        wo: DVec3,
+        /// Directional albedo, the normalizer of the target density.
+        albedo: f64,
+    },
+    /// An environment map through the cosine about a normal.
+    Envmap {
+        /// The unit normal.
+        normal: DVec3,
+        /// The map, shared by the pool.
+        map: Arc<EnvmapDensity>,
+        /// `1 / ∫ pdf_map(l) max(0, n.l) dl`, the normalizer.
+        scale: f64,
+    },
+}
+
 /// One training condition: what a step needs to score a set for it.
 pub struct PoolCondition {
-    /// `(roughness, theta_o in degrees)`.
+    /// The condition in blob units: `(roughness, theta_o in degrees)` for the
+    /// BRDF, the normal's octahedral square point for a map.
     pub cond: [f64; 2],
     /// [`normalized`] `cond`, the network's condition input.
     pub unit: [f64; 2],
-    /// View direction.
-    pub wo: DVec3,
-    /// Directional albedo, the normalizer of the target density.
-    pub albedo: f64,
+    /// The target density's ingredients.
+    pub density: ConditionDensity,
+    /// Where the directions live.
+    pub domain: Domain,
     /// The caps.
     pub caps: Vec<Cap>,
     /// Their target measures.
@@ -58,22 +87,30 @@ pub struct PoolCondition {
     /// window of caps: the scale against which the trainer ranks conditions.
     pub baseline_loss: f64,
     /// The specular share `p_s = A_spec / A` of the albedo, the mixture warp's lobe
-    /// probability.
+    /// probability (0 for a map).
     pub lobe_probability: f64,
     /// How the network's points become directions ([`PointWarp::of_shape`]).
     pub warp: PointWarp,
 }
 
 impl PoolCondition {
-    /// Target density `q(x) = f(wo, x) (n.x) / A` at direction `x`.
+    /// Target density at direction `x`: `q(x) = f(wo, x) (n.x) / A` for the BRDF,
+    /// `pdf_map(x) max(0, n.x) scale` for a map.
     pub fn pdf(&self, x: DVec3) -> f64 {
-        BrdfModel::Gltf.cosine_weighted(self.wo, x, self.cond[0]) / self.albedo
+        match &self.density {
+            ConditionDensity::Brdf { wo, albedo } => {
+                BrdfModel::Gltf.cosine_weighted(*wo, x, self.cond[0]) / albedo
+            }
+            ConditionDensity::Envmap { normal, map, scale } => {
+                map.pdf(x) * normal.dot(x).max(0.0) * scale
+            }
+        }
     }
 
-    /// Local sharpness factor `sqrt(2 pi q(x))`, clamped (direction optimizer's
+    /// Local sharpness factor `sqrt(area q(x))`, clamped (direction optimizer's
     /// local units).
     pub fn local_factor(&self, x: DVec3) -> f64 {
-        local_factor(Domain::Hemisphere.area(), self.pdf(x))
+        local_factor(self.domain.area(), self.pdf(x))
     }
 
     /// The direction of the network's point `p` ([`PointWarp::direction`]) and its
@@ -83,20 +120,20 @@ impl PoolCondition {
     pub fn direction(&self, p: DVec2) -> (DVec3, DVec3, DVec3) {
         let warp = |u: DVec2| {
             DVec3::from_array(self.warp.direction(
-                Domain::Hemisphere,
+                self.domain,
                 self.cond,
                 self.lobe_probability,
                 u.to_array(),
             ))
         };
         if self.warp == PointWarp::EqualArea {
-            let (jx, jy) = map_jacobian(Domain::Hemisphere, p);
+            let (jx, jy) = map_jacobian(self.domain, p);
             return (warp(p), jx, jy);
         }
         let [jx, jy] = self
             .warp
             .direction_differences(
-                Domain::Hemisphere,
+                self.domain,
                 self.cond,
                 self.lobe_probability,
                 p.to_array(),
@@ -146,12 +183,23 @@ fn warp_targets(target: &BrdfTarget, shape: &Shape) -> Vec<DVec2> {
 pub struct ConditionPool {
     /// Conditions in pool order.
     pub conditions: Vec<PoolCondition>,
+    /// The target's data, as read once for the pool (distillation reuses it).
+    pub target: LoadedTarget,
 }
 
 impl ConditionPool {
-    /// `count` conditions with `caps` caps each, for the sets of a network of
-    /// `shape`, from `seed`; built in parallel, identical for any thread count.
-    pub fn new(count: usize, caps: usize, window: usize, shape: &Shape, seed: u64) -> Self {
+    /// `count` conditions of `target` with `caps` caps each, for the sets of a
+    /// network of `shape`, from `seed`; built in parallel, identical for any thread
+    /// count. An error if a map cannot be read, or a normal receives no light.
+    pub fn new(
+        target: &TrainTarget,
+        count: usize,
+        caps: usize,
+        window: usize,
+        shape: &Shape,
+        seed: u64,
+    ) -> Result<Self> {
+        let loaded = target.load()?;
         let scramble = derive_seed(seed, 0x706f_6f6c) as u32;
         let conditions = (0..count)
             .into_par_iter()
@@ -160,13 +208,24 @@ impl ConditionPool {
                     sobol_burley::sample(p as u32, 0, scramble) as f64,
                     sobol_burley::sample(p as u32, 1, scramble) as f64,
                 ];
-                let cond: [f64; 2] = core::array::from_fn(|a| {
-                    CONDITION_MIN[a] + u[a] * (CONDITION_MAX[a] - CONDITION_MIN[a])
-                });
-                condition(cond, caps, window, shape, derive_seed(seed, p as u64))
+                let seed = derive_seed(seed, p as u64);
+                match &loaded {
+                    LoadedTarget::GltfBrdf => {
+                        let cond: [f64; 2] = core::array::from_fn(|a| {
+                            CONDITION_MIN[a] + u[a] * (CONDITION_MAX[a] - CONDITION_MIN[a])
+                        });
+                        Ok(condition(cond, caps, window, shape, seed))
+                    }
+                    LoadedTarget::Envmap(map) => {
+                        envmap_condition(map, u, caps, window, shape, seed)
+                    }
+                }
             })
-            .collect();
-        Self { conditions }
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Self {
+            conditions,
+            target: loaded,
+        })
     }
 
     /// Number of conditions.
@@ -198,8 +257,11 @@ fn condition(
     let pc = PoolCondition {
         cond,
         unit: normalized(cond),
-        wo: view_direction(cond[1]),
-        albedo: target.albedo(),
+        density: ConditionDensity::Brdf {
+            wo: view_direction(cond[1]),
+            albedo: target.albedo(),
+        },
+        domain: Domain::Hemisphere,
         caps,
         measures,
         warp_targets: warp_targets(&target, shape),
@@ -207,21 +269,138 @@ fn condition(
         lobe_probability: target.lobe_probability(),
         warp: PointWarp::of_shape(shape),
     };
-    let w = window.min(pc.caps.len());
     let pts = warped_owen_sobol_directions(&target, n, seed);
-    let local: Vec<f64> = pts.iter().map(|&x| pc.local_factor(x)).collect();
-    let mut g = vec![DVec3::ZERO; n];
-    let baseline_loss = cap_loss_and_gradient(
-        &pts,
-        &pc.caps[..w],
-        CapArea::Precomputed(&pc.measures[..w]),
-        1.0,
-        Some(&local),
-        GradientPath::Fast,
-        &mut g,
-    );
     PoolCondition {
-        baseline_loss,
+        baseline_loss: pc.window_loss(&pts, window),
         ..pc
+    }
+}
+
+impl PoolCondition {
+    /// Cap loss of `pts` on the first window of `window` caps at sharpness 1:
+    /// the baseline's score ([`PoolCondition::baseline_loss`]).
+    fn window_loss(&self, pts: &[DVec3], window: usize) -> f64 {
+        let w = window.min(self.caps.len());
+        let local: Vec<f64> = pts.iter().map(|&x| self.local_factor(x)).collect();
+        let mut g = vec![DVec3::ZERO; pts.len()];
+        cap_loss_and_gradient(
+            pts,
+            &self.caps[..w],
+            CapArea::Precomputed(&self.measures[..w]),
+            1.0,
+            Some(&local),
+            GradientPath::Fast,
+            &mut g,
+        )
+    }
+}
+
+/// The pool condition of the normal whose octahedral square point is `u`: caps
+/// measured on the mass-adaptive rule of the map lit through the cosine about the
+/// normal; pretraining targets and the baseline from that density's inverse CDF
+/// (what the renderer's map sampler would do for this normal alone).
+fn envmap_condition(
+    map: &Arc<EnvmapDensity>,
+    u: [f64; 2],
+    caps: usize,
+    window: usize,
+    shape: &Shape,
+    seed: u64,
+) -> Result<PoolCondition> {
+    let n = shape.n() as usize;
+    let normal = square_to_sphere(DVec2::from(u));
+    let lit = map.cosine_weighted(normal)?;
+    let table = CapMeasureTable::new(&lit.mass_rule(POOL_RULE_POINTS));
+    let caps = epoch_caps(seed, 0, caps);
+    let measures: Vec<f64> = caps
+        .iter()
+        .map(|c| table.measure(c.center, c.cos_theta))
+        .collect();
+    // A normal that no light reaches trains on the cosine lobe (its weight is 0).
+    let share = map.irradiance(normal) / map.integral();
+    let warp = PointWarp::of_shape(shape);
+    // A lattice residual is a warp of the BRDF mixture's primary space only.
+    anyhow::ensure!(
+        warp == PointWarp::EqualArea,
+        "environment samplers use the equal-area output (no mixture prior)"
+    );
+    let warp_targets = (0..PRETRAIN_INSTANCES)
+        .flat_map(|k| {
+            let z = instance_offset::<f64>(k);
+            let g = shape.lattice_generator();
+            let lit = &lit;
+            (0..shape.n()).map(move |i| {
+                let p = shifted_lattice_point(i, shape.n(), g, z);
+                sphere_to_square(lit.sample(DVec2::new(p[0], p[1])))
+            })
+        })
+        .collect();
+    let mut pc = PoolCondition {
+        cond: u,
+        unit: u,
+        density: ConditionDensity::Envmap {
+            normal,
+            map: Arc::clone(map),
+            scale: if share > 0.0 { 1.0 / share } else { 0.0 },
+        },
+        domain: Domain::Sphere,
+        caps,
+        measures,
+        warp_targets,
+        baseline_loss: 0.0,
+        lobe_probability: 0.0,
+        warp,
+    };
+    pc.baseline_loss = pc.window_loss(&warped_owen_sobol_directions(&lit, n, seed), window);
+    Ok(pc)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nuld_core::network::Activation;
+
+    /// An environment pool condition measures its caps on the lit map: a cap a
+    /// little wider than the hemisphere about the normal holds all the mass, one a
+    /// little narrower than the opposite hemisphere none (the tiny map's pixels are
+    /// 11 degrees tall, and a pixel lit at its centre reaches below the horizon), and
+    /// the density integrates to 1 (midpoint rule on the sphere's equal-area square).
+    #[test]
+    fn envmap_conditions_hold_the_lit_map() {
+        let dir = std::env::temp_dir().join(format!("nuld-pool-envmap-{}", std::process::id()));
+        let map = crate::render::blobs::tiny_map(&dir);
+        let shape = Shape::new(8, &[4], Activation::Relu, 3).unwrap();
+        let pool =
+            ConditionPool::new(&TrainTarget::envmap(&map).unwrap(), 3, 64, 32, &shape, 5).unwrap();
+        let LoadedTarget::Envmap(density) = &pool.target else {
+            panic!("an envmap target")
+        };
+        for pc in &pool.conditions {
+            let ConditionDensity::Envmap { normal, .. } = pc.density else {
+                panic!("an envmap condition")
+            };
+            assert_eq!(pc.domain, Domain::Sphere);
+            let lit = density.cosine_weighted(normal).unwrap();
+            let table = CapMeasureTable::new(&lit.mass_rule(POOL_RULE_POINTS));
+            assert!((table.measure(normal, -0.2) - 1.0).abs() < 1e-9);
+            assert!(table.measure(-normal, 0.2) < 1e-9);
+            assert!(table.measure(normal, 0.0) > 0.95);
+            let k = 256;
+            let integral: f64 = (0..k * k)
+                .map(|j| {
+                    let p = DVec2::new(
+                        ((j % k) as f64 + 0.5) / k as f64,
+                        ((j / k) as f64 + 0.5) / k as f64,
+                    );
+                    pc.pdf(square_to_sphere(p))
+                })
+                .sum::<f64>()
+                * Domain::Sphere.area()
+                / (k * k) as f64;
+            assert!((integral - 1.0).abs() < 0.02, "{integral}");
+            assert!(pc.baseline_loss > 0.0 && pc.baseline_loss.is_finite());
+            assert_eq!(pc.warp_targets.len(), (PRETRAIN_INSTANCES * 8) as usize);
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

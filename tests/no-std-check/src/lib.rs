@@ -75,7 +75,8 @@ pub unsafe extern "C" fn nuld_check_direction(
 /// Writes sample `i` of instance `instance` of the conditional blob to
 /// `out[0..4]` (direction, weight) in the given mode: 0 table mode at
 /// `(c0, c1)`, 1 network mode at `(c0, c1)`, 2 `sample_brdf` with the view
-/// `(c1, 0, 1)` and roughness `c0`. Returns 0 on success, 1 otherwise.
+/// `(c1, 0, 1)` and roughness `c0`, 3 `sample_envmap` at the normal `(c0, c1, 1)`.
+/// Returns 0 on success, 1 otherwise.
 ///
 /// # Safety
 /// `ptr` must be valid for `len` bytes and `out` for four `f32` writes.
@@ -98,7 +99,8 @@ pub unsafe extern "C" fn nuld_check_conditional(
             let s = match mode {
                 0 => cs.sample(Vec2::new(c0, c1), instance, i),
                 1 => cs.sample_network(Vec2::new(c0, c1), instance, i),
-                _ => cs.sample_brdf(Vec3::new(c1, 0.0, 1.0), c0, instance, i),
+                2 => cs.sample_brdf(Vec3::new(c1, 0.0, 1.0), c0, instance, i),
+                _ => cs.sample_envmap(Vec3::new(c0, c1, 1.0), instance, i),
             };
             *out = s.direction.x;
             *out.add(1) = s.direction.y;
