@@ -583,6 +583,54 @@ fn sample_prints_what_the_runtime_serves_and_rejects_bad_input() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `bake` and `sample` on environment samplers: one-line errors for a missing map,
+/// two targets at once, a normal given to a BRDF blob, or both `--cond` and
+/// `--normal`; nothing written.
+#[test]
+fn envmap_bake_and_sample_reject_bad_input_with_one_line() {
+    let dir = scratch("envmap-bad");
+    let out = dir.join("never");
+    let missing = dir.join("missing.hdr");
+    let e = failure(&["bake", "--envmap", missing.to_str().unwrap()], &out);
+    assert!(
+        e.contains("cannot read environment map") && e.contains("missing.hdr"),
+        "{e}"
+    );
+    assert_eq!(e.trim().lines().count(), 1, "{e}");
+    let e = failure(&["bake", "--brdf", "--envmap", "x.hdr"], &out);
+    assert!(e.contains("cannot be used with"), "{e}");
+    let e = failure(&["bake"], &out);
+    assert!(e.contains("--brdf or --envmap MAP"), "{e}");
+    assert!(!out.exists());
+    let file = dir.join("brdf.nuld");
+    conditional_blob(&file);
+    for args in [
+        vec!["--normal", "0,0,1"],
+        vec!["--normal", "0,0,0"],
+        vec!["--cond", "0.5,30", "--normal", "0,0,1"],
+        vec![],
+    ] {
+        let o = build_tool()
+            .arg("sample")
+            .arg(&file)
+            .args(&args)
+            .output()
+            .unwrap();
+        assert!(!o.status.success(), "{args:?}");
+        assert!(o.stdout.is_empty(), "{args:?}");
+        let err = String::from_utf8(o.stderr).unwrap();
+        assert!(!err.trim().is_empty(), "{args:?}");
+        if args == ["--normal", "0,0,1"] {
+            assert_eq!(err.trim().lines().count(), 1, "{err}");
+            assert!(
+                err.contains("--normal needs an environment sampler"),
+                "{err}"
+            );
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// `build-tool shader` writes each language's kernel to `--out` (the same bytes
 /// the library translates), prints it to stdout without `--out`, and fails with one
 /// line and no file for an unwritable path or an unknown language.

@@ -30,13 +30,13 @@ pub enum Command {
     Sobol(sobol::SobolArgs),
     /// Print a blob's points as CSV: `set,index,x,y` (2D) or `set,index,x,y,z`.
     Export(export::ExportArgs),
-    /// Print a conditional blob's samples at one condition as CSV: `index,x,y,z,weight`.
+    /// Print a conditional blob's samples at one condition (--cond) or normal (--normal) as CSV: `index,x,y,z,weight`.
     Sample(sample::SampleArgs),
     /// Optimize point sets for a target density: DIR/set.nuld, report.json, set.png.
     Optimize(optimize::OptimizeArgs),
     /// Exact discrepancies of a blob's point sets against a target density.
     Metrics(metrics::MetricsArgs),
-    /// Train and distill a conditional sampler (--brdf): DIR/brdf.nuld, report.json, loss.png, sets.png.
+    /// Train and distill a conditional sampler (--brdf, or --envmap MAP): DIR/brdf.nuld or DIR/envmap.nuld, report.json, loss.png, sets.png.
     Bake(bake::BakeArgs),
     /// Time the optimizer: fast vs dense gradient per epoch, and full default runs.
     Bench(bench::BenchArgs),

@@ -155,7 +155,6 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
             nuld_core::network::MAX_WIDTH
         );
     }
-    crate::output::ensure_dir(out)?;
     let ckpt_path = checkpoint_path(out);
     let resume = if config.resume {
         let c = Checkpoint::load(&ckpt_path)?;
@@ -173,6 +172,8 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     let t = Instant::now();
     let mut trainer = Trainer::new(config.train.clone(), resume)?;
     timings.pool_s = t.elapsed().as_secs_f64();
+    // Only now: a map that cannot be read leaves no directory behind.
+    crate::output::ensure_dir(out)?;
 
     let t = Instant::now();
     let progress = Progress::stderr("bake", trainer.total_steps() as u64, "step");
