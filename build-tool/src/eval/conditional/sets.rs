@@ -107,6 +107,10 @@ impl ConditionalSets for MixtureOwenSobol {
 pub fn blob_sets(bytes: &[u8]) -> Result<Vec<Box<dyn ConditionalSets + '_>>> {
     let blob = nuld_runtime::Blob::parse(bytes).map_err(|e| anyhow::anyhow!("{e}"))?;
     let cs = blob.conditional().map_err(|e| anyhow::anyhow!("{e}"))?;
+    anyhow::ensure!(
+        cs.target() == nuld_runtime::ConditionalTarget::GltfBrdf,
+        "eval conditional judges glTF BRDF samplers; this blob samples an environment map (bake --envmap)"
+    );
     let n = cs.len() as usize;
     let cond = |r: f64, t: f64| nuld_runtime::glam::Vec2::new(r as f32, t as f32);
     let table = SampleFnSets::new("table", n, move |r, t, k, i| {
@@ -116,4 +120,23 @@ pub fn blob_sets(bytes: &[u8]) -> Result<Vec<Box<dyn ConditionalSets + '_>>> {
         cs.sample_network(cond(r, t), k, i).direction.as_dvec3()
     });
     Ok(vec![Box::new(table), Box::new(network)])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// BRDF blobs give their two modes; an environment blob is refused by name.
+    #[test]
+    fn blob_sets_take_brdf_blobs_only() {
+        let brdf = nuld_runtime::doc_example_conditional_blob();
+        let sets = blob_sets(&brdf.0).unwrap();
+        assert_eq!(sets.len(), 2);
+        let dir = std::env::temp_dir().join(format!("nuld-blob-sets-{}", std::process::id()));
+        let map = crate::render::blobs::tiny_map(&dir);
+        let env = crate::render::blobs::tiny_envmap_blob(4, &map);
+        let e = blob_sets(env.as_slice()).err().unwrap().to_string();
+        assert!(e.contains("bake --envmap"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
