@@ -297,26 +297,36 @@ impl<'a> ConditionalSampler<'a> {
     /// [`Self::square_point`] at the normalized condition `u`.
     #[inline]
     fn square_point_at(&self, u: [f32; 2], instance: u32, i: u32) -> Vec2 {
+        let (cell, corner) = self.table_corners(u, instance, i);
+        let (p00, p10, p01, p11) = (corner(0, 0), corner(1, 0), corner(0, 1), corner(1, 1));
+        let axis = |a: usize| cell.lerp(p00[a], p10[a], p01[a], p11[a]);
+        Vec2::new(axis(0), axis(1))
+    }
+
+    /// The point-table cell of the normalized condition `u` and the stored square
+    /// point of its corner `(dx, dy)` for index `i` (mod `n`) of instance
+    /// `instance` (mod `S`), decoded by `(q + 0.5) / 65536`: what both table
+    /// modes interpolate.
+    #[inline]
+    fn table_corners(
+        &self,
+        u: [f32; 2],
+        instance: u32,
+        i: u32,
+    ) -> (GridCell, impl Fn(u32, u32) -> [f32; 2] + '_) {
         let info = &self.info;
         let cell = GridCell::locate(u, info.grid);
         let k = instance.checked_rem(info.instances).unwrap_or(0);
         let j = i.checked_rem(info.n).unwrap_or(0);
-        let code = |dx, dy| {
+        let corner = move |dx, dy| {
             let at = info.point_table_index(cell.node(dx, dy), k, j);
-            self.table
+            let q = self
+                .table
                 .get(at)
-                .map_or([CENTRE_CODE; 2], |&w| unpack_point(w))
+                .map_or([CENTRE_CODE; 2], |&w| unpack_point(w));
+            [unorm16_decode(q[0]), unorm16_decode(q[1])]
         };
-        let (c00, c10, c01, c11) = (code(0, 0), code(1, 0), code(0, 1), code(1, 1));
-        let axis = |a: usize| {
-            cell.lerp(
-                unorm16_decode(c00[a]),
-                unorm16_decode(c10[a]),
-                unorm16_decode(c01[a]),
-                unorm16_decode(c11[a]),
-            )
-        };
-        Vec2::new(axis(0), axis(1))
+        (cell, corner)
     }
 
     /// Network mode's point of the unit square for index `i` (mod `n`) of any
@@ -381,20 +391,9 @@ impl<'a> ConditionalSampler<'a> {
     /// domain's equal-area map in `f32`, then [`GridCell::nlerp`].
     #[inline]
     fn table_direction_at(&self, u: [f32; 2], instance: u32, i: u32) -> [f32; 3] {
-        let info = &self.info;
-        let cell = GridCell::locate(u, info.grid);
-        let k = instance.checked_rem(info.instances).unwrap_or(0);
-        let j = i.checked_rem(info.n).unwrap_or(0);
-        let corner = |dx, dy| {
-            let at = info.point_table_index(cell.node(dx, dy), k, j);
-            let q = self
-                .table
-                .get(at)
-                .map_or([CENTRE_CODE; 2], |&w| unpack_point(w));
-            self.domain
-                .to_direction_real([unorm16_decode(q[0]), unorm16_decode(q[1])])
-        };
-        cell.nlerp(corner(0, 0), corner(1, 0), corner(0, 1), corner(1, 1))
+        let (cell, corner) = self.table_corners(u, instance, i);
+        let d = |dx, dy| self.domain.to_direction_real(corner(dx, dy));
+        cell.nlerp(d(0, 0), d(1, 0), d(0, 1), d(1, 1))
     }
 
     /// Table mode for an environment sampler ([`ConditionalTarget::EnvmapNormal`])
@@ -526,13 +525,9 @@ fn typed_section<'a, T: bytemuck::Pod>(
 /// as `(cos phi, sin phi)`; degenerate views read as normal incidence.
 #[inline]
 fn view_condition(wo: Vec3, roughness: f32) -> (Vec2, Vec2) {
-    // Scaling by the largest component first keeps |wo| finite for huge inputs and
-    // away from underflow for tiny ones.
-    let m = wo.abs().max_element();
-    if !(wo.is_finite() && m > 0.0) {
+    let Some(w) = scaled_to_largest(wo) else {
         return (Vec2::new(roughness, 0.0), Vec2::X);
-    }
-    let w = wo / m;
+    };
     let cos_theta = (w.z / w.length()).clamp(0.0, 1.0);
     let theta = libm::acosf(cos_theta) * DEGREES_PER_RADIAN;
     let planar = libm::sqrtf(w.x * w.x + w.y * w.y);
@@ -544,17 +539,20 @@ fn view_condition(wo: Vec3, roughness: f32) -> (Vec2, Vec2) {
     (Vec2::new(roughness, theta), azimuth)
 }
 
+/// `v` divided by its largest absolute component, or `None` for a zero, infinite
+/// or NaN `v`. Scaling first keeps `|v|` finite for huge inputs and away from
+/// underflow for tiny ones.
+#[inline]
+fn scaled_to_largest(v: Vec3) -> Option<Vec3> {
+    let m = v.abs().max_element();
+    (v.is_finite() && m > 0.0).then(|| v / m)
+}
+
 /// The condition of a normal: its equal-area octahedral square point; a
 /// degenerate normal reads as `+z`.
 #[inline]
 fn normal_condition(n: Vec3) -> Vec2 {
-    let m = n.abs().max_element();
-    let d = if n.is_finite() && m > 0.0 {
-        let w = n / m;
-        w / w.length()
-    } else {
-        Vec3::Z
-    };
+    let d = scaled_to_largest(n).map_or(Vec3::Z, |w| w / w.length());
     Vec2::from_array(nuld_core::sphere::sphere_to_square_real(d.to_array()))
 }
 
