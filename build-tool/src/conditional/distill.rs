@@ -121,8 +121,7 @@ pub fn distill(
     }
 }
 
-/// The irradiance `E(n)` at every weight-grid node's normal, in parallel chunks
-/// of nodes (each value the same sum whatever the thread count).
+/// The irradiance `E(n)` at every weight-grid node's normal.
 fn envmap_weights(info: &ConditionalInfo, map: &EnvmapDensity) -> Vec<f32> {
     let g = info.weight_grid;
     let normals: Vec<_> = (0..g[0] * g[1])
@@ -131,9 +130,8 @@ fn envmap_weights(info: &ConditionalInfo, map: &EnvmapDensity) -> Vec<f32> {
             square_to_sphere(DVec2::from(u))
         })
         .collect();
-    normals
-        .par_chunks(64)
-        .flat_map_iter(|chunk| map.irradiances(chunk))
+    map.irradiances(&normals)
+        .into_iter()
         .map(|e| e as f32)
         .collect()
 }

@@ -43,6 +43,7 @@ use super::target::{normalize_rule, DirectionDensity, DirectionSpecError};
 use crate::density::image::{load_luminance, LuminanceImage, NegativePixels};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
+use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use std::path::Path;
 
@@ -433,7 +434,9 @@ impl EnvmapDensity {
     }
 
     /// [`Self::irradiance`] at each of `normals`, the pixel centres computed once
-    /// (pixels without light skipped). `O(W H + lit pixels x normals)`.
+    /// (pixels without light skipped), the normals in parallel (each sum in pixel
+    /// order, so the values do not depend on the thread count).
+    /// `O(W H + lit pixels x normals)`.
     pub fn irradiances(&self, normals: &[DVec3]) -> Vec<f64> {
         let w = self.width;
         let lit: Vec<(DVec3, f64)> = (0..self.height)
@@ -442,7 +445,7 @@ impl EnvmapDensity {
             .map(|(c, r)| (self.pixel_center(c, r), self.mass[r * w + c]))
             .collect();
         normals
-            .iter()
+            .par_iter()
             .map(|n| {
                 let share: f64 = lit.iter().map(|(d, m)| m * n.dot(*d).max(0.0)).sum();
                 self.integral * share
@@ -452,11 +455,13 @@ impl EnvmapDensity {
 
     /// The density `q(l | n) ∝ L(l) max(0, n.l)` of the map lit through a cosine
     /// about the unit normal `n`, on the sphere: every pixel's luminance times
-    /// `max(0, n.c_p)` at its centre `c_p` (piecewise constant like the map). If no
-    /// light reaches `n` (the map is black above its horizon), the plain cosine
-    /// lobe about `n`: any set serves there, since the estimator's weight `E(n)`
-    /// is 0.
-    pub fn cosine_weighted(&self, n: DVec3) -> Result<Self, DirectionSpecError> {
+    /// `max(0, n.c_p)` at its centre `c_p` (piecewise constant like the map), and
+    /// the irradiance `E(n)` it integrates to (the lit map's
+    /// [`integral`](Self::integral), [`Self::irradiance`]'s sum). If no light
+    /// reaches `n` (the map is black above its horizon), the plain cosine lobe
+    /// about `n` and `E(n) = 0`: any set serves there, since the estimator's
+    /// weight is 0.
+    pub fn cosine_weighted(&self, n: DVec3) -> Result<(Self, f64), DirectionSpecError> {
         let (w, h) = (self.width, self.height);
         let dphi = TAU / w as f64;
         let values = (0..h)
@@ -485,7 +490,9 @@ impl EnvmapDensity {
             height: h,
             values,
         };
-        Self::from_luminance(&img, Domain::Sphere, &self.name)
+        let lit = Self::from_luminance(&img, Domain::Sphere, &self.name)?;
+        let irradiance = if dark { 0.0 } else { lit.integral };
+        Ok((lit, irradiance))
     }
 
     /// Direction of the centre of pixel `(c, r)`.
@@ -703,7 +710,6 @@ mod tests {
     use crate::seeding::rng;
     use crate::sphere::geometry::{random_direction, uniform_hemisphere_cap_measure};
     use rand::Rng;
-    use rayon::prelude::*;
     use std::io::Write;
 
     const COURTYARD: &str = "../../shared/data/envmaps/courtyard.hdr";

@@ -190,7 +190,8 @@ pub struct ConditionPool {
 impl ConditionPool {
     /// `count` conditions of `target` with `caps` caps each, for the sets of a
     /// network of `shape`, from `seed`; built in parallel, identical for any thread
-    /// count. An error if a map cannot be read, or a normal receives no light.
+    /// count. An error if a map cannot be read, or if an environment sampler's
+    /// network has the BRDF mixture's lattice residual.
     pub fn new(
         target: &TrainTarget,
         count: usize,
@@ -200,6 +201,13 @@ impl ConditionPool {
         seed: u64,
     ) -> Result<Self> {
         let loaded = target.load()?;
+        if let LoadedTarget::Envmap(_) = loaded {
+            // A lattice residual is a warp of the BRDF mixture's primary space only.
+            anyhow::ensure!(
+                PointWarp::of_shape(shape) == PointWarp::EqualArea,
+                "environment samplers use the equal-area output (no mixture prior)"
+            );
+        }
         let scramble = derive_seed(seed, 0x706f_6f6c) as u32;
         let conditions = (0..count)
             .into_par_iter()
@@ -309,21 +317,15 @@ fn envmap_condition(
 ) -> Result<PoolCondition> {
     let n = shape.n() as usize;
     let normal = square_to_sphere(DVec2::from(u));
-    let lit = map.cosine_weighted(normal)?;
+    // A normal that no light reaches trains on the cosine lobe (its weight is 0).
+    let (lit, irradiance) = map.cosine_weighted(normal)?;
     let table = CapMeasureTable::new(&lit.mass_rule(POOL_RULE_POINTS));
     let caps = epoch_caps(seed, 0, caps);
     let measures: Vec<f64> = caps
         .iter()
         .map(|c| table.measure(c.center, c.cos_theta))
         .collect();
-    // A normal that no light reaches trains on the cosine lobe (its weight is 0).
-    let share = map.irradiance(normal) / map.integral();
-    let warp = PointWarp::of_shape(shape);
-    // A lattice residual is a warp of the BRDF mixture's primary space only.
-    anyhow::ensure!(
-        warp == PointWarp::EqualArea,
-        "environment samplers use the equal-area output (no mixture prior)"
-    );
+    let share = irradiance / map.integral();
     let warp_targets = (0..PRETRAIN_INSTANCES)
         .flat_map(|k| {
             let z = instance_offset::<f64>(k);
@@ -349,7 +351,7 @@ fn envmap_condition(
         warp_targets,
         baseline_loss: 0.0,
         lobe_probability: 0.0,
-        warp,
+        warp: PointWarp::EqualArea,
     };
     pc.baseline_loss = pc.window_loss(&warped_owen_sobol_directions(&lit, n, seed), window);
     Ok(pc)
@@ -360,11 +362,14 @@ mod tests {
     use super::*;
     use nuld_core::network::Activation;
 
-    /// An environment pool condition measures its caps on the lit map: a cap a
-    /// little wider than the hemisphere about the normal holds all the mass, one a
-    /// little narrower than the opposite hemisphere none (the tiny map's pixels are
-    /// 11 degrees tall, and a pixel lit at its centre reaches below the horizon), and
-    /// the density integrates to 1 (midpoint rule on the sphere's equal-area square).
+    /// An environment pool condition measures its caps on the lit map: its
+    /// measures agree with the exact cap measure of the lit map
+    /// ([`EnvmapDensity::cap_measure`], a quadrature independent of the rule); a
+    /// cap a little wider than the hemisphere about the normal holds all the mass,
+    /// one a little narrower than the opposite hemisphere none (the tiny map's
+    /// pixels are 11 degrees tall, and a pixel lit at its centre reaches below the
+    /// horizon); the lit map integrates to the irradiance; and the density
+    /// integrates to 1 (midpoint rule on the sphere's equal-area square).
     #[test]
     fn envmap_conditions_hold_the_lit_map() {
         let dir = std::env::temp_dir().join(format!("nuld-pool-envmap-{}", std::process::id()));
@@ -380,7 +385,15 @@ mod tests {
                 panic!("an envmap condition")
             };
             assert_eq!(pc.domain, Domain::Sphere);
-            let lit = density.cosine_weighted(normal).unwrap();
+            let (lit, irradiance) = density.cosine_weighted(normal).unwrap();
+            assert!((irradiance / density.irradiance(normal) - 1.0).abs() < 1e-12);
+            let worst = pc
+                .caps
+                .iter()
+                .zip(&pc.measures)
+                .map(|(c, m)| (m - lit.cap_measure(c.center, c.cos_theta)).abs())
+                .fold(0.0, f64::max);
+            assert!(worst < 5e-3, "{worst}");
             let table = CapMeasureTable::new(&lit.mass_rule(POOL_RULE_POINTS));
             assert!((table.measure(normal, -0.2) - 1.0).abs() < 1e-9);
             assert!(table.measure(-normal, 0.2) < 1e-9);
