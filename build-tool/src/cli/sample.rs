@@ -93,14 +93,9 @@ pub fn write_csv(
 ) -> Result<()> {
     let blob = Blob::parse(bytes).map_err(|e| anyhow!("{e}"))?;
     let cs = blob.conditional().map_err(|e| anyhow!("{e}"))?;
-    let envmap = cs.target() == ConditionalTarget::EnvmapNormal;
-    let c = match at {
-        At::Condition(c) => Vec2::from(c.0),
-        At::Normal(_) if !envmap => {
-            bail!("--normal needs an environment sampler; this blob's condition is --cond ROUGHNESS,THETA_O_DEG")
-        }
-        At::Normal(_) => Vec2::ZERO,
-    };
+    if matches!(at, At::Normal(_)) && cs.target() != ConditionalTarget::EnvmapNormal {
+        bail!("--normal needs an environment sampler; this blob's condition is --cond ROUGHNESS,THETA_O_DEG");
+    }
     writeln!(out, "index,x,y,z,weight")?;
     for i in 0..cs.len() {
         let s = match (at, mode) {
@@ -108,8 +103,10 @@ pub fn write_csv(
             (At::Normal(n), SampleMode::Network) => {
                 cs.sample_envmap_network(Vec3::from(n.0), instance, i)
             }
-            (At::Condition(_), SampleMode::Table) => cs.sample(c, instance, i),
-            (At::Condition(_), SampleMode::Network) => cs.sample_network(c, instance, i),
+            (At::Condition(c), SampleMode::Table) => cs.sample(Vec2::from(c.0), instance, i),
+            (At::Condition(c), SampleMode::Network) => {
+                cs.sample_network(Vec2::from(c.0), instance, i)
+            }
         };
         let d = s.direction;
         writeln!(out, "{i},{},{},{},{}", d.x, d.y, d.z, s.weight)?;

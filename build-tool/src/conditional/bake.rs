@@ -132,12 +132,9 @@ impl BakeConfig {
         }
     }
 
-    /// The blob's file name: `brdf.nuld` or `envmap.nuld`.
-    pub fn blob_name(&self) -> &'static str {
-        match self.train.target {
-            TrainTarget::GltfBrdf => "brdf.nuld",
-            TrainTarget::Envmap { .. } => "envmap.nuld",
-        }
+    /// The blob's file name: `brdf.nuld` or `envmap.nuld` ([`TrainTarget::name`]).
+    pub fn blob_name(&self) -> String {
+        format!("{}.nuld", self.train.target.name())
     }
 }
 
@@ -174,6 +171,12 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     timings.pool_s = t.elapsed().as_secs_f64();
     // Only now: a map that cannot be read leaves no directory behind.
     crate::output::ensure_dir(out)?;
+    if let LoadedTarget::Envmap(map) = &trainer.pool.target {
+        // As `optimize` does: e.g. the negative pixels of a lossy EXR, set to 0.
+        for note in map.notes() {
+            eprintln!("note: {note}");
+        }
+    }
 
     let t = Instant::now();
     let progress = Progress::stderr("bake", trainer.total_steps() as u64, "step");
@@ -207,10 +210,7 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     );
     let blob = parts.to_blob(&Metadata {
         generator: "bake",
-        target: match target {
-            LoadedTarget::GltfBrdf => "brdf",
-            LoadedTarget::Envmap(_) => "envmap",
-        },
+        target: config.train.target.name(),
         seed: config.train.seed,
     })?;
     timings.distill_s = t.elapsed().as_secs_f64();
@@ -241,11 +241,7 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     };
     render_loglog(
         &out.join("loss.png"),
-        if brdf {
-            "bake --brdf: training loss"
-        } else {
-            "bake --envmap: training loss"
-        },
+        &format!("bake --{}: training loss", config.train.target.name()),
         "step",
         "loss",
         &[series],
@@ -321,7 +317,7 @@ fn render_envmap_sets(
     ];
     let lit: Vec<EnvmapDensity> = normals
         .iter()
-        .map(|(_, n)| map.cosine_weighted(*n))
+        .map(|(_, n)| map.cosine_weighted(*n).map(|(lit, _)| lit))
         .collect::<Result<_, _>>()?;
     let densities: Vec<Box<dyn Fn(DVec2) -> f64 + '_>> = lit
         .iter()

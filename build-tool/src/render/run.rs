@@ -147,10 +147,7 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
     ensure_dir(&out.join("images"))?;
     ensure_dir(&out.join("errors"))?;
     blobs.complete(&config.spp, out, &config.bake)?;
-    let map_target = TrainTarget::Envmap {
-        path: config.envmap.clone(),
-        content_hash: content_hash(&map_bytes),
-    };
+    let map_target = TrainTarget::envmap_with_bytes(&config.envmap, &map_bytes);
     let envmap_template = config.envmap_bake.clone().with_envmap(map_target);
     envmap_blobs.complete(&config.spp, out, &envmap_template)?;
 

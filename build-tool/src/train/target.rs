@@ -6,7 +6,6 @@ use crate::seeding::content_hash;
 use crate::sphere::EnvmapDensity;
 use anyhow::{Context, Result};
 use nuld_core::blob::Domain;
-use nuld_core::conditional::ConditionalTarget;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -14,11 +13,12 @@ use std::sync::Arc;
 /// The target family of a training run.
 #[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum TrainTarget {
-    /// The glTF 2.0 BRDF over `(roughness, theta_o)` ([`ConditionalTarget::GltfBrdf`]).
+    /// The glTF 2.0 BRDF over `(roughness, theta_o)`
+    /// ([`nuld_core::conditional::ConditionalTarget::GltfBrdf`]).
     #[default]
     GltfBrdf,
     /// An environment map through the cosine about the normal
-    /// ([`ConditionalTarget::EnvmapNormal`]).
+    /// ([`nuld_core::conditional::ConditionalTarget::EnvmapNormal`]).
     Envmap {
         /// The map's file (HDR, EXR or any image `image` reads).
         path: PathBuf,
@@ -34,23 +34,25 @@ impl TrainTarget {
     pub fn envmap(path: &Path) -> Result<Self> {
         let bytes = std::fs::read(path)
             .with_context(|| format!("cannot read environment map {}", path.display()))?;
-        Ok(Self::Envmap {
-            path: path.to_path_buf(),
-            content_hash: content_hash(&bytes),
-        })
+        Ok(Self::envmap_with_bytes(path, &bytes))
     }
 
-    /// The blob's target code.
-    pub fn conditional_target(&self) -> ConditionalTarget {
-        match self {
-            Self::GltfBrdf => ConditionalTarget::GltfBrdf,
-            Self::Envmap { .. } => ConditionalTarget::EnvmapNormal,
+    /// The environment map at `path` whose file holds `bytes` (for a caller that
+    /// has read it already).
+    pub fn envmap_with_bytes(path: &Path, bytes: &[u8]) -> Self {
+        Self::Envmap {
+            path: path.to_path_buf(),
+            content_hash: content_hash(bytes),
         }
     }
 
-    /// Where the sampler's directions live.
-    pub fn domain(&self) -> Domain {
-        self.conditional_target().domain()
+    /// `brdf` or `envmap`: the bake's option, the blob's file stem and its
+    /// metadata target.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::GltfBrdf => "brdf",
+            Self::Envmap { .. } => "envmap",
+        }
     }
 
     /// Reads what the pool needs: nothing for the BRDF, the map (on the sphere) for
