@@ -14,6 +14,7 @@ use super::nuld_sampler::{NuldMode, NuldSampler};
 use crate::conditional::bake::{bake, BakeConfig};
 use crate::pointset::AlignedBytes;
 use anyhow::{anyhow, bail, Context, Result};
+use glam::DVec3;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -38,7 +39,9 @@ impl<'e> SamplerBlobs<'e> {
     }
 
     /// Reads each of `paths` as environment samplers of `env`; errors as
-    /// [`Self::read`], and for a blob baked for another map.
+    /// [`Self::read`], and for a blob baked for another map: one whose weight
+    /// table, at nine of its nodes ([`NuldSampler::irradiance_nodes`]), is more
+    /// than 1e-3 (of the largest of them) off the map's irradiance there.
     pub fn read_envmap(paths: &[PathBuf], env: &'e Environment) -> Result<Self> {
         Self::read_family(paths, Some(env))
     }
@@ -69,10 +72,25 @@ impl<'e> SamplerBlobs<'e> {
         let sampler = match self.env {
             None => NuldSampler::new(buf.as_slice(), NuldMode::Table),
             Some(env) => NuldSampler::envmap(buf.as_slice(), NuldMode::Table, env),
-        };
-        let n = sampler
-            .map_err(|e| anyhow!("{what} blob {}: {e}", path.display()))?
-            .len();
+        }
+        .map_err(|e| anyhow!("{what} blob {}: {e}", path.display()))?;
+        if let Some(env) = self.env {
+            let (normals, blob): (Vec<DVec3>, Vec<f64>) =
+                sampler.irradiance_nodes().into_iter().unzip();
+            let map = env.irradiances(&normals);
+            let scale = map.iter().fold(0.0, |m: f64, &e| m.max(e));
+            for ((b, m), n) in blob.iter().zip(&map).zip(&normals) {
+                // NaN compares false: such a blob is refused too.
+                let agrees = (b - m).abs() <= 1e-3 * scale;
+                if !agrees {
+                    bail!(
+                        "environment blob {}: an environment sampler baked for another map (irradiance {b:.4e} in the blob, {m:.4e} from the map, at the normal {n:.3})",
+                        path.display()
+                    );
+                }
+            }
+        }
+        let n = sampler.len();
         if let Some((other, _)) = self.by_n.get(&n) {
             bail!(
                 "{what} blobs {} and {} both have N = {n}; give one blob per sample count",
@@ -89,7 +107,7 @@ impl<'e> SamplerBlobs<'e> {
     /// this family's) at `N` points per set.
     pub fn complete(&mut self, spp: &[u32], dir: &Path, template: &BakeConfig) -> Result<()> {
         let what = self.what();
-        let stem = template.blob_name().trim_end_matches(".nuld");
+        let stem = template.train.target.name();
         for &n in spp {
             if self.by_n.contains_key(&n) {
                 continue;
@@ -232,6 +250,39 @@ mod tests {
         assert!(blobs.get(4).is_some());
         let brighter = Environment::constant(100.0).unwrap();
         let e = SamplerBlobs::read_envmap(&[own], &brighter)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("baked for another map"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A map with a strong sun and a coarse weight grid: between nodes the
+    /// interpolated irradiance is far off near the sun's horizon, but the check
+    /// reads the nodes, so the map's own blob is accepted (a check of interpolated
+    /// values refused it), and the same blob against another map is not.
+    #[test]
+    fn a_sun_maps_own_blob_is_accepted_at_a_coarse_weight_grid() {
+        use crate::train::TrainTarget;
+        let dir = std::env::temp_dir().join(format!("nuld-render-sunblob-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let map = dir.join("sun.hdr");
+        let img = image::Rgb32FImage::from_fn(64, 32, |x, y| {
+            let v = if (x, y) == (10, 8) { 20000.0 } else { 0.3 };
+            image::Rgb([v; 3])
+        });
+        image::DynamicImage::ImageRgb32F(img).save(&map).unwrap();
+        let mut config = super::super::RenderConfig::quick(PathBuf::new())
+            .envmap_bake
+            .with_envmap(TrainTarget::envmap(&map).unwrap());
+        config.train.n = 4;
+        config.weight_grid = [5, 5];
+        bake(&config, &dir.join("b")).unwrap();
+        let blob = dir.join("b").join("envmap.nuld");
+        let env = Environment::from_file(&map).unwrap();
+        let blobs = SamplerBlobs::read_envmap(std::slice::from_ref(&blob), &env).unwrap();
+        assert!(blobs.get(4).is_some());
+        let sky = Environment::from_file(&tiny_map(&dir)).unwrap();
+        let e = SamplerBlobs::read_envmap(&[blob], &sky)
             .unwrap_err()
             .to_string();
         assert!(e.contains("baked for another map"), "{e}");

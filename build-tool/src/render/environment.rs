@@ -86,10 +86,10 @@ impl Environment {
         self.power() * self.density.pdf(w)
     }
 
-    /// The irradiance `E(n) = ∫ L(l) max(0, n.l) dl` at a surface facing the unit
-    /// normal `n` ([`EnvmapDensity::irradiance`]).
-    pub fn irradiance(&self, n: DVec3) -> f64 {
-        self.density.irradiance(n)
+    /// The irradiance `E(n) = ∫ L(l) max(0, n.l) dl` at surfaces facing each of
+    /// the unit `normals` ([`EnvmapDensity::irradiances`]).
+    pub fn irradiances(&self, normals: &[DVec3]) -> Vec<f64> {
+        self.density.irradiances(normals)
     }
 
     /// Density per steradian of both warps at `w`: `L(w) / Φ`.

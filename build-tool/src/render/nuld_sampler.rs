@@ -15,8 +15,9 @@
 
 use super::environment::Environment;
 use super::sampler::{DirectionSampler, PixelKey, Sample, ShadingPoint, Technique};
-use glam::DVec3;
-use nuld_runtime::glam::Vec3;
+use glam::{DVec2, DVec3};
+use nuld_core::sphere::square_to_sphere;
+use nuld_runtime::glam::Vec2;
 use nuld_runtime::{Blob, BlobError, BlobKind, ConditionalSampler, ConditionalTarget};
 
 /// Table mode or network mode.
@@ -40,14 +41,6 @@ pub enum NuldBlobError {
     /// A conditional blob for another target.
     #[error("a conditional sampler for target code {0}, not {1}")]
     Target(u32, &'static str),
-    /// An environment sampler whose irradiance table disagrees with the map.
-    #[error("an environment sampler baked for another map (irradiance {blob:.4e} in the blob, {map:.4e} from the map)")]
-    OtherMap {
-        /// Mean of the blob's `E` at the six axis normals.
-        blob: f64,
-        /// The same from the map.
-        map: f64,
-    },
 }
 
 /// What ours samples.
@@ -96,42 +89,39 @@ impl<'a> NuldSampler<'a> {
     }
 
     /// The environment sampler of the blob `bytes` for the map `env` in `mode`;
-    /// an error unless they hold one whose irradiance at the six axis normals
-    /// agrees with the map's within 10% (a blob of another map would not).
+    /// an error unless they hold a conditional environment sampler. That the blob
+    /// was baked for `env` is the reader's check, made once per blob
+    /// ([`super::blobs::SamplerBlobs::read_envmap`]).
     pub fn envmap(
         bytes: &'a [u8],
         mode: NuldMode,
         env: &'a Environment,
     ) -> Result<Self, NuldBlobError> {
         let sampler = conditional(bytes, ConditionalTarget::EnvmapNormal, "an environment map")?;
-        let axes = [
-            Vec3::X,
-            Vec3::NEG_X,
-            Vec3::Y,
-            Vec3::NEG_Y,
-            Vec3::Z,
-            Vec3::NEG_Z,
-        ];
-        let blob = axes
-            .iter()
-            .map(|&n| sampler.sample_envmap(n, 0, 0).weight as f64)
-            .sum::<f64>()
-            / 6.0;
-        let map = axes
-            .iter()
-            .map(|n| env.irradiance(n.as_dvec3()))
-            .sum::<f64>()
-            / 6.0;
-        // NaN compares false: such a blob is refused too.
-        let agrees = (blob - map).abs() <= 0.1 * map;
-        if !agrees {
-            return Err(NuldBlobError::OtherMap { blob, map });
-        }
         Ok(Self {
             sampler,
             mode,
             kind: Kind::Envmap(env),
         })
+    }
+
+    /// Nine nodes of the weight table (first, middle and last per axis), each as
+    /// the normal it stands for and the stored weight `E(n)` there, read back
+    /// through [`ConditionalSampler::weight`] at the node's condition: values the
+    /// bake computed exactly, to compare with the map's own irradiance (between
+    /// nodes the table is an interpolation, which a sun's kink makes coarse).
+    pub fn irradiance_nodes(&self) -> Vec<(DVec3, f64)> {
+        let info = self.sampler.info();
+        let picks = |g: u32| [0, (g - 1) / 2, g - 1];
+        picks(info.weight_grid[0])
+            .into_iter()
+            .flat_map(|j0| picks(info.weight_grid[1]).map(|j1| [j0, j1]))
+            .map(|j| {
+                let u = info.weight_grid_condition(j);
+                let w = self.sampler.weight(Vec2::new(u[0] as f32, u[1] as f32));
+                (square_to_sphere(DVec2::from(u)), w as f64)
+            })
+            .collect()
     }
 
     /// Points per set `N` of the blob.
@@ -165,17 +155,19 @@ impl DirectionSampler for NuldSampler<'_> {
     fn samples(&self, at: &ShadingPoint, key: PixelKey, n: u32, out: &mut Vec<Sample>) {
         out.clear();
         if let Kind::Envmap(env) = self.kind {
-            let normal = at.frame.to_world(DVec3::Z);
+            let normal = at.frame.to_world(DVec3::Z).as_vec3();
             let k = key.instance();
             out.extend((0..n).map(|i| {
                 let s = match self.mode {
-                    NuldMode::Table => self.sampler.sample_envmap(normal.as_vec3(), k, i),
-                    NuldMode::Network => self.sampler.sample_envmap_network(normal.as_vec3(), k, i),
+                    NuldMode::Table => self.sampler.sample_envmap(normal, k, i),
+                    NuldMode::Network => self.sampler.sample_envmap_network(normal, k, i),
                 };
                 let l = s.direction.as_dvec3();
-                let (cos, radiance) = (normal.dot(l), env.radiance(l));
-                let weight = if cos > 0.0 && radiance > 0.0 {
-                    at.cosine_weighted(l) * s.weight as f64 / (radiance * cos)
+                let local = at.frame.to_local(l);
+                let radiance = env.radiance(l);
+                // f cos / q with q = L cos / E: the cosines cancel.
+                let weight = if local.z > 0.0 && radiance > 0.0 {
+                    nuld_core::brdf::brdf(at.wo, local, at.roughness) * s.weight as f64 / radiance
                 } else {
                     0.0
                 };
