@@ -583,9 +583,9 @@ fn sample_prints_what_the_runtime_serves_and_rejects_bad_input() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// `bake` and `sample` on environment samplers: one-line errors for a missing map,
-/// two targets at once, a normal given to a BRDF blob, or both `--cond` and
-/// `--normal`; nothing written.
+/// `bake` and `sample` on environment samplers: one-line errors for a missing or
+/// undecodable map, an unusable `--out`, two targets at once, a normal given to a
+/// BRDF blob, or both `--cond` and `--normal`; nothing written.
 #[test]
 fn envmap_bake_and_sample_reject_bad_input_with_one_line() {
     let dir = scratch("envmap-bad");
@@ -601,7 +601,22 @@ fn envmap_bake_and_sample_reject_bad_input_with_one_line() {
     assert!(e.contains("cannot be used with"), "{e}");
     let e = failure(&["bake"], &out);
     assert!(e.contains("--brdf or --envmap MAP"), "{e}");
+    // A map that exists but does not decode fails in the pool, after the output
+    // directory was made: it goes again.
+    let junk = dir.join("junk.hdr");
+    std::fs::write(&junk, b"not an image").unwrap();
+    let e = failure(&["bake", "--envmap", junk.to_str().unwrap()], &out);
+    assert_eq!(e.trim().lines().count(), 1, "{e}");
     assert!(!out.exists());
+    // An --out that cannot be a directory fails before the pool: its error comes
+    // first, not the map's.
+    let e = failure(
+        &["bake", "--envmap", junk.to_str().unwrap()],
+        &junk.join("out"),
+    );
+    assert!(e.contains("cannot create directory"), "{e}");
+    assert_eq!(e.trim().lines().count(), 1, "{e}");
+    assert_eq!(std::fs::read(&junk).unwrap(), b"not an image");
     let file = dir.join("brdf.nuld");
     conditional_blob(&file);
     for args in [

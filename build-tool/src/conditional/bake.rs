@@ -152,6 +152,9 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
             nuld_core::network::MAX_WIDTH
         );
     }
+    // Before the pool (seconds to minutes): an unusable --out fails at once, and
+    // the directory goes again if the run fails before writing into it.
+    let out_dir = crate::output::NewDir::create(out)?;
     let ckpt_path = checkpoint_path(out);
     let resume = if config.resume {
         let c = Checkpoint::load(&ckpt_path)?;
@@ -169,8 +172,6 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     let t = Instant::now();
     let mut trainer = Trainer::new(config.train.clone(), resume)?;
     timings.pool_s = t.elapsed().as_secs_f64();
-    // Only now: a map that cannot be read leaves no directory behind.
-    crate::output::ensure_dir(out)?;
     if let LoadedTarget::Envmap(map) = &trainer.pool.target {
         // As `optimize` does: e.g. the negative pixels of a lossy EXR, set to 0.
         for note in map.notes() {
@@ -195,6 +196,7 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
         }
     }
     trainer.state.save(&ckpt_path)?;
+    out_dir.keep();
     progress.finish();
     timings.train_s = t.elapsed().as_secs_f64();
 
