@@ -53,7 +53,7 @@ pub struct BakeArgs {
     /// Initial Adam step.
     #[arg(long, default_value_t = TrainConfig::default().learning_rate)]
     pub lr: f64,
-    /// Held-out conditions per axis of the quality check in the report (--brdf only; 0: none).
+    /// Held-out conditions per axis of the quality check in the report (0: none).
     #[arg(long, default_value_t = BakeConfig::default().quality_grid, allow_negative_numbers = true, value_parser = super::count)]
     pub quality_grid: usize,
     /// Output directory.

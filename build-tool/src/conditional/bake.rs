@@ -94,7 +94,7 @@ pub struct BakeReport {
     /// Steps per entry of `loss_curve`.
     pub loss_block: usize,
     /// Held-out quality (network mode, f16 parameters, against Owen-Sobol through
-    /// the mixture warp).
+    /// the mixture warp for the BRDF, through the lit map's inverse CDF for a map).
     pub quality: Option<Quality>,
 }
 
@@ -218,13 +218,12 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     timings.distill_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let brdf = matches!(target, LoadedTarget::GltfBrdf);
-    let quality = (brdf && config.quality_grid > 0).then(|| {
-        evaluate(
-            &params,
-            &QualityConfig::held_out(config.quality_grid, 0x9a11),
-        )
-    });
+    let quality = (config.quality_grid > 0)
+        .then(|| {
+            let held_out = QualityConfig::held_out(target, config.quality_grid, 0x9a11);
+            evaluate(&params, target, &held_out)
+        })
+        .transpose()?;
     timings.quality_s = t.elapsed().as_secs_f64();
 
     let losses = &trainer.state.losses;

@@ -1,10 +1,15 @@
-//! A quick quality check of a conditional BRDF sampler at held-out conditions,
-//! in network mode on the f16 parameters that ship.
+//! A quick quality check of a conditional sampler at held-out conditions, in
+//! network mode on the f16 parameters that ship.
 //!
 //! * **cap L2**: the paper's `D_cap,2` (Eq. 9, `theta` uniform) by Monte Carlo over
-//!   shared measured caps ([`MeasuredCaps`]) against the target [`BrdfTarget`],
-//!   mean over instances, divided by the same for Owen-Sobol sets warped by the
-//!   renderer's mixture warp ([`BrdfTarget::sample`]) over as many seeds;
+//!   shared measured caps ([`MeasuredCaps`]) against the condition's target, mean
+//!   over instances, divided by the same for Owen-Sobol sets through the standard
+//!   warp over as many seeds: for a BRDF sampler the target is the [`BrdfTarget`]
+//!   and the warp the renderer's mixture ([`BrdfTarget::sample`]); for an
+//!   environment sampler the target is the map lit through the cosine about the
+//!   normal ([`crate::sphere::EnvmapDensity::cosine_weighted`], caps measured by its exact
+//!   quadrature) and the warp that lit map's inverse CDF, which is what a renderer
+//!   sampling the map for this one normal could do at best;
 //! * **diversity**: `D_cap,2` of the union of many instances over the mean of a
 //!   single instance's (independent sets: about `1/sqrt(instances)`; identical
 //!   sets: 1), and the mean angle from a point of one instance to the nearest point
@@ -14,20 +19,25 @@
 use crate::baselines::warped_owen_sobol_directions;
 use crate::eval::conditional::diversity;
 use crate::network::Params;
+use crate::progress::Progress;
 use crate::sphere::metrics::{CapRadius, MeasuredCaps};
 use crate::sphere::{BrdfTarget, DirectionDensity};
 use crate::train::pool::normalized;
-use glam::DVec3;
+use crate::train::target::LoadedTarget;
+use anyhow::Result;
+use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
 use nuld_core::brdf::{CONDITION_MAX, CONDITION_MIN};
 use nuld_core::conditional::PointWarp;
+use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
 use serde::Serialize;
 
 /// Settings of [`evaluate`].
 #[derive(Clone, Debug, Serialize)]
 pub struct QualityConfig {
-    /// Held-out conditions `(roughness, theta_o in degrees)`.
+    /// Held-out conditions in blob units: `(roughness, theta_o in degrees)` for a
+    /// BRDF sampler, the normal's octahedral square point for an environment one.
     pub conditions: Vec<[f64; 2]>,
     /// Instances (and baseline seeds) averaged per condition.
     pub instances: u32,
@@ -40,15 +50,17 @@ pub struct QualityConfig {
 }
 
 impl QualityConfig {
-    /// A `k x k` grid of conditions at cell centres of the condition range
-    /// (off any point-table grid with an odd node count... and most even ones),
-    /// 8 instances, unions of 64, 4096 caps.
-    pub fn held_out(k: usize, seed: u64) -> Self {
-        // Cell centre `j` of axis `a` of the condition range.
-        let at = |j: usize, a: usize| {
-            let (lo, hi) = (CONDITION_MIN[a], CONDITION_MAX[a]);
-            lo + (j as f64 + 0.5) / k as f64 * (hi - lo)
+    /// A `k x k` grid of conditions at cell centres of `target`'s condition range
+    /// (off any point-table grid with an odd node count... and most even ones):
+    /// `(roughness, theta_o)` for the BRDF, the octahedral square `[0,1]^2` of the
+    /// normal for a map; 8 instances, unions of 64, 4096 caps.
+    pub fn held_out(target: &LoadedTarget, k: usize, seed: u64) -> Self {
+        let (lo, hi) = match target {
+            LoadedTarget::GltfBrdf => (CONDITION_MIN, CONDITION_MAX),
+            LoadedTarget::Envmap(_) => ([0.0; 2], [1.0; 2]),
         };
+        // Cell centre `j` of axis `a` of the condition range.
+        let at = |j: usize, a: usize| lo[a] + (j as f64 + 0.5) / k as f64 * (hi[a] - lo[a]);
         let conditions = (0..k * k).map(|j| [at(j % k, 0), at(j / k, 1)]).collect();
         Self {
             conditions,
@@ -63,8 +75,11 @@ impl QualityConfig {
 /// The figures of one held-out condition.
 #[derive(Clone, Debug, Serialize)]
 pub struct ConditionQuality {
-    /// `(roughness, theta_o in degrees)`.
+    /// In blob units (see [`QualityConfig::conditions`]).
     pub condition: [f64; 2],
+    /// An environment sampler's normal (world frame, `+z` up).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub normal: Option<[f64; 3]>,
     /// Mean `D_cap,2` of single instances.
     pub ours: f64,
     /// Mean `D_cap,2` of warped Owen-Sobol sets.
@@ -80,7 +95,8 @@ pub struct ConditionQuality {
 /// The summary over all held-out conditions.
 #[derive(Clone, Debug, Serialize)]
 pub struct Quality {
-    /// Per condition.
+    /// Per condition (an environment sampler's normals that no light reaches are
+    /// left out: their target is undefined and their weight 0).
     pub conditions: Vec<ConditionQuality>,
     /// Mean of the ratios.
     pub mean_ratio: f64,
@@ -96,76 +112,194 @@ pub struct Quality {
 /// `p_s` the condition's lobe probability (used by the mixture warp,
 /// [`PointWarp::direction`]).
 pub fn instance_directions(params: &Params, cond: [f64; 2], p_s: f64, k: u32) -> Vec<DVec3> {
-    let unit = normalized(cond);
+    directions_at(params, normalized(cond), cond, Domain::Hemisphere, p_s, k)
+}
+
+/// Instance `k`'s directions at the condition `cond` (blob units; `unit` its
+/// normalized form, the network's input) on `domain`.
+fn directions_at(
+    params: &Params,
+    unit: [f64; 2],
+    cond: [f64; 2],
+    domain: Domain,
+    p_s: f64,
+    k: u32,
+) -> Vec<DVec3> {
     let warp = PointWarp::of_shape(&params.shape);
     (0..params.shape.n())
         .map(|i| {
             let s = params.square_point(unit, k, i);
-            DVec3::from_array(warp.direction(Domain::Hemisphere, cond, p_s, s))
+            DVec3::from_array(warp.direction(domain, cond, p_s, s))
         })
         .collect()
 }
 
-/// Scores `params` rounded to f16 (see the module docs).
-pub fn evaluate(params: &Params, config: &QualityConfig) -> Quality {
-    let shipped = params.rounded_to_f16();
-    let n = params.shape.n() as usize;
-    let conditions: Vec<ConditionQuality> = config
-        .conditions
-        .iter()
-        .enumerate()
-        .map(|(ci, &cond)| {
-            let target = BrdfTarget::new(cond[0], cond[1], Domain::Hemisphere)
-                .expect("held-out conditions lie in the range");
-            let caps = MeasuredCaps::draw(
-                config.caps,
-                crate::seeding::derive_seed(config.seed, ci as u64),
-                CapRadius::ThetaUniform,
-                |w, t| target.cap_measure(w, t),
-            );
-            let d = |pts: &[DVec3]| caps.l2_squared(pts, CapRadius::ThetaUniform).0.sqrt();
-            let sets: Vec<Vec<DVec3>> = (0..config.union_instances.max(config.instances).max(2))
-                .into_par_iter()
-                .map(|k| instance_directions(&shipped, cond, target.lobe_probability(), k))
-                .collect();
-            let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len() as f64;
-            let ours = mean(
-                sets[..config.instances as usize]
-                    .par_iter()
-                    .map(|s| d(s))
-                    .collect(),
-            );
-            let baseline = mean(
-                (0..config.instances as u64)
-                    .into_par_iter()
-                    .map(|s| {
-                        d(&warped_owen_sobol_directions(
-                            &target,
-                            n,
-                            config.seed ^ (s + 1),
-                        ))
-                    })
-                    .collect(),
-            );
-            // Nearest neighbours within a set need two points (`bake --n 1` has one).
-            let spread =
-                (n >= 2).then(|| diversity(&sets[..config.union_instances.max(2) as usize], &caps));
-            ConditionQuality {
-                condition: cond,
-                ours,
-                baseline,
-                ratio: ours / baseline,
-                union_ratio: spread.as_ref().map_or(f64::NAN, |s| s.union_ratio),
-                nn_ratio: spread.as_ref().map_or(f64::NAN, |s| s.nn_ratio),
+/// One held-out condition's target and where a point of ours goes.
+struct HeldOut {
+    /// The target (caps, baseline warp).
+    density: Box<dyn DirectionDensity>,
+    /// The condition normalized to `[0,1]^2` (the network's input).
+    unit: [f64; 2],
+    /// The condition in blob units.
+    cond: [f64; 2],
+    normal: Option<DVec3>,
+    domain: Domain,
+    lobe_probability: f64,
+}
+
+impl HeldOut {
+    /// `cond` of `target`, or `None` for a normal that no light reaches.
+    fn new(target: &LoadedTarget, cond: [f64; 2]) -> Result<Option<Self>> {
+        Ok(match target {
+            LoadedTarget::GltfBrdf => {
+                let t = BrdfTarget::new(cond[0], cond[1], Domain::Hemisphere)?;
+                Some(Self {
+                    unit: normalized(cond),
+                    cond,
+                    normal: None,
+                    domain: Domain::Hemisphere,
+                    lobe_probability: t.lobe_probability(),
+                    density: Box::new(t),
+                })
+            }
+            LoadedTarget::Envmap(map) => {
+                let normal = square_to_sphere(DVec2::from(cond));
+                let (lit, irradiance) = map.cosine_weighted(normal)?;
+                (irradiance > 0.0).then(|| Self {
+                    unit: cond,
+                    cond,
+                    normal: Some(normal),
+                    domain: Domain::Sphere,
+                    lobe_probability: 0.0,
+                    density: Box::new(lit) as Box<dyn DirectionDensity>,
+                })
             }
         })
-        .collect();
+    }
+
+    /// The directions of instance `k` (network mode, `params` as given).
+    fn directions(&self, params: &Params, k: u32) -> Vec<DVec3> {
+        let (unit, cond, p_s) = (self.unit, self.cond, self.lobe_probability);
+        directions_at(params, unit, cond, self.domain, p_s, k)
+    }
+}
+
+/// Scores `params` rounded to f16 on `target` (see the module docs). An error only
+/// if a held-out BRDF condition lies outside the range.
+pub fn evaluate(params: &Params, target: &LoadedTarget, config: &QualityConfig) -> Result<Quality> {
+    let shipped = params.rounded_to_f16();
+    let n = params.shape.n() as usize;
+    let mut conditions = Vec::new();
+    // Seconds per condition for a map (exact cap measures of the lit map).
+    let progress = Progress::stderr("quality", config.conditions.len() as u64, "condition");
+    for (ci, &cond) in config.conditions.iter().enumerate() {
+        progress.inc(1);
+        let Some(held) = HeldOut::new(target, cond)? else {
+            continue;
+        };
+        let density = held.density.as_ref();
+        let caps = MeasuredCaps::draw(
+            config.caps,
+            crate::seeding::derive_seed(config.seed, ci as u64),
+            CapRadius::ThetaUniform,
+            |w, t| density.cap_measure(w, t),
+        );
+        let d = |pts: &[DVec3]| caps.l2_squared(pts, CapRadius::ThetaUniform).0.sqrt();
+        let sets: Vec<Vec<DVec3>> = (0..config.union_instances.max(config.instances).max(2))
+            .into_par_iter()
+            .map(|k| held.directions(&shipped, k))
+            .collect();
+        let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len() as f64;
+        let ours = mean(
+            sets[..config.instances as usize]
+                .par_iter()
+                .map(|s| d(s))
+                .collect(),
+        );
+        let baseline = mean(
+            (0..config.instances as u64)
+                .into_par_iter()
+                .map(|s| {
+                    d(&warped_owen_sobol_directions(
+                        density,
+                        n,
+                        config.seed ^ (s + 1),
+                    ))
+                })
+                .collect(),
+        );
+        // Nearest neighbours within a set need two points (`bake --n 1` has one).
+        let spread =
+            (n >= 2).then(|| diversity(&sets[..config.union_instances.max(2) as usize], &caps));
+        conditions.push(ConditionQuality {
+            condition: cond,
+            normal: held.normal.map(|n| n.to_array()),
+            ours,
+            baseline,
+            ratio: ours / baseline,
+            union_ratio: spread.as_ref().map_or(f64::NAN, |s| s.union_ratio),
+            nn_ratio: spread.as_ref().map_or(f64::NAN, |s| s.nn_ratio),
+        });
+    }
+    progress.finish();
     let m = conditions.len().max(1) as f64;
-    Quality {
+    Ok(Quality {
         mean_ratio: conditions.iter().map(|c| c.ratio).sum::<f64>() / m,
         worst_ratio: conditions.iter().map(|c| c.ratio).fold(0.0, f64::max),
         mean_union_ratio: conditions.iter().map(|c| c.union_ratio).sum::<f64>() / m,
         mean_nn_ratio: conditions.iter().map(|c| c.nn_ratio).sum::<f64>() / m,
         conditions,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::train::TrainTarget;
+    use nuld_core::network::{Activation, Shape};
+
+    /// On a map lit only above the horizon: the held-out normals are the cell
+    /// centres of the octahedral square, each judged names its normal, and the
+    /// normal `-z` (the square's corner), which faces only the dark lower half
+    /// (E = 0), is left out; a network that ignores the instance makes identical
+    /// instances (union ratio 1, no nearest-neighbour distance across), and
+    /// one that lines its points up on one arc is far worse than Owen-Sobol through
+    /// the lit map.
+    #[test]
+    fn an_envmap_check_judges_lit_normals_against_the_lit_maps_inverse_cdf() {
+        let dir = std::env::temp_dir().join(format!("nuld-quality-envmap-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("upper.png");
+        image::RgbImage::from_fn(32, 16, |_, y| image::Rgb([if y < 8 { 200 } else { 0 }; 3]))
+            .save(&path)
+            .unwrap();
+        let target = TrainTarget::envmap(&path).unwrap().load().unwrap();
+        let mut config = QualityConfig::held_out(&target, 4, 3);
+        assert_eq!(config.conditions.len(), 16);
+        assert_eq!(config.conditions[5], [0.375, 0.375]);
+        let held_out = config.conditions.clone();
+        config.conditions.push([0.0, 0.0]);
+        config.caps = 512;
+        config.union_instances = 8;
+        // Point i at the square point (sigmoid(i / 4), 1/2) whatever the instance:
+        // a per-index bias i / 16 on one hidden unit, read by the first output.
+        let shape = Shape::new(16, &[4], Activation::Relu, 5).unwrap();
+        let mut values = vec![0.0; shape.param_len()];
+        for i in 0..16 {
+            values[shape.embedding_offset(i)] = i as f64 / 16.0;
+        }
+        values[shape.layers().last().unwrap().weights] = 4.0;
+        let same = Params { shape, values };
+        let q = evaluate(&same, &target, &config).unwrap();
+        let judged: Vec<[f64; 2]> = q.conditions.iter().map(|c| c.condition).collect();
+        assert_eq!(judged, held_out);
+        for c in &q.conditions {
+            let n = DVec3::from_array(c.normal.unwrap());
+            assert!((n - square_to_sphere(DVec2::from(c.condition))).length() < 1e-12);
+            assert!(c.ratio > 2.0, "{c:?}");
+            assert!((c.union_ratio - 1.0).abs() < 1e-12, "{c:?}");
+            assert_eq!(c.nn_ratio, 0.0, "{c:?}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
