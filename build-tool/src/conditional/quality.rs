@@ -142,8 +142,11 @@ struct HeldOut {
     unit: [f64; 2],
     /// The condition in blob units.
     cond: [f64; 2],
+    /// An environment sampler's normal.
     normal: Option<DVec3>,
+    /// Where the sets live.
     domain: Domain,
+    /// The BRDF mixture's `p_s` (0 for a map: its warp does not read it).
     lobe_probability: f64,
 }
 
@@ -184,8 +187,8 @@ impl HeldOut {
     }
 }
 
-/// Scores `params` rounded to f16 on `target` (see the module docs). An error only
-/// if a held-out BRDF condition lies outside the range.
+/// Scores `params` rounded to f16 on `target` (see the module docs). An error if a
+/// held-out BRDF condition lies outside the range or a lit map cannot be built.
 pub fn evaluate(params: &Params, target: &LoadedTarget, config: &QualityConfig) -> Result<Quality> {
     let shipped = params.rounded_to_f16();
     let n = params.shape.n() as usize;
