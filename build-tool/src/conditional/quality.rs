@@ -22,12 +22,10 @@ use crate::network::Params;
 use crate::progress::Progress;
 use crate::sphere::metrics::{CapRadius, MeasuredCaps};
 use crate::sphere::{BrdfTarget, DirectionDensity};
-use crate::train::pool::normalized;
 use crate::train::target::LoadedTarget;
 use anyhow::Result;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
-use nuld_core::brdf::{CONDITION_MAX, CONDITION_MIN};
 use nuld_core::conditional::PointWarp;
 use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
@@ -55,13 +53,11 @@ impl QualityConfig {
     /// `(roughness, theta_o)` for the BRDF, the octahedral square `[0,1]^2` of the
     /// normal for a map; 8 instances, unions of 64, 4096 caps.
     pub fn held_out(target: &LoadedTarget, k: usize, seed: u64) -> Self {
-        let (lo, hi) = match target {
-            LoadedTarget::GltfBrdf => (CONDITION_MIN, CONDITION_MAX),
-            LoadedTarget::Envmap(_) => ([0.0; 2], [1.0; 2]),
-        };
-        // Cell centre `j` of axis `a` of the condition range.
-        let at = |j: usize, a: usize| lo[a] + (j as f64 + 0.5) / k as f64 * (hi[a] - lo[a]);
-        let conditions = (0..k * k).map(|j| [at(j % k, 0), at(j / k, 1)]).collect();
+        // Cell centre `j` of an axis of the unit square.
+        let centre = |j: usize| (j as f64 + 0.5) / k as f64;
+        let conditions = (0..k * k)
+            .map(|j| target.condition([centre(j % k), centre(j / k)]))
+            .collect();
         Self {
             conditions,
             instances: 8,
@@ -112,7 +108,8 @@ pub struct Quality {
 /// `p_s` the condition's lobe probability (used by the mixture warp,
 /// [`PointWarp::direction`]).
 pub fn instance_directions(params: &Params, cond: [f64; 2], p_s: f64, k: u32) -> Vec<DVec3> {
-    directions_at(params, normalized(cond), cond, Domain::Hemisphere, p_s, k)
+    let unit = LoadedTarget::GltfBrdf.normalized(cond);
+    directions_at(params, unit, cond, Domain::Hemisphere, p_s, k)
 }
 
 /// Instance `k`'s directions at the condition `cond` (blob units; `unit` its
@@ -153,11 +150,12 @@ struct HeldOut {
 impl HeldOut {
     /// `cond` of `target`, or `None` for a normal that no light reaches.
     fn new(target: &LoadedTarget, cond: [f64; 2]) -> Result<Option<Self>> {
+        let unit = target.normalized(cond);
         Ok(match target {
             LoadedTarget::GltfBrdf => {
                 let t = BrdfTarget::new(cond[0], cond[1], Domain::Hemisphere)?;
                 Some(Self {
-                    unit: normalized(cond),
+                    unit,
                     cond,
                     normal: None,
                     domain: Domain::Hemisphere,
@@ -169,7 +167,7 @@ impl HeldOut {
                 let normal = square_to_sphere(DVec2::from(cond));
                 let (lit, irradiance) = map.cosine_weighted(normal)?;
                 (irradiance > 0.0).then(|| Self {
-                    unit: cond,
+                    unit,
                     cond,
                     normal: Some(normal),
                     domain: Domain::Sphere,
@@ -180,37 +178,24 @@ impl HeldOut {
         })
     }
 
-    /// The directions of instance `k` (network mode, `params` as given).
-    fn directions(&self, params: &Params, k: u32) -> Vec<DVec3> {
-        let (unit, cond, p_s) = (self.unit, self.cond, self.lobe_probability);
-        directions_at(params, unit, cond, self.domain, p_s, k)
-    }
-}
-
-/// Scores `params` rounded to f16 on `target` (see the module docs). An error if a
-/// held-out BRDF condition lies outside the range or a lit map cannot be built.
-pub fn evaluate(params: &Params, target: &LoadedTarget, config: &QualityConfig) -> Result<Quality> {
-    let shipped = params.rounded_to_f16();
-    let n = params.shape.n() as usize;
-    let mut conditions = Vec::new();
-    // Seconds per condition for a map (exact cap measures of the lit map).
-    let progress = Progress::stderr("quality", config.conditions.len() as u64, "condition");
-    for (ci, &cond) in config.conditions.iter().enumerate() {
-        progress.inc(1);
-        let Some(held) = HeldOut::new(target, cond)? else {
-            continue;
-        };
-        let density = held.density.as_ref();
+    /// The figures of `shipped` (the f16-rounded parameters) here; `index` numbers
+    /// the condition in its config (the caps' seed).
+    fn score(&self, shipped: &Params, config: &QualityConfig, index: usize) -> ConditionQuality {
+        let n = shipped.shape.n() as usize;
+        let density = self.density.as_ref();
         let caps = MeasuredCaps::draw(
             config.caps,
-            crate::seeding::derive_seed(config.seed, ci as u64),
+            crate::seeding::derive_seed(config.seed, index as u64),
             CapRadius::ThetaUniform,
             |w, t| density.cap_measure(w, t),
         );
         let d = |pts: &[DVec3]| caps.l2_squared(pts, CapRadius::ThetaUniform).0.sqrt();
         let sets: Vec<Vec<DVec3>> = (0..config.union_instances.max(config.instances).max(2))
             .into_par_iter()
-            .map(|k| held.directions(&shipped, k))
+            .map(|k| {
+                let (unit, cond, p_s) = (self.unit, self.cond, self.lobe_probability);
+                directions_at(shipped, unit, cond, self.domain, p_s, k)
+            })
             .collect();
         let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len() as f64;
         let ours = mean(
@@ -234,15 +219,30 @@ pub fn evaluate(params: &Params, target: &LoadedTarget, config: &QualityConfig) 
         // Nearest neighbours within a set need two points (`bake --n 1` has one).
         let spread =
             (n >= 2).then(|| diversity(&sets[..config.union_instances.max(2) as usize], &caps));
-        conditions.push(ConditionQuality {
-            condition: cond,
-            normal: held.normal.map(|n| n.to_array()),
+        ConditionQuality {
+            condition: self.cond,
+            normal: self.normal.map(|n| n.to_array()),
             ours,
             baseline,
             ratio: ours / baseline,
             union_ratio: spread.as_ref().map_or(f64::NAN, |s| s.union_ratio),
             nn_ratio: spread.as_ref().map_or(f64::NAN, |s| s.nn_ratio),
-        });
+        }
+    }
+}
+
+/// Scores `params` rounded to f16 on `target` (see the module docs). An error if a
+/// held-out BRDF condition lies outside the range or a lit map cannot be built.
+pub fn evaluate(params: &Params, target: &LoadedTarget, config: &QualityConfig) -> Result<Quality> {
+    let shipped = params.rounded_to_f16();
+    let mut conditions = Vec::new();
+    // Seconds per condition for a map (exact cap measures of the lit map).
+    let progress = Progress::stderr("quality", config.conditions.len() as u64, "condition");
+    for (index, &cond) in config.conditions.iter().enumerate() {
+        if let Some(held) = HeldOut::new(target, cond)? {
+            conditions.push(held.score(&shipped, config, index));
+        }
+        progress.inc(1);
     }
     progress.finish();
     let m = conditions.len().max(1) as f64;

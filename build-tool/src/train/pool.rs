@@ -26,7 +26,7 @@ use crate::sphere::{BrdfTarget, CapMeasureTable, DirectionDensity, EnvmapDensity
 use anyhow::Result;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
-use nuld_core::brdf::{view_direction, BrdfModel, CONDITION_MAX, CONDITION_MIN};
+use nuld_core::brdf::{view_direction, BrdfModel};
 use nuld_core::conditional::PointWarp;
 use nuld_core::network::{instance_offset, shifted_lattice_point, Shape};
 use nuld_core::sphere::{hemisphere_to_square, sphere_to_square, square_to_sphere};
@@ -36,12 +36,6 @@ use std::sync::Arc;
 /// Points of the rule that measures a pool condition's caps: `2^14`, 1/16 of a
 /// [`BrdfTarget::new`]'s, so that building the pool costs seconds, not minutes.
 pub const POOL_RULE_POINTS: usize = 1 << 14;
-
-/// The normalized condition in `[0,1]^2` of `(roughness, theta_o_deg)`: its place
-/// between [`CONDITION_MIN`] and [`CONDITION_MAX`].
-pub fn normalized(cond: [f64; 2]) -> [f64; 2] {
-    core::array::from_fn(|a| (cond[a] - CONDITION_MIN[a]) / (CONDITION_MAX[a] - CONDITION_MIN[a]))
-}
 
 /// What a condition's target density is made of.
 pub enum ConditionDensity {
@@ -68,7 +62,7 @@ pub struct PoolCondition {
     /// The condition in blob units: `(roughness, theta_o in degrees)` for the
     /// BRDF, the normal's octahedral square point for a map.
     pub cond: [f64; 2],
-    /// [`normalized`] `cond`, the network's condition input.
+    /// [`LoadedTarget::normalized`] `cond`, the network's condition input.
     pub unit: [f64; 2],
     /// The target density's ingredients.
     pub density: ConditionDensity,
@@ -217,15 +211,11 @@ impl ConditionPool {
                     sobol_burley::sample(p as u32, 1, scramble) as f64,
                 ];
                 let seed = derive_seed(seed, p as u64);
+                let cond = loaded.condition(u);
                 match &loaded {
-                    LoadedTarget::GltfBrdf => {
-                        let cond: [f64; 2] = core::array::from_fn(|a| {
-                            CONDITION_MIN[a] + u[a] * (CONDITION_MAX[a] - CONDITION_MIN[a])
-                        });
-                        Ok(condition(cond, caps, window, shape, seed))
-                    }
+                    LoadedTarget::GltfBrdf => Ok(condition(cond, caps, window, shape, seed)),
                     LoadedTarget::Envmap(map) => {
-                        envmap_condition(map, u, caps, window, shape, seed)
+                        envmap_condition(map, cond, caps, window, shape, seed)
                     }
                 }
             })
@@ -264,7 +254,7 @@ fn condition(
         .collect();
     let pc = PoolCondition {
         cond,
-        unit: normalized(cond),
+        unit: LoadedTarget::GltfBrdf.normalized(cond),
         density: ConditionDensity::Brdf {
             wo: view_direction(cond[1]),
             albedo: target.albedo(),

@@ -6,6 +6,7 @@ use crate::seeding::content_hash;
 use crate::sphere::EnvmapDensity;
 use anyhow::{Context, Result};
 use nuld_core::blob::Domain;
+use nuld_core::brdf::{CONDITION_MAX, CONDITION_MIN};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -76,4 +77,61 @@ pub enum LoadedTarget {
     GltfBrdf,
     /// The map's luminance as a density on the sphere.
     Envmap(Arc<EnvmapDensity>),
+}
+
+impl LoadedTarget {
+    /// The conditions a sampler of this target serves, in blob units, as the
+    /// corners `(lo, hi)` of a box: `(roughness, theta_o in degrees)` from
+    /// [`CONDITION_MIN`] to [`CONDITION_MAX`] for the BRDF, the normal's equal-area
+    /// octahedral square point in `[0,1]^2` for a map.
+    pub fn condition_range(&self) -> ([f64; 2], [f64; 2]) {
+        match self {
+            Self::GltfBrdf => (CONDITION_MIN, CONDITION_MAX),
+            Self::Envmap(_) => ([0.0; 2], [1.0; 2]),
+        }
+    }
+
+    /// The condition at the point `u` of `[0,1]^2`: `lo + u (hi - lo)` per axis.
+    pub fn condition(&self, u: [f64; 2]) -> [f64; 2] {
+        let (lo, hi) = self.condition_range();
+        core::array::from_fn(|a| lo[a] + u[a] * (hi[a] - lo[a]))
+    }
+
+    /// The inverse of [`Self::condition`]: the place of `cond` in its range,
+    /// `(cond - lo) / (hi - lo)` per axis (the network's condition input).
+    pub fn normalized(&self, cond: [f64; 2]) -> [f64; 2] {
+        let (lo, hi) = self.condition_range();
+        core::array::from_fn(|a| (cond[a] - lo[a]) / (hi[a] - lo[a]))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The BRDF's range runs from `CONDITION_MIN` to `CONDITION_MAX` (its corners
+    /// map onto them, its centre onto their midpoint); a map's conditions are the
+    /// octahedral square itself, bit for bit both ways (the pool relies on it).
+    #[test]
+    fn conditions_map_the_unit_square_onto_each_targets_range() {
+        let brdf = LoadedTarget::GltfBrdf;
+        assert_eq!(brdf.condition([0.0, 0.0]), CONDITION_MIN);
+        assert_eq!(brdf.condition([1.0, 1.0]), CONDITION_MAX);
+        let mid = brdf.condition([0.5, 0.5]);
+        for a in 0..2 {
+            assert!((mid[a] - 0.5 * (CONDITION_MIN[a] + CONDITION_MAX[a])).abs() < 1e-12);
+        }
+        let back = brdf.normalized([0.55, 44.5]);
+        assert!(back.iter().all(|x| (x - 0.5).abs() < 1e-12), "{back:?}");
+        let dir = std::env::temp_dir().join(format!("nuld-target-range-{}", std::process::id()));
+        let map = TrainTarget::envmap(&crate::render::blobs::tiny_map(&dir))
+            .unwrap()
+            .load()
+            .unwrap();
+        for u in [[0.0, 1.0], [0.3, 0.7], [0.123_456_789, 0.999_999]] {
+            assert_eq!(map.condition(u), u);
+            assert_eq!(map.normalized(u), u);
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
