@@ -121,7 +121,9 @@ fn ns_per_sample(count: u32, mut f: impl FnMut(u32)) -> f64 {
 /// Times, one thread, `samples` samples per method (a tenth of it for network
 /// mode): the incumbent (direction only, and with its estimator weight
 /// `f cos / p` as a renderer needs it), table mode (`sample` and `sample_brdf`),
-/// and network mode at n 64 with hidden [32, 32] ReLU and [64, 64] SiLU. Every
+/// and network mode at n 64 with hidden [32, 32] ReLU and [64, 64] SiLU, each on
+/// the blob's f16 weights and on weights decoded once
+/// ([`nuld_runtime::ConditionalSampler::decode_network`]). Every
 /// method cycles through the same fixed set of conditions, instance `s / n` and
 /// index `s mod n` for sample `s`; the incumbent's per-condition setup (its
 /// [`BrdfTarget`], albedos included) is done before timing, which favours it.
@@ -206,6 +208,16 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
             format!("{name}: sample_network"),
             ns_per_sample(samples / 10, |s| {
                 black_box(cs.sample_network(conds[at(s)], s / n, s % n));
+            }),
+        ));
+        let mut buf = vec![0.0f32; cs.decoded_network_len()];
+        let decoded = cs
+            .decode_network(&mut buf)
+            .ok_or_else(|| anyhow!("decode_network refused a buffer of its own length"))?;
+        rows.push((
+            format!("{name}: decoded, sample_network"),
+            ns_per_sample(samples / 10, |s| {
+                black_box(decoded.sample_network(conds[at(s)], s / n, s % n));
             }),
         ));
     }

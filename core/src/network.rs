@@ -321,6 +321,15 @@ pub trait Parameters<T: Real> {
     fn row_dot(&self, start: usize, x: &[T], scratch: &mut [T]) -> T {
         read_dot(self, start, x, scratch)
     }
+    /// [`Parameters::row_dot`] of the [`UNIT_BLOCK`] consecutive rows of length
+    /// `x.len()` from `start`, each with exactly the bits `row_dot` gives it. The
+    /// default dots the rows one by one; storage that holds `T` dots them together
+    /// ([`dot_block`]), which keeps more multiply-adds in flight per row.
+    #[inline(always)]
+    fn block_dot(&self, start: usize, x: &[T], scratch: &mut [T]) -> [T; UNIT_BLOCK] {
+        let len = x.len();
+        core::array::from_fn(|r| self.row_dot(start.saturating_add(r * len), x, scratch))
+    }
 }
 
 /// [`Parameters::row_dot`] through a copy of the row in `scratch`.
@@ -367,6 +376,19 @@ impl<T: Real> Parameters<T> for &[T] {
             None => read_dot(self, start, x, scratch),
         }
     }
+    #[inline(always)]
+    fn block_dot(&self, start: usize, x: &[T], scratch: &mut [T]) -> [T; UNIT_BLOCK] {
+        let len = x.len();
+        match start
+            .checked_add(UNIT_BLOCK * len)
+            .and_then(|end| <[T]>::get(self, start..end))
+        {
+            Some(rows) => dot_block(rows, x),
+            None => {
+                core::array::from_fn(|r| self.row_dot(start.saturating_add(r * len), x, scratch))
+            }
+        }
+    }
 }
 
 /// Parameters stored as IEEE binary16 bits, all finite (blobs are validated so),
@@ -395,6 +417,14 @@ impl Parameters<f32> for F16Params<'_> {
                 *o = self.get(start.saturating_add(k));
             }),
         }
+    }
+    /// The block's rows decoded into `scratch` in one pass, then [`dot_block`].
+    #[inline(always)]
+    fn block_dot(&self, start: usize, x: &[f32], scratch: &mut [f32]) -> [f32; UNIT_BLOCK] {
+        let len = (UNIT_BLOCK * x.len()).min(scratch.len());
+        let rows = &mut scratch[..len];
+        self.read(start, rows);
+        dot_block(rows, x)
     }
 }
 
@@ -467,6 +497,9 @@ impl<W> Network<W> {
         // Two buffers used in turn as a layer's input and output.
         let mut a = [T::ZERO; MAX_WIDTH];
         let mut b = [T::ZERO; MAX_WIDTH];
+        // Rows decoded from storage that does not hold `T` (one block at a time),
+        // cleared once per evaluation rather than per layer.
+        let mut scratch = [T::ZERO; UNIT_BLOCK * MAX_WIDTH];
         a[..INPUTS].copy_from_slice(input);
         let embedding = shape.embedding_offset(i);
         let hidden = shape.layers as usize;
@@ -475,21 +508,13 @@ impl<W> Network<W> {
             let (x, width) = (&a[..span.fan_in], span.width);
             if l < hidden {
                 let first = (l == 0).then_some(embedding);
-                layer(
-                    w,
-                    span.weights,
-                    span.bias,
-                    first,
-                    x,
-                    &mut b[..width],
-                    |o, z| {
-                        record(l, o, z);
-                        act.apply(z)
-                    },
-                );
+                layer(w, span, first, x, &mut b[..width], &mut scratch, |o, z| {
+                    record(l, o, z);
+                    act.apply(z)
+                });
                 core::mem::swap(&mut a, &mut b);
             } else {
-                layer(w, span.weights, span.bias, None, x, &mut out, |_, z| z);
+                layer(w, span, None, x, &mut out, &mut scratch, |_, z| z);
             }
         }
         if shape.lattice_residual {
@@ -528,22 +553,71 @@ pub fn dot<T: Real>(w: &[T], x: &[T]) -> T {
     ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]))
 }
 
+/// Units a dense layer computes together ([`Parameters::block_dot`]).
+pub const UNIT_BLOCK: usize = 4;
+
+/// [`dot`] of each of the [`UNIT_BLOCK`] consecutive rows at the start of `rows`
+/// (each `x.len()` long) with `x`: the same partial sums in the same order as
+/// [`dot`], so each result has `dot`'s bits. Side by side, the rows give the
+/// processor four independent chains of sums where one `dot` has one, and each
+/// chunk of `x` is loaded once for four rows. A `rows` shorter than the block
+/// dots what is there, row by row (never so in a validated network).
+#[inline(always)]
+pub fn dot_block<T: Real>(rows: &[T], x: &[T]) -> [T; UNIT_BLOCK] {
+    let len = x.len();
+    let row = |r: usize| {
+        let start = (r * len).min(rows.len());
+        let end = ((r + 1) * len).min(rows.len());
+        rows.get(start..end).unwrap_or(&[])
+    };
+    if rows.len() < UNIT_BLOCK * len {
+        return core::array::from_fn(|r| dot(row(r), x));
+    }
+    let rows: [&[T]; UNIT_BLOCK] = core::array::from_fn(row);
+    let mut s = [[T::ZERO; DOT_LANES]; UNIT_BLOCK];
+    // `chunks_exact`, not `as_chunks` (Rust 1.88; core promises 1.85).
+    fn lanes<T: Real>(v: &[T]) -> impl Iterator<Item = [T; DOT_LANES]> + '_ {
+        v.chunks_exact(DOT_LANES)
+            .map(|c| <[T; DOT_LANES]>::try_from(c).unwrap_or([T::ZERO; DOT_LANES]))
+    }
+    fn tail<T>(v: &[T], done: usize) -> &[T] {
+        v.get(done..).unwrap_or(&[])
+    }
+    let done = len / DOT_LANES * DOT_LANES;
+    let [r0, r1, r2, r3] = rows;
+    let quads = lanes(r0).zip(lanes(r1)).zip(lanes(r2)).zip(lanes(r3));
+    for (xk, (((w0, w1), w2), w3)) in lanes(x).zip(quads) {
+        for (sr, wk) in s.iter_mut().zip([w0, w1, w2, w3]) {
+            for c in 0..DOT_LANES {
+                sr[c] = sr[c] + wk[c] * xk[c];
+            }
+        }
+    }
+    for (sr, row) in s.iter_mut().zip(rows) {
+        for (sc, (&w, &x)) in sr.iter_mut().zip(tail(row, done).iter().zip(tail(x, done))) {
+            *sc = *sc + w * x;
+        }
+    }
+    s.map(|s| ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7])))
+}
+
 /// One dense layer: `out[o] = finish(o, acc)` with
 /// `acc = (w(bias + o) [+ w(extra + o)]) + dot(row_o, x)`, `row_o` the `fan_in`
-/// parameters from `off + o fan_in` ([`dot`] fixes the order of the sum).
+/// parameters from `span.weights + o fan_in`, `bias = span.bias` ([`dot`] fixes the
+/// order of the sum; units go in blocks of [`UNIT_BLOCK`], [`Parameters::block_dot`]).
 #[inline(always)]
 fn layer<T: Real>(
     w: &impl Parameters<T>,
-    off: usize,
-    bias: usize,
+    span: LayerSpan,
     extra: Option<usize>,
     x: &[T],
     out: &mut [T],
+    scratch: &mut [T; UNIT_BLOCK * MAX_WIDTH],
     mut finish: impl FnMut(usize, T) -> T,
 ) {
+    let (off, bias) = (span.weights, span.bias);
     let fan_in = x.len().min(MAX_WIDTH);
     let x = &x[..fan_in];
-    let mut scratch = [T::ZERO; MAX_WIDTH];
     // The biases (and the embedding row) in one vectorized read each, not a
     // bounds-checked decode per unit: `out` holds each unit's `acc` until its dot.
     w.read(bias, out);
@@ -554,9 +628,18 @@ fn layer<T: Real>(
             *acc = *acc + v;
         }
     }
-    for (o, slot) in out.iter_mut().enumerate() {
-        let acc = *slot;
-        *slot = finish(o, acc + w.row_dot(off + o * fan_in, x, &mut scratch));
+    let first = out.len() / UNIT_BLOCK * UNIT_BLOCK;
+    let mut blocks = out.chunks_exact_mut(UNIT_BLOCK);
+    for (b, slots) in blocks.by_ref().enumerate() {
+        let o = b * UNIT_BLOCK;
+        let dots = w.block_dot(off + o * fan_in, x, scratch);
+        for (r, (slot, d)) in slots.iter_mut().zip(dots).enumerate() {
+            *slot = finish(o + r, *slot + d);
+        }
+    }
+    for (r, slot) in blocks.into_remainder().iter_mut().enumerate() {
+        let o = first + r;
+        *slot = finish(o, *slot + w.row_dot(off + o * fan_in, x, scratch));
     }
 }
 
@@ -660,7 +743,9 @@ pub fn input_features<T: Real>(shape: &Shape, c: [T; 2], k: u32, i: u32) -> [T; 
 
 #[cfg(test)]
 mod tests {
+    extern crate std;
     use super::*;
+    use std::vec::Vec;
 
     fn shape(act: Activation) -> Shape {
         Shape::new(4, &[3, 2], act, 3).unwrap()
@@ -837,5 +922,101 @@ mod tests {
         assert_eq!(f, [-1.0, 1.0, -1.0, -1.0, 1.0]);
         let g = condition_features::<f32>([0.5, 0.25]);
         assert_eq!(g, [0.0, -0.5, -0.75, -0.5, -0.875]);
+    }
+
+    /// A fixed pseudo-random value in `[-1, 1)` for test data.
+    fn noise(j: usize) -> f64 {
+        (hash_u32(j as u32) as f64 / 2f64.powi(31)) - 1.0
+    }
+
+    #[test]
+    fn dot_block_gives_each_row_the_bits_of_dot() {
+        for len in [1, 3, 7, 8, 9, 11, 16, 31, 32, 33, 64, 128] {
+            let rows: Vec<f64> = (0..UNIT_BLOCK * len)
+                .map(|j| noise(j + 1000 * len))
+                .collect();
+            let x: Vec<f64> = (0..len).map(|j| noise(j + 7)).collect();
+            let got = dot_block(&rows, &x);
+            for (r, row) in rows.chunks_exact(len).enumerate() {
+                assert_eq!(
+                    got[r].to_bits(),
+                    dot(row, &x).to_bits(),
+                    "f64 len {len} row {r}"
+                );
+            }
+            let rows32: Vec<f32> = rows.iter().map(|&v| v as f32).collect();
+            let x32: Vec<f32> = x.iter().map(|&v| v as f32).collect();
+            let got = dot_block(&rows32, &x32);
+            for (r, row) in rows32.chunks_exact(len).enumerate() {
+                assert_eq!(
+                    got[r].to_bits(),
+                    dot(row, &x32).to_bits(),
+                    "f32 len {len} row {r}"
+                );
+            }
+            // A block cut short dots what is there: the last rows empty (0).
+            let short = dot_block(&rows[..2 * len + 1], &x);
+            assert_eq!(short[1].to_bits(), dot(&rows[len..2 * len], &x).to_bits());
+            assert_eq!(short[2], dot(&rows[2 * len..2 * len + 1], &x));
+            assert_eq!(short[3], 0.0);
+        }
+    }
+
+    /// A network wide enough for blocks of units and a remainder in every layer
+    /// (widths 9 and 6, output 2), with an embedding: each unit equals its
+    /// explicit `b + (E +) dot(row, x)` bit for bit, in both precisions, and the
+    /// f16 storage gives the bits of the same values decoded to `f32`.
+    #[test]
+    fn blocks_of_units_give_each_unit_its_own_dot() {
+        let shape = Shape::new(5, &[9, 6], Activation::Silu, 3).unwrap();
+        let p: Vec<f64> = (0..shape.param_len()).map(|j| noise(j) / 2.0).collect();
+        let net = Network {
+            shape,
+            params: &p[..],
+        };
+        let input: [f64; INPUTS] = core::array::from_fn(|k| noise(k + 99));
+        let i = 7u32; // wraps to row 2 of E
+        let t = net.forward(i, input);
+        let mut x: Vec<f64> = input.to_vec();
+        let mut want_out = [0.0; OUTPUTS];
+        for (l, span) in shape.layers().enumerate() {
+            let z: Vec<f64> = (0..span.width)
+                .map(|o| {
+                    let mut acc = p[span.bias + o];
+                    if l == 0 {
+                        acc += p[shape.embedding_offset(i) + o];
+                    }
+                    let row = &p[span.weights + o * span.fan_in..][..span.fan_in];
+                    acc + dot(row, &x)
+                })
+                .collect();
+            if l < shape.hidden().len() {
+                for (o, zo) in z.iter().enumerate() {
+                    assert_eq!(t.pre[l][o].to_bits(), zo.to_bits(), "layer {l} unit {o}");
+                }
+                x = z.iter().map(|&v| Activation::Silu.apply(v)).collect();
+            } else {
+                want_out.copy_from_slice(&z);
+            }
+        }
+        assert_eq!(t.output.map(f64::to_bits), want_out.map(f64::to_bits));
+
+        let bits: Vec<u16> = p
+            .iter()
+            .map(|&v| crate::quantize::f16_encode(v as f32))
+            .collect();
+        let decoded: Vec<f32> = bits.iter().map(|&h| f16_decode_finite(h)).collect();
+        let input32 = input.map(|v| v as f32);
+        let from_f16 = Network {
+            shape,
+            params: F16Params(&bits),
+        }
+        .evaluate(i, input32);
+        let from_f32 = Network {
+            shape,
+            params: &decoded[..],
+        }
+        .evaluate(i, input32);
+        assert_eq!(from_f16.map(f32::to_bits), from_f32.map(f32::to_bits));
     }
 }

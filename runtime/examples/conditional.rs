@@ -22,6 +22,13 @@ fn main() -> Result<(), BlobError> {
     // direction (z = normal) and rotates the set to its azimuth.
     let b = cs.sample_network(cond, 123_456, 0);
     let c = cs.sample_brdf(Vec3::new(0.2, 0.5, 0.8), 0.3, 7, 0);
+    // Network mode runs faster on weights decoded once into the caller's memory
+    // (a renderer keeps a Vec of `cs.decoded_network_len()` per blob); the
+    // samples are the same bits. `None` if the buffer is too short.
+    let mut decoded = [0.0f32; 64];
+    if let Some(fast) = cs.decode_network(&mut decoded) {
+        assert_eq!(fast.sample_network(cond, 123_456, 0), b);
+    }
     println!("N {n}, S {instances}: estimate {estimate}, {b:?}, {c:?}");
     Ok(())
 }

@@ -11,7 +11,7 @@ use nuld_core::blob::{BlobError, Domain, Layout, SectionTag};
 use nuld_core::conditional::{
     unpack_point, ConditionalInfo, ConditionalTarget, GridCell, PointWarp, CONDITIONAL_INFO_LEN,
 };
-use nuld_core::network::{input_features, Activation, F16Params, Network, Shape};
+use nuld_core::network::{input_features, Activation, F16Params, Network, Parameters, Shape};
 use nuld_core::quantize::{f16_is_finite, unorm16_decode};
 
 /// One sample: a unit direction and the estimator weight of every sample of its
@@ -43,9 +43,17 @@ pub struct ConditionalSampler<'a> {
     domain: Domain,
     target: ConditionalTarget,
     warp: PointWarp,
-    params: &'a [u16],
+    params: NetworkParams<'a>,
     table: &'a [u32],
     weights: &'a [f32],
+}
+
+/// Where network mode reads its parameters: the blob's f16 bits (zero-copy), or
+/// the caller's buffer holding them decoded ([`ConditionalSampler::decode_network`]).
+#[derive(Clone, Copy, Debug)]
+enum NetworkParams<'a> {
+    F16(&'a [u16]),
+    F32(&'a [f32]),
 }
 
 /// Square point used if a table lookup ever missed (it cannot in a parsed blob).
@@ -176,7 +184,7 @@ impl<'a> ConditionalSampler<'a> {
             domain,
             target,
             warp,
-            params,
+            params: NetworkParams::F16(params),
             table,
             weights,
         })
@@ -185,11 +193,10 @@ impl<'a> ConditionalSampler<'a> {
     /// Every parameter a finite f16 (so [`f16_decode_finite`] applies), every
     /// weight finite and `>= 0`. `O(param_len + weight_table_len)`.
     fn check_values(&self) -> Result<(), BlobError> {
-        let bad_param = self
-            .params
-            .iter()
-            .enumerate()
-            .find(|(_, &h)| !f16_is_finite(h));
+        let NetworkParams::F16(params) = self.params else {
+            return Ok(());
+        };
+        let bad_param = params.iter().enumerate().find(|(_, &h)| !f16_is_finite(h));
         if let Some((index, &bits)) = bad_param {
             let index = index as u64;
             return Err(BlobError::NonFiniteParam { index, bits });
@@ -343,13 +350,63 @@ impl<'a> ConditionalSampler<'a> {
     #[inline]
     fn network_square_point_at(&self, u: [f32; 2], instance: u32, i: u32) -> Vec2 {
         let input = input_features::<f32>(&self.shape, u, instance, i);
-        let params = self.params;
-        let net = Network {
-            shape: self.shape,
+        let shape = self.shape;
+        Vec2::from_array(match self.params {
             // Every index below `param_len` exists and is finite (`validate`).
-            params: F16Params(params),
-        };
-        Vec2::from_array(net.square_point(i, input))
+            NetworkParams::F16(params) => Network {
+                shape,
+                params: F16Params(params),
+            }
+            .square_point(i, input),
+            NetworkParams::F32(params) => Network { shape, params }.square_point(i, input),
+        })
+    }
+
+    /// Length of the `f32` buffer [`Self::decode_network`] needs:
+    /// [`Shape::param_len`], 4 bytes per parameter.
+    pub fn decoded_network_len(&self) -> usize {
+        self.shape.param_len()
+    }
+
+    /// This sampler with network mode reading the network's parameters decoded to
+    /// `f32` into `buf` (its first [`Self::decoded_network_len`] entries), instead
+    /// of decoding each f16 on every sample. The decode is exact, so every method
+    /// returns the same bits as on `self`; network mode gets faster (the f16
+    /// decode is most of its cost on a CPU without a half-float unit; `build-tool
+    /// bench --only runtime` times both), table mode is unchanged. Decode once per
+    /// blob, as a renderer uploads tables once. `None` if `buf` is shorter;
+    /// `O(param_len)`, never panics.
+    ///
+    /// ```
+    /// # let bytes = nuld_runtime::doc_example_conditional_blob();
+    /// use nuld_runtime::glam::Vec2;
+    /// let cs = nuld_runtime::Blob::parse(&bytes.0)?.conditional()?;
+    /// let mut buf = [0.0f32; 64];
+    /// let fast = cs.decode_network(&mut buf).expect("a long enough buffer");
+    /// let c = Vec2::new(0.5, 30.0);
+    /// assert_eq!(fast.sample_network(c, 9, 2), cs.sample_network(c, 9, 2));
+    /// assert!(cs.decode_network(&mut [0.0; 1]).is_none());
+    /// # Ok::<(), nuld_runtime::BlobError>(())
+    /// ```
+    pub fn decode_network<'b>(&self, buf: &'b mut [f32]) -> Option<ConditionalSampler<'b>>
+    where
+        'a: 'b,
+    {
+        let len = self.decoded_network_len();
+        let out = buf.get_mut(..len)?;
+        match self.params {
+            NetworkParams::F16(params) => {
+                if params.len() != len {
+                    return None;
+                }
+                F16Params(params).read(0, out);
+            }
+            NetworkParams::F32(params) => out.copy_from_slice(params.get(..len)?),
+        }
+        Some(ConditionalSampler {
+            params: NetworkParams::F32(out),
+            ..*self
+        })
     }
 
     /// Table mode: the direction of index `i` of instance `instance` at condition
@@ -574,7 +631,7 @@ mod tests {
     use crate::Blob;
     use nuld_core::blob::{encoded_len, write, BlobKind};
     use nuld_core::conditional::sections;
-    use nuld_core::quantize::f16_encode;
+    use nuld_core::quantize::{f16_decode_finite, f16_encode};
     use std::vec::Vec;
 
     /// The four sections of a conditional blob, owned, for building test blobs.
@@ -662,6 +719,53 @@ mod tests {
         change(&mut p);
         let bytes = encode(&p);
         Blob::parse(bytes.get()).map(|_| ())
+    }
+
+    #[test]
+    fn a_decoded_network_samples_the_same_bits() {
+        let bytes = encode(&parts());
+        let cs = Blob::parse(bytes.get()).unwrap().conditional().unwrap();
+        let len = cs.decoded_network_len();
+        assert_eq!(len, cs.shape().param_len());
+        assert!(cs.decode_network(&mut std::vec![0.0; len - 1]).is_none());
+        let mut buf = std::vec![f32::NAN; len + 3];
+        let fast = cs.decode_network(&mut buf).unwrap();
+        for k in 0..2000u32 {
+            let c = Vec2::new(
+                (noise(3, k) % 1300) as f32 / 1000.0 - 0.1,
+                (noise(4, k) % 900) as f32 / 10.0,
+            );
+            let (instance, i) = (noise(5, k), k % 11);
+            let wo = Vec3::new(c.y.to_radians().sin(), 0.3, c.y.to_radians().cos());
+            let n = Vec3::new(c.x - 0.5, 0.2, 1.0);
+            assert_eq!(
+                fast.sample_network(c, instance, i),
+                cs.sample_network(c, instance, i)
+            );
+            assert_eq!(
+                fast.sample_brdf_network(wo, c.x, instance, i),
+                cs.sample_brdf_network(wo, c.x, instance, i)
+            );
+            assert_eq!(
+                fast.sample_envmap_network(n, instance, i),
+                cs.sample_envmap_network(n, instance, i)
+            );
+            // Table mode does not read the network.
+            assert_eq!(fast.sample(c, instance, i), cs.sample(c, instance, i));
+        }
+        // Decoding a decoded sampler copies its weights.
+        let mut again = std::vec![0.0; len];
+        let twice = fast.decode_network(&mut again).unwrap();
+        let c = Vec2::new(0.4, 33.0);
+        assert_eq!(twice.sample_network(c, 8, 3), cs.sample_network(c, 8, 3));
+        assert_eq!(again, buf[..len]);
+        // The weights are the f16 values decoded; the rest of the buffer is untouched.
+        let Parts { params, .. } = parts();
+        assert!(params
+            .iter()
+            .zip(&buf)
+            .all(|(&h, &v)| f16_decode_finite(h) == v));
+        assert!(buf[len..].iter().all(|v| v.is_nan()));
     }
 
     #[test]

@@ -75,8 +75,10 @@ pub unsafe extern "C" fn nuld_check_direction(
 /// Writes sample `i` of instance `instance` of the conditional blob to
 /// `out[0..4]` (direction, weight) in the given mode: 0 table mode at
 /// `(c0, c1)`, 1 network mode at `(c0, c1)`, 2 `sample_brdf` with the view
-/// `(c1, 0, 1)` and roughness `c0`, 3 `sample_envmap` at the normal `(c0, c1, 1)`.
-/// Returns 0 on success, 1 otherwise.
+/// `(c1, 0, 1)` and roughness `c0`, 3 `sample_envmap` at the normal `(c0, c1, 1)`,
+/// 4 network mode at `(c0, c1)` on weights decoded into a stack buffer
+/// (`decode_network`). Returns 0 on success, 1 otherwise (also for a network
+/// too large for the buffer in mode 4).
 ///
 /// # Safety
 /// `ptr` must be valid for `len` bytes and `out` for four `f32` writes.
@@ -96,10 +98,15 @@ pub unsafe extern "C" fn nuld_check_conditional(
     let bytes = core::slice::from_raw_parts(ptr, len);
     match Blob::parse(bytes).and_then(|b| b.conditional()) {
         Ok(cs) => {
+            let mut decoded = [0.0f32; 8192];
             let s = match mode {
                 0 => cs.sample(Vec2::new(c0, c1), instance, i),
                 1 => cs.sample_network(Vec2::new(c0, c1), instance, i),
                 2 => cs.sample_brdf(Vec3::new(c1, 0.0, 1.0), c0, instance, i),
+                4 => match cs.decode_network(&mut decoded) {
+                    Some(fast) => fast.sample_network(Vec2::new(c0, c1), instance, i),
+                    None => return 1,
+                },
                 _ => cs.sample_envmap(Vec3::new(c0, c1, 1.0), instance, i),
             };
             *out = s.direction.x;
