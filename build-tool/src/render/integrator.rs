@@ -208,7 +208,9 @@ mod tests {
                 env: &env,
             };
             let lobes = LobeTable::new(&[roughness]);
-            let samplers = lineup::samplers(blob.as_slice(), None, 16, 5, &lobes, &env).unwrap();
+            let mut weights = Default::default();
+            let samplers =
+                lineup::samplers(blob.as_slice(), None, 16, 5, &lobes, &env, &mut weights).unwrap();
             // A at each surface pixel's view angle.
             let albedo: Vec<Option<f64>> = (0..24)
                 .flat_map(|y| (0..24).map(move |x| (x, y)))

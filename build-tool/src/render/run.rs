@@ -222,14 +222,24 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
         let (envmap_path, envmap_bytes) = envmap_blobs
             .get(n)
             .with_context(|| format!("no environment blob with N = {n}"))?;
-        let samplers = lineup::samplers(bytes, Some(envmap_bytes), n, config.seed, &lobes, &env)
-            .with_context(|| {
-                format!(
-                    "blobs {} and {}",
-                    blob_path.display(),
-                    envmap_path.display()
-                )
-            })?;
+        // Network mode's weights, decoded once per blob (as a renderer would).
+        let mut weights = Default::default();
+        let samplers = lineup::samplers(
+            bytes,
+            Some(envmap_bytes),
+            n,
+            config.seed,
+            &lobes,
+            &env,
+            &mut weights,
+        )
+        .with_context(|| {
+            format!(
+                "blobs {} and {}",
+                blob_path.display(),
+                envmap_path.display()
+            )
+        })?;
         for sampler in &samplers {
             progress.set_context(format!(
                 "{} {} {n} spp",
