@@ -8,9 +8,10 @@
 //! are timed on blobs with random contents ([`random_parts`]).
 
 use crate::conditional::blob::ConditionalParts;
-use crate::conditional::distill::brdf_info;
+use crate::conditional::distill::info;
 use crate::pointset::AlignedBytes;
 use crate::sphere::{BrdfTarget, DirectionDensity};
+use crate::train::target::LoadedTarget;
 use anyhow::{anyhow, ensure, Result};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Metadata;
@@ -23,9 +24,9 @@ use rand::{Rng, SeedableRng};
 use std::hint::black_box;
 use std::time::Instant;
 
-/// A BRDF conditional sampler (hemisphere, the condition range of
-/// [`brdf_info`]) with random contents: `n` points, `instances` stored instances, a
-/// `grid` point table of random codes, a 7 x 9 weight table of weights in
+/// A BRDF conditional sampler (hemisphere, the BRDF's condition range: [`info`]
+/// of [`LoadedTarget::GltfBrdf`]) with random contents: `n` points, `instances`
+/// stored instances, a `grid` point table of random codes, a 7 x 9 weight table of weights in
 /// `[0.5, 1.6)`, and a network of the given hidden widths (1 to 3) with f16
 /// parameters uniform in `[-0.6, 0.6]`, with the given point warp (for
 /// [`PointWarp::BrdfMixture`] a second weight-grid table of lobe probabilities
@@ -52,7 +53,7 @@ pub fn random_parts(
     let shape = Shape::new(n, hidden, activation, lattice_generator)
         .ok_or_else(|| anyhow!("n {n}, hidden {hidden:?}: no valid network"))?
         .with_lattice_residual(warp == PointWarp::BrdfMixture);
-    let info = brdf_info(&shape, instances, grid, [7, 9]);
+    let info = info(&shape, &LoadedTarget::GltfBrdf, instances, grid, [7, 9]);
     let params = (0..shape.param_len())
         .map(|_| nuld_core::quantize::f16_encode(rng.random_range(-0.6f32..=0.6)))
         .collect();

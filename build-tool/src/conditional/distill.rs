@@ -9,7 +9,7 @@
 //!   ([`directional_albedo`]), followed for a [`PointWarp::BrdfMixture`] sampler by
 //!   the lobe probability `p_s = A_spec / A` at the same nodes (what
 //!   [`crate::sphere::brdf_albedo::lobe_probability`] computes, from the same
-//!   quadrature); for an environment sampler ([`ConditionalTarget::EnvmapNormal`])
+//!   quadrature); for an environment sampler ([`nuld_core::conditional::ConditionalTarget::EnvmapNormal`])
 //!   the irradiance `E(n)` of the map at every node's normal
 //!   ([`EnvmapDensity::irradiance`]).
 
@@ -19,59 +19,42 @@ use crate::sphere::brdf_albedo::directional_albedo;
 use crate::sphere::EnvmapDensity;
 use crate::train::target::LoadedTarget;
 use glam::DVec2;
-use nuld_core::blob::Domain;
-use nuld_core::brdf::{BrdfModel, BrdfParts, CONDITION_MAX, CONDITION_MIN};
-use nuld_core::conditional::{pack_point, ConditionalInfo, ConditionalTarget, PointWarp};
+use nuld_core::brdf::{BrdfModel, BrdfParts};
+use nuld_core::conditional::{pack_point, ConditionalInfo, PointWarp};
 use nuld_core::network::{Shape, MAX_HIDDEN_LAYERS};
 use nuld_core::quantize::unorm16_encode;
 use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
 
-/// The info record of a glTF BRDF sampler over the condition range
-/// ([`CONDITION_MIN`] to [`CONDITION_MAX`]) with a network of `shape` (its point
-/// warp [`PointWarp::of_shape`]), `instances` stored instances, and the given point
-/// and weight grids (nodes per axis, each `>= 2`).
-pub fn brdf_info(
+/// The info record of a sampler of `target` over its condition range
+/// ([`LoadedTarget::condition_range`]) and domain, with a network of `shape` (its
+/// point warp [`PointWarp::of_shape`]), `instances` stored instances, and the given
+/// point and weight grids (nodes per axis, each `>= 2`).
+pub fn info(
     shape: &Shape,
+    target: &LoadedTarget,
     instances: u32,
     grid: [u32; 2],
     weight_grid: [u32; 2],
 ) -> ConditionalInfo {
     let mut hidden = [0u32; MAX_HIDDEN_LAYERS];
     hidden[..shape.hidden().len()].copy_from_slice(shape.hidden());
+    let (lo, hi) = target.condition_range();
+    let kind = target.kind();
     ConditionalInfo {
         n: shape.n(),
         instances,
-        domain: Domain::Hemisphere as u32,
-        target: ConditionalTarget::GltfBrdf as u32,
+        domain: kind.domain() as u32,
+        target: kind as u32,
         grid,
         weight_grid,
-        cond_min: CONDITION_MIN.map(|x| x as f32),
-        cond_max: CONDITION_MAX.map(|x| x as f32),
+        cond_min: lo.map(|x| x as f32),
+        cond_max: hi.map(|x| x as f32),
         hidden,
         activation: shape.activation() as u32,
         lattice_generator: shape.lattice_generator(),
         warp: PointWarp::of_shape(shape) as u32,
         reserved: [0; 2],
-    }
-}
-
-/// The info record of an environment sampler: condition = the normal's octahedral
-/// square point over `[0,1]^2`, directions on the sphere, the equal-area output,
-/// otherwise as [`brdf_info`].
-pub fn envmap_info(
-    shape: &Shape,
-    instances: u32,
-    grid: [u32; 2],
-    weight_grid: [u32; 2],
-) -> ConditionalInfo {
-    ConditionalInfo {
-        domain: Domain::Sphere as u32,
-        target: ConditionalTarget::EnvmapNormal as u32,
-        cond_min: [0.0; 2],
-        cond_max: [1.0; 2],
-        warp: PointWarp::EqualArea as u32,
-        ..brdf_info(shape, instances, grid, weight_grid)
     }
 }
 
@@ -84,10 +67,7 @@ pub fn distill(
     grid: [u32; 2],
     weight_grid: [u32; 2],
 ) -> ConditionalParts {
-    let info = match target {
-        LoadedTarget::GltfBrdf => brdf_info(&params.shape, instances, grid, weight_grid),
-        LoadedTarget::Envmap(_) => envmap_info(&params.shape, instances, grid, weight_grid),
-    };
+    let info = info(&params.shape, target, instances, grid, weight_grid);
     let shipped = params.rounded_to_f16();
     let n = info.n;
     let nodes = (grid[0] * grid[1]) as usize;
@@ -187,5 +167,41 @@ mod tests {
         assert_eq!(c[1], 89.0);
         let a = directional_albedo(BrdfModel::Gltf, c[0], c[1]).total();
         assert_eq!(parts.weights[8], a as f32);
+    }
+
+    #[test]
+    fn info_records_each_targets_code_domain_range_and_warp() {
+        use nuld_core::blob::Domain;
+        use nuld_core::brdf::{CONDITION_MAX, CONDITION_MIN};
+        let shape = Shape::new(5, &[6, 3], Activation::Relu, 2).unwrap();
+        let brdf = info(
+            &shape.with_lattice_residual(true),
+            &LoadedTarget::GltfBrdf,
+            3,
+            [3, 2],
+            [4, 5],
+        );
+        assert_eq!((brdf.target, brdf.domain), (1, Domain::Hemisphere as u32));
+        assert_eq!(brdf.cond_min, CONDITION_MIN.map(|x| x as f32));
+        assert_eq!(brdf.cond_max, CONDITION_MAX.map(|x| x as f32));
+        assert_eq!(brdf.warp, PointWarp::BrdfMixture as u32);
+        assert_eq!(
+            (brdf.n, brdf.instances, brdf.grid, brdf.weight_grid),
+            (5, 3, [3, 2], [4, 5])
+        );
+        assert_eq!((brdf.hidden, brdf.lattice_generator), ([6, 3, 0], 2));
+        assert_eq!(brdf.shape(), Some(shape.with_lattice_residual(true)));
+
+        let dir = std::env::temp_dir().join(format!("nuld-distill-info-{}", std::process::id()));
+        let map = crate::train::target::TrainTarget::envmap(&crate::render::blobs::tiny_map(&dir))
+            .unwrap()
+            .load()
+            .unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+        let env = info(&shape, &map, 3, [3, 2], [4, 5]);
+        assert_eq!((env.target, env.domain), (2, Domain::Sphere as u32));
+        assert_eq!((env.cond_min, env.cond_max), ([0.0; 2], [1.0; 2]));
+        assert_eq!(env.warp, PointWarp::EqualArea as u32);
+        assert_eq!(env.shape(), Some(shape));
     }
 }

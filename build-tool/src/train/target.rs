@@ -7,6 +7,7 @@ use crate::sphere::EnvmapDensity;
 use anyhow::{Context, Result};
 use nuld_core::blob::Domain;
 use nuld_core::brdf::{CONDITION_MAX, CONDITION_MIN};
+use nuld_core::conditional::ConditionalTarget;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -80,6 +81,15 @@ pub enum LoadedTarget {
 }
 
 impl LoadedTarget {
+    /// The blob's target code of this family (which also fixes its domain,
+    /// [`ConditionalTarget::domain`]).
+    pub fn kind(&self) -> ConditionalTarget {
+        match self {
+            Self::GltfBrdf => ConditionalTarget::GltfBrdf,
+            Self::Envmap(_) => ConditionalTarget::EnvmapNormal,
+        }
+    }
+
     /// The conditions a sampler of this target serves, in blob units, as the
     /// corners `(lo, hi)` of a box: `(roughness, theta_o in degrees)` from
     /// [`CONDITION_MIN`] to [`CONDITION_MAX`] for the BRDF, the normal's equal-area
