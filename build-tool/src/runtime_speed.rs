@@ -26,8 +26,8 @@ use std::time::Instant;
 
 /// A BRDF conditional sampler (hemisphere, the BRDF's condition range: [`info`]
 /// of [`LoadedTarget::GltfBrdf`]) with random contents: `n` points, `instances`
-/// stored instances, a `grid` point table of random codes, a 7 x 9 weight table of weights in
-/// `[0.5, 1.6)`, and a network of the given hidden widths (1 to 3) with f16
+/// stored instances, a `grid` point table of random codes, a 7 x 9 weight table
+/// of weights in `[0.5, 1.6)`, and a network of the given hidden widths (1 to 3) with f16
 /// parameters uniform in `[-0.6, 0.6]`, with the given point warp (for
 /// [`PointWarp::BrdfMixture`] a second weight-grid table of lobe probabilities
 /// uniform in `[0.02, 0.98)`). Deterministic for a seed. Fails if the counts

@@ -327,9 +327,20 @@ pub trait Parameters<T: Real> {
     /// ([`dot_block`]), which keeps more multiply-adds in flight per row.
     #[inline(always)]
     fn block_dot(&self, start: usize, x: &[T], scratch: &mut [T]) -> [T; UNIT_BLOCK] {
-        let len = x.len();
-        core::array::from_fn(|r| self.row_dot(start.saturating_add(r * len), x, scratch))
+        rows_one_by_one(self, start, x, scratch)
     }
+}
+
+/// [`Parameters::block_dot`] as [`UNIT_BLOCK`] calls of [`Parameters::row_dot`].
+#[inline(always)]
+fn rows_one_by_one<T: Real, W: Parameters<T> + ?Sized>(
+    w: &W,
+    start: usize,
+    x: &[T],
+    scratch: &mut [T],
+) -> [T; UNIT_BLOCK] {
+    let len = x.len();
+    core::array::from_fn(|r| w.row_dot(start.saturating_add(r * len), x, scratch))
 }
 
 /// [`Parameters::row_dot`] through a copy of the row in `scratch`.
@@ -384,9 +395,7 @@ impl<T: Real> Parameters<T> for &[T] {
             .and_then(|end| <[T]>::get(self, start..end))
         {
             Some(rows) => dot_block(rows, x),
-            None => {
-                core::array::from_fn(|r| self.row_dot(start.saturating_add(r * len), x, scratch))
-            }
+            None => rows_one_by_one(self, start, x, scratch),
         }
     }
 }
@@ -550,6 +559,12 @@ pub fn dot<T: Real>(w: &[T], x: &[T]) -> T {
     for (sc, (&wk, &xk)) in s.iter_mut().zip(wr.iter().zip(xr)) {
         *sc = *sc + wk * xk;
     }
+    sum_lanes(s)
+}
+
+/// The last step of [`dot`]: `((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7))`.
+#[inline(always)]
+fn sum_lanes<T: Real>(s: [T; DOT_LANES]) -> T {
     ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]))
 }
 
@@ -598,7 +613,7 @@ pub fn dot_block<T: Real>(rows: &[T], x: &[T]) -> [T; UNIT_BLOCK] {
             *sc = *sc + w * x;
         }
     }
-    s.map(|s| ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7])))
+    s.map(sum_lanes)
 }
 
 /// One dense layer: `out[o] = finish(o, acc)` with
@@ -929,6 +944,19 @@ mod tests {
         (hash_u32(j as u32) as f64 / 2f64.powi(31)) - 1.0
     }
 
+    /// `dot_block` of `rows` against `dot` of each row, compared by `bits`.
+    fn assert_block_is_dot<T: Real>(rows: &[T], x: &[T], bits: impl Fn(T) -> u64, what: &str) {
+        let got = dot_block(rows, x);
+        for (r, row) in rows.chunks_exact(x.len()).enumerate() {
+            assert_eq!(
+                bits(got[r]),
+                bits(dot(row, x)),
+                "{what} len {} row {r}",
+                x.len()
+            );
+        }
+    }
+
     #[test]
     fn dot_block_gives_each_row_the_bits_of_dot() {
         for len in [1, 3, 7, 8, 9, 11, 16, 31, 32, 33, 64, 128] {
@@ -936,24 +964,10 @@ mod tests {
                 .map(|j| noise(j + 1000 * len))
                 .collect();
             let x: Vec<f64> = (0..len).map(|j| noise(j + 7)).collect();
-            let got = dot_block(&rows, &x);
-            for (r, row) in rows.chunks_exact(len).enumerate() {
-                assert_eq!(
-                    got[r].to_bits(),
-                    dot(row, &x).to_bits(),
-                    "f64 len {len} row {r}"
-                );
-            }
+            assert_block_is_dot(&rows, &x, f64::to_bits, "f64");
             let rows32: Vec<f32> = rows.iter().map(|&v| v as f32).collect();
             let x32: Vec<f32> = x.iter().map(|&v| v as f32).collect();
-            let got = dot_block(&rows32, &x32);
-            for (r, row) in rows32.chunks_exact(len).enumerate() {
-                assert_eq!(
-                    got[r].to_bits(),
-                    dot(row, &x32).to_bits(),
-                    "f32 len {len} row {r}"
-                );
-            }
+            assert_block_is_dot(&rows32, &x32, |v| v.to_bits() as u64, "f32");
             // A block cut short dots what is there: the last rows empty (0).
             let short = dot_block(&rows[..2 * len + 1], &x);
             assert_eq!(short[1].to_bits(), dot(&rows[len..2 * len], &x).to_bits());
