@@ -7,6 +7,8 @@
 //!   `brdf:ROUGHNESS,THETA_O_DEG` (`brdf-burley:...`), `envmap:PATH`;
 //! * [`closed_form`]: the `uniform` and `cosine` targets;
 //! * [`brdf_target`], [`envmap`]: the two tabulated targets;
+//! * [`filtered_luminance`]: a map's bilinearly filtered luminance (the light of
+//!   `bake --envmap` and `render`) and its exact tabulation on half pixels;
 //! * [`brdf_albedo`]: the BRDF's directional albedo (the `brdf` normalizer and the
 //!   per-condition sample weight) and tables of it;
 //! * [`geometry`]: closed-form cap measures (uniform sphere and hemisphere, cosine);
@@ -26,6 +28,7 @@ pub mod brdf_target;
 pub mod cap_table;
 pub mod closed_form;
 pub mod envmap;
+pub mod filtered_luminance;
 pub mod geometry;
 pub mod metrics;
 pub mod spec;
@@ -36,6 +39,7 @@ pub use brdf_target::BrdfTarget;
 pub use cap_table::CapMeasureTable;
 pub use closed_form::{CosineDirections, UniformDirections};
 pub use envmap::EnvmapDensity;
+pub use filtered_luminance::FilteredLuminance;
 pub use geometry::{
     cosine_cap_measure, random_direction, uniform_hemisphere_cap_measure,
     uniform_sphere_cap_measure,
