@@ -15,8 +15,9 @@ pub struct BakeArgs {
     #[arg(long, conflicts_with = "envmap")]
     pub brdf: bool,
     /// Bake the environment-map sampler of this map (HDR, EXR; equirectangular, +z
-    /// up): q(l | n) proportional to L(l) max(0, n.l), condition: the surface
-    /// normal, weight: the irradiance E(n). Writes DIR/envmap.nuld.
+    /// up): q(l | n) proportional to L(l) max(0, n.l), L the map's bilinearly
+    /// filtered luminance, condition: the surface normal, weight: the irradiance
+    /// E(n). Writes DIR/envmap.nuld.
     #[arg(long, value_name = "MAP")]
     pub envmap: Option<PathBuf>,
     /// Points per set.

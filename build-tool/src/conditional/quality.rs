@@ -261,7 +261,9 @@ mod tests {
     use crate::train::TrainTarget;
     use nuld_core::network::{Activation, Shape};
 
-    /// On a map lit only above the horizon: the held-out normals are the cell
+    /// On a map lit only above the horizon (its filtered light reaches half a
+    /// pixel beyond the lit rows, so the row just above the horizon is dark too):
+    /// the held-out normals are the cell
     /// centres of the octahedral square, each judged names its normal, and the
     /// normal `-z` (the square's corner), which faces only the dark lower half
     /// (E = 0), is left out; a network that ignores the instance makes identical
@@ -273,7 +275,7 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("nuld-quality-envmap-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("upper.png");
-        image::RgbImage::from_fn(32, 16, |_, y| image::Rgb([if y < 8 { 200 } else { 0 }; 3]))
+        image::RgbImage::from_fn(32, 16, |_, y| image::Rgb([if y < 7 { 200 } else { 0 }; 3]))
             .save(&path)
             .unwrap();
         let target = TrainTarget::envmap(&path).unwrap().load().unwrap();

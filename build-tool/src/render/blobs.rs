@@ -84,7 +84,7 @@ impl<'e> SamplerBlobs<'e> {
                 let agrees = (b - m).abs() <= 1e-3 * scale;
                 if !agrees {
                     bail!(
-                        "environment blob {}: an environment sampler baked for another map (irradiance {b:.4e} in the blob, {m:.4e} from the map, at the normal {n:.3})",
+                        "environment blob {}: an environment sampler baked for another map, or before the light was filtered bilinearly: bake it again (irradiance {b:.4e} in the blob, {m:.4e} from the map, at the normal {n:.3})",
                         path.display()
                     );
                 }

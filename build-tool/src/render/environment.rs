@@ -4,25 +4,29 @@
 //! and rendered in luminance (Rec.709 `Y`): with base colour 1 every surface is
 //! grey, so the luminance of the image is the image of the luminance. The
 //! equirectangular convention is [`EnvmapDensity`]'s (`+z` up, `phi` from `+x`
-//! towards `+y`, row 0 at `theta = 0`), and the radiance is piecewise constant on
-//! pixels: `L(w)` is the luminance of the pixel holding `w`. That is exactly the
-//! density the map's samplers draw from (`pdf(w) = L(w) / Φ`, `Φ = ∫ L dw`), so
-//! `L / pdf` is the constant `Φ` wherever `L > 0`.
+//! towards `+y`, row 0 at `theta = 0`), and the radiance `L(w)` is the map's
+//! bilinearly filtered luminance ([`FilteredLuminance`]), as a renderer's
+//! filtered texture lookup gives it.
 //!
-//! Two warps of a uniform point `u` of the square, both onto that density:
+//! Two warps of a uniform point `u` of the square, both onto the density of the
+//! filtered map tabulated on half pixels with their exact masses
+//! ([`EnvmapDensity::from_luminance_filtered`], the density `bake --envmap` trains
+//! on), as pbrt-v4 builds its sampling distribution from the filtered image:
 //! * **marginal-conditional inverse CDF** ([`Environment::sample_inverse_cdf`],
 //!   [`EnvmapDensity`]'s own sampler): a row by `u.y`, a column within it by `u.x`;
 //! * **hierarchical warping** ([`Environment::sample_hierarchical`], Clarberg et
-//!   al. 2005, [`HierarchicalWarp`]) over the grid of pixel masses.
+//!   al. 2005, [`HierarchicalWarp`]) over the grid of half-pixel masses.
 //!
-//! Both place the point inside its pixel uniformly in `z = cos theta` and `phi`
-//! ([`EnvmapDensity::pixel_direction`]), so their density is the same
-//! piecewise-constant [`Environment::pdf`].
+//! Both place the point inside its half pixel uniformly in `z = cos theta` and
+//! `phi` ([`EnvmapDensity::pixel_direction`]), so their density is the same
+//! piecewise-constant [`Environment::pdf`]; it is positive wherever `L` is (a half
+//! pixel's mass is `∫ L` over it), so `L / pdf` is finite and the estimators are
+//! unbiased, and it varies inside a half pixel where `L` does.
 
 use crate::baselines::HierarchicalWarp;
 use crate::density::image::{load_luminance, LuminanceImage};
 use crate::density::CellGrid;
-use crate::sphere::{DirectionDensity, EnvmapDensity};
+use crate::sphere::{DirectionDensity, EnvmapDensity, FilteredLuminance};
 use anyhow::{Context, Result};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
@@ -31,6 +35,7 @@ use std::path::Path;
 /// An environment map: radiance lookup, density and the two warps.
 #[derive(Clone, Debug)]
 pub struct Environment {
+    radiance: FilteredLuminance,
     density: EnvmapDensity,
     hierarchical: HierarchicalWarp,
 }
@@ -57,8 +62,11 @@ impl Environment {
     /// The map from decoded luminance (`name` for messages). Negative pixels are
     /// set to 0, as [`EnvmapDensity`] does.
     pub fn from_luminance(img: &LuminanceImage, name: &str) -> Result<Self> {
-        let density = EnvmapDensity::from_luminance(img, Domain::Sphere, name)
+        let density = EnvmapDensity::from_luminance_filtered(img, Domain::Sphere, name)
             .with_context(|| format!("environment map {name}"))?;
+        let mut clamped = img.clone();
+        clamped.clamp_negatives();
+        let radiance = FilteredLuminance::new(&clamped);
         let (w, h) = (density.width(), density.height());
         let mass: Vec<f64> = (0..h)
             .flat_map(|r| (0..w).map(move |c| (c, r)))
@@ -70,20 +78,22 @@ impl Environment {
             mass,
         });
         Ok(Self {
+            radiance,
             density,
             hierarchical,
         })
     }
 
-    /// `Φ = ∫ L(w) dw` over the sphere (luminance times steradians).
+    /// `Φ = ∫ L(w) dw` over the sphere (luminance times steradians; exact, the sum
+    /// of the half pixels' masses).
     pub fn power(&self) -> f64 {
         self.density.integral()
     }
 
     /// Radiance (luminance) arriving from direction `w` (any length > 0): the
-    /// pixel's value, `Φ pdf(w)`.
+    /// map's bilinearly filtered luminance there ([`FilteredLuminance::at`]).
     pub fn radiance(&self, w: DVec3) -> f64 {
-        self.power() * self.density.pdf(w)
+        self.radiance.at(w)
     }
 
     /// The irradiance `E(n) = ∫ L(l) max(0, n.l) dl` at surfaces facing each of
@@ -92,7 +102,8 @@ impl Environment {
         self.density.irradiances(normals)
     }
 
-    /// Density per steradian of both warps at `w`: `L(w) / Φ`.
+    /// Density per steradian of both warps at `w`: the mean of `L` over the half
+    /// pixel holding `w`, over `Φ`.
     pub fn pdf(&self, w: DVec3) -> f64 {
         self.density.pdf(w)
     }
@@ -103,8 +114,8 @@ impl Environment {
     }
 
     /// The direction of `u` in `[0,1)^2` by hierarchical warping: the quadtree picks
-    /// a pixel with its mass and a point in it, which is spread uniformly in `z` and
-    /// `phi` within the pixel ([`EnvmapDensity::pixel_direction`]).
+    /// a half pixel with its mass and a point in it, which is spread uniformly in
+    /// `z` and `phi` within the half pixel ([`EnvmapDensity::pixel_direction`]).
     pub fn sample_hierarchical(&self, u: DVec2) -> DVec3 {
         let p = self.hierarchical.warp(u);
         let (w, h) = (self.density.width(), self.density.height());
@@ -146,7 +157,7 @@ mod tests {
     }
 
     #[test]
-    fn radiance_is_the_pixel_value_and_power_its_integral() {
+    fn radiance_is_the_pixel_value_at_centres_and_power_its_integral() {
         let img = test_map();
         let env = Environment::from_luminance(&img, "test").unwrap();
         // Pixel centres by the map convention, independently of the density code.

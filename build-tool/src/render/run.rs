@@ -163,7 +163,7 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
     // The reference, cached by everything it depends on.
     let key = content_hash(
         format!(
-            "reference v1 {:016x} {scene:?} {camera:?} {} {}",
+            "reference v2 (bilinear radiance) {:016x} {scene:?} {camera:?} {} {}",
             content_hash(&map_bytes),
             config.reference_samples,
             config.seed

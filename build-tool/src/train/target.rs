@@ -63,7 +63,7 @@ impl TrainTarget {
         match self {
             Self::GltfBrdf => Ok(LoadedTarget::GltfBrdf),
             Self::Envmap { path, .. } => {
-                let map = EnvmapDensity::from_file(path, Domain::Sphere)
+                let map = EnvmapDensity::from_file_filtered(path, Domain::Sphere)
                     .with_context(|| format!("environment map {}", path.display()))?;
                 Ok(LoadedTarget::Envmap(Arc::new(map)))
             }
@@ -76,7 +76,8 @@ impl TrainTarget {
 pub enum LoadedTarget {
     /// The glTF BRDF (closed form, nothing to read).
     GltfBrdf,
-    /// The map's luminance as a density on the sphere.
+    /// The map's bilinearly filtered luminance as a density on the sphere
+    /// ([`EnvmapDensity::from_luminance_filtered`]).
     Envmap(Arc<EnvmapDensity>),
 }
 
