@@ -261,15 +261,14 @@ mod tests {
     use crate::train::TrainTarget;
     use nuld_core::network::{Activation, Shape};
 
-    /// On a map lit only above the horizon (its filtered light reaches half a
-    /// pixel beyond the lit rows, so the row just above the horizon is dark too):
-    /// the held-out normals are the cell
-    /// centres of the octahedral square, each judged names its normal, and the
-    /// normal `-z` (the square's corner), which faces only the dark lower half
-    /// (E = 0), is left out; a network that ignores the instance makes identical
-    /// instances (union ratio 1, no nearest-neighbour distance across), and
-    /// one that lines its points up on one arc is far worse than Owen-Sobol through
-    /// the lit map.
+    /// On a map lit only above the horizon (the row just above it is dark too,
+    /// since the filtered light reaches half a pixel beyond the lit rows): the
+    /// held-out normals are the cell centres of the octahedral square, each judged
+    /// names its normal, and the normal `-z` (the square's corner), which faces
+    /// only the dark lower half (E = 0), is left out; a network that ignores the
+    /// instance makes identical instances (union ratio 1, no nearest-neighbour
+    /// distance across), and one that lines its points up on one arc is far worse
+    /// than Owen-Sobol through the lit map.
     #[test]
     fn an_envmap_check_judges_lit_normals_against_the_lit_maps_inverse_cdf() {
         let dir = std::env::temp_dir().join(format!("nuld-quality-envmap-{}", std::process::id()));

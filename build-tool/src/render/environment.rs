@@ -64,9 +64,7 @@ impl Environment {
     pub fn from_luminance(img: &LuminanceImage, name: &str) -> Result<Self> {
         let density = EnvmapDensity::from_luminance_filtered(img, Domain::Sphere, name)
             .with_context(|| format!("environment map {name}"))?;
-        let mut clamped = img.clone();
-        clamped.clamp_negatives();
-        let radiance = FilteredLuminance::new(&clamped);
+        let radiance = FilteredLuminance::new(img);
         let (w, h) = (density.width(), density.height());
         let mass: Vec<f64> = (0..h)
             .flat_map(|r| (0..w).map(move |c| (c, r)))
@@ -133,7 +131,7 @@ impl Environment {
 mod tests {
     use super::*;
     use crate::seeding::rng;
-    use crate::sphere::geometry::random_direction;
+    use crate::sphere::geometry::{direction_from_angles, random_direction};
     use rand::Rng;
     use std::f64::consts::TAU;
 
@@ -164,11 +162,7 @@ mod tests {
         for (c, r) in [(5, 3), (0, 0), (15, 7), (8, 4)] {
             let theta = std::f64::consts::PI * (r as f64 + 0.5) / 8.0;
             let phi = TAU * (c as f64 + 0.5) / 16.0;
-            let w = DVec3::new(
-                theta.sin() * phi.cos(),
-                theta.sin() * phi.sin(),
-                theta.cos(),
-            );
+            let w = direction_from_angles(theta, phi);
             let want = img.values[r * 16 + c];
             assert!((env.radiance(w) - want).abs() < 1e-9 * want, "{c},{r}");
         }

@@ -39,7 +39,7 @@
 
 use super::cap_table::profile_of_rule;
 use super::filtered_luminance::FilteredLuminance;
-use super::geometry::unit_or_z;
+use super::geometry::{acos_clamped, unit_or_z};
 use super::target::{normalize_rule, DirectionDensity, DirectionSpecError};
 use crate::density::image::{load_luminance, LuminanceImage, NegativePixels};
 use glam::{DVec2, DVec3};
@@ -176,6 +176,21 @@ fn cleaned(
     Ok((img, negative))
 }
 
+/// Pixel coordinates of the unit direction `w` on a `width x height`
+/// equirectangular map (module docs): `x = W phi / (2 pi)` in `[0, W]`,
+/// `y = H theta / pi` in `[0, H]`, so pixel `(c, r)` covers `[c, c + 1) x
+/// [r, r + 1)`. The inverse of [`EnvmapDensity::pixel_direction`]'s placement;
+/// [`EnvmapDensity::pdf`](DirectionDensity::pdf) and [`FilteredLuminance::at`]
+/// both read the map through it.
+pub(crate) fn pixel_coords(w: DVec3, width: usize, height: usize) -> DVec2 {
+    let theta = acos_clamped(w.z);
+    let mut phi = w.y.atan2(w.x);
+    if phi < 0.0 {
+        phi += TAU;
+    }
+    DVec2::new(phi / TAU * width as f64, theta / PI * height as f64)
+}
+
 /// `z = cos(pi r / H)` written as `sin(pi (H - 2r) / (2H))`, exact 0 at the equator.
 fn z_edge(r: usize, h: usize) -> f64 {
     (PI * (h as f64 - 2.0 * r as f64) / (2.0 * h as f64)).sin()
@@ -198,6 +213,17 @@ impl EnvmapDensity {
         name: &str,
     ) -> Result<Self, DirectionSpecError> {
         let (img, negative) = cleaned(img, name)?;
+        Self::from_cleaned(&img, negative, domain, name)
+    }
+
+    /// The density of a map that [`cleaned`] returned (with the count of the
+    /// negative pixels it set to 0).
+    fn from_cleaned(
+        img: &LuminanceImage,
+        negative: NegativePixels,
+        domain: Domain,
+        name: &str,
+    ) -> Result<Self, DirectionSpecError> {
         let (w, h) = (img.width, img.height);
         let hemi = domain == Domain::Hemisphere;
         let clip = |z: f64| if hemi { z.max(0.0) } else { z };
@@ -283,9 +309,7 @@ impl EnvmapDensity {
     ) -> Result<Self, DirectionSpecError> {
         let (img, negative) = cleaned(img, name)?;
         let fine = FilteredLuminance::new(&img).half_pixel_averages();
-        let mut d = Self::from_luminance(&fine, domain, name)?;
-        d.negative = negative;
-        Ok(d)
+        Self::from_cleaned(&fine, negative, domain, name)
     }
 
     /// `∫ L(w) dw` over the domain (luminance times steradians, negative pixels as
@@ -573,13 +597,9 @@ impl DirectionDensity for EnvmapDensity {
         if self.domain == Domain::Hemisphere && w.z < 0.0 {
             return 0.0;
         }
-        let theta = w.z.clamp(-1.0, 1.0).acos();
-        let r = ((theta / PI * self.height as f64) as usize).min(self.height - 1);
-        let mut phi = w.y.atan2(w.x);
-        if phi < 0.0 {
-            phi += TAU;
-        }
-        let c = ((phi / TAU * self.width as f64) as usize).min(self.width - 1);
+        let p = pixel_coords(w, self.width, self.height);
+        let r = (p.y as usize).min(self.height - 1);
+        let c = (p.x as usize).min(self.width - 1);
         let dz = self.z_hi[r] - self.z_lo[r];
         if dz <= 0.0 {
             return 0.0;
@@ -747,7 +767,9 @@ impl EnvmapDensity {
 mod tests {
     use super::*;
     use crate::seeding::rng;
-    use crate::sphere::geometry::{random_direction, uniform_hemisphere_cap_measure};
+    use crate::sphere::geometry::{
+        direction_from_angles, random_direction, uniform_hemisphere_cap_measure,
+    };
     use rand::Rng;
     use std::io::Write;
 
@@ -808,11 +830,7 @@ mod tests {
             let area = theta.sin() * (PI / nt as f64) * (TAU / np as f64);
             for b in 0..np {
                 let phi = TAU * (b as f64 + 0.5) / np as f64;
-                let l = DVec3::new(
-                    theta.sin() * phi.cos(),
-                    theta.sin() * phi.sin(),
-                    theta.cos(),
-                );
+                let l = direction_from_angles(theta, phi);
                 let v = lum.at(l) * area;
                 integral += v;
                 for (e, n) in lit.iter_mut().zip(&normals) {

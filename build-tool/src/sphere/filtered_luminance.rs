@@ -22,17 +22,20 @@
 //! half pixel's exact mass `∫ L dw`, and its density differs from `L / ∫ L` only
 //! inside half pixels.
 
+use super::envmap::pixel_coords;
+use super::geometry::unit_or_z;
 use crate::density::image::LuminanceImage;
 use glam::DVec3;
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::PI;
 
 /// Cells per pixel side of [`FilteredLuminance::half_pixel_averages`]: the finest
 /// grid whose cells each lie within one bilinear patch.
 pub const SUBDIVISION: usize = 2;
 
 /// The bilinearly filtered luminance `L` of a `W x H` equirectangular map
-/// (module docs). Values are the map's, not checked: callers clamp negative
-/// pixels and reject non-finite ones first ([`super::EnvmapDensity`] does).
+/// (module docs), negative pixels read as 0 (as [`super::EnvmapDensity`] reads
+/// them). Values are not otherwise checked: callers reject non-finite ones first
+/// ([`super::EnvmapDensity`]'s constructors do).
 #[derive(Clone, Debug, PartialEq)]
 pub struct FilteredLuminance {
     width: usize,
@@ -41,12 +44,17 @@ pub struct FilteredLuminance {
 }
 
 impl FilteredLuminance {
-    /// The filtered map of `img` (which must hold `width * height >= 1` values).
+    /// The filtered map of `img` (which must hold `width * height >= 1` values),
+    /// its negative values set to 0.
     pub fn new(img: &LuminanceImage) -> Self {
         Self {
             width: img.width,
             height: img.height,
-            values: img.values.clone(),
+            values: img
+                .values
+                .iter()
+                .map(|&v| if v < 0.0 { 0.0 } else { v })
+                .collect(),
         }
     }
 
@@ -72,13 +80,8 @@ impl FilteredLuminance {
     /// `L(w)` for a direction `w` (any length > 0; the zero vector reads as `+z`),
     /// luminance units.
     pub fn at(&self, w: DVec3) -> f64 {
-        let w = super::geometry::unit_or_z(w);
-        let theta = w.z.clamp(-1.0, 1.0).acos();
-        let phi = w.y.atan2(w.x).rem_euclid(TAU);
-        self.at_pixel_coords(
-            phi / TAU * self.width as f64,
-            theta / PI * self.height as f64,
-        )
+        let p = pixel_coords(unit_or_z(w), self.width, self.height);
+        self.at_pixel_coords(p.x, p.y)
     }
 
     /// The `(SUBDIVISION W) x (SUBDIVISION H)` image whose cell `(j, i)` holds the
@@ -112,14 +115,8 @@ impl FilteredLuminance {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn direction(theta: f64, phi: f64) -> DVec3 {
-        DVec3::new(
-            theta.sin() * phi.cos(),
-            theta.sin() * phi.sin(),
-            theta.cos(),
-        )
-    }
+    use crate::sphere::geometry::direction_from_angles as direction;
+    use std::f64::consts::TAU;
 
     fn map() -> FilteredLuminance {
         let (w, h) = (8, 4);

@@ -25,6 +25,18 @@ pub(crate) fn unit_or_z(w: DVec3) -> DVec3 {
     }
 }
 
+/// The unit direction at polar angle `theta` from `+z` and azimuth `phi` from
+/// `+x` toward `+y`, written out for tests to place directions independently of
+/// the code under test.
+#[cfg(test)]
+pub(crate) fn direction_from_angles(theta: f64, phi: f64) -> DVec3 {
+    DVec3::new(
+        theta.sin() * phi.cos(),
+        theta.sin() * phi.sin(),
+        theta.cos(),
+    )
+}
+
 /// Uniform measure `(1 - t)/2` of the cap `C(w, t)` on the whole sphere
 /// (`t` clamped into `[-1, 1]`).
 #[inline]
