@@ -24,24 +24,17 @@ use rand::{Rng, SeedableRng};
 use std::hint::black_box;
 use std::time::Instant;
 
-/// A BRDF conditional sampler (hemisphere, the BRDF's condition range: [`info`]
-/// of [`LoadedTarget::GltfBrdf`]) with random contents: `n` points, `instances`
-/// stored instances, a `grid` point table of random codes, a 7 x 9 weight table
-/// of weights in `[0.5, 1.6)`, and a network of the given hidden widths (1 to 3) with f16
-/// parameters uniform in `[-0.6, 0.6]`, with the given point warp (for
-/// [`PointWarp::BrdfMixture`] a second weight-grid table of lobe probabilities
-/// uniform in `[0.02, 0.98)`). Deterministic for a seed. Fails if the counts
-/// describe no valid network.
-pub fn random_parts(
+/// The network shape of [`random_parts`]: `n` points, the given hidden widths (1
+/// to 3) and activation, a residual for [`PointWarp::BrdfMixture`], and
+/// `instance_slots` instance slots ([`Shape::with_instance_slots`]). Fails if the
+/// counts describe no valid network.
+pub fn random_shape(
     n: u32,
     hidden: &[u32],
     activation: Activation,
-    instances: u32,
-    grid: [u32; 2],
     warp: PointWarp,
-    seed: u64,
-) -> Result<ConditionalParts> {
-    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
+    instance_slots: u32,
+) -> Result<Shape> {
     ensure!(
         hidden.len() <= MAX_HIDDEN_LAYERS,
         "{} hidden layers, at most {MAX_HIDDEN_LAYERS}",
@@ -50,9 +43,27 @@ pub fn random_parts(
     // Odd: coprime to every power of two, so the lattice's second coordinate is a
     // permutation for such n.
     let lattice_generator = (n / 3) | 1;
-    let shape = Shape::new(n, hidden, activation, lattice_generator)
+    Shape::new(n, hidden, activation, lattice_generator)
         .ok_or_else(|| anyhow!("n {n}, hidden {hidden:?}: no valid network"))?
-        .with_lattice_residual(warp == PointWarp::BrdfMixture);
+        .with_lattice_residual(warp == PointWarp::BrdfMixture)
+        .with_instance_slots(instance_slots)
+        .ok_or_else(|| anyhow!("{instance_slots} instance slots overflow the embedding"))
+}
+
+/// A BRDF conditional sampler (hemisphere, the BRDF's condition range: [`info`]
+/// of [`LoadedTarget::GltfBrdf`]) with random contents: `n` points, `instances`
+/// stored instances, a `grid` point table of random codes, a 7 x 9 weight table
+/// of weights in `[0.5, 1.6)`, and a network of `shape` ([`random_shape`]) with f16
+/// parameters uniform in `[-0.6, 0.6]`, with the shape's point warp (for
+/// the BRDF mixture a second weight-grid table of lobe probabilities
+/// uniform in `[0.02, 0.98)`). Deterministic for a seed.
+pub fn random_parts(
+    shape: Shape,
+    instances: u32,
+    grid: [u32; 2],
+    seed: u64,
+) -> Result<ConditionalParts> {
+    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
     let info = info(&shape, &LoadedTarget::GltfBrdf, instances, grid, [7, 9]);
     let params = (0..shape.param_len())
         .map(|_| nuld_core::quantize::f16_encode(rng.random_range(-0.6f32..=0.6)))
@@ -157,8 +168,11 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
         target: "random",
         seed: 0,
     };
+    // The default bake's instance slots: the embedding rows a sample reads.
+    let slots = crate::train::TrainConfig::default().instance_slots;
     let blob = |hidden: &[u32], act| -> Result<AlignedBytes> {
-        random_parts(n, hidden, act, 16, [10, 9], PointWarp::BrdfMixture, 2)?.to_blob(&meta)
+        let shape = random_shape(n, hidden, act, PointWarp::BrdfMixture, slots)?;
+        random_parts(shape, 16, [10, 9], 2)?.to_blob(&meta)
     };
     let (relu, silu) = (
         blob(&[32, 32], Activation::Relu)?,

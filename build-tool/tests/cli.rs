@@ -470,7 +470,8 @@ fn conditional_blob(path: &Path) {
         activation: 1,
         lattice_generator: 5,
         warp: 0,
-        reserved: [0; 2],
+        instance_slots: 0,
+        reserved: 0,
     };
     let params = (0..info.shape().unwrap().param_len())
         .map(|j| f16_encode(((j * 37 % 101) as f32 - 50.0) / 60.0))

@@ -348,8 +348,11 @@ pub enum BlobError {
     /// The hidden widths describe no [`crate::network::Shape`]: no first layer, a
     /// width above [`crate::network::MAX_WIDTH`], or a non-zero width after a zero.
     NetworkWidths([u32; 3]),
-    /// A reserved field of the conditional info is not zero.
-    ConditionalReserved([u32; 2]),
+    /// The conditional info's instance slots `M` make the network's embedding
+    /// (`M n h1` numbers) larger than a `u32` counts.
+    InstanceSlots(u32),
+    /// The reserved field of the conditional info is not zero.
+    ConditionalReserved(u32),
     /// The conditional info's warp is not a
     /// [`crate::conditional::PointWarp`] code, or names a warp the target has none of.
     UnknownPointWarp(u32),
@@ -545,8 +548,12 @@ impl core::fmt::Display for BlobError {
                 "blob network hidden widths {h:?} are not 1 to 3 layers of 1 to {} units",
                 crate::network::MAX_WIDTH
             ),
+            Self::InstanceSlots(m) => write!(
+                f,
+                "blob network instance slots {m} make an embedding larger than 2^32 numbers"
+            ),
             Self::ConditionalReserved(r) => {
-                write!(f, "blob conditional info reserved fields {r:?} are not zero")
+                write!(f, "blob conditional info reserved field {r} is not zero")
             }
             Self::UnknownPointWarp(w) => write!(f, "blob conditional point warp {w} is unknown"),
             Self::ParamElementSize(s) => write!(

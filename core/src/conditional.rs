@@ -172,8 +172,12 @@ pub struct ConditionalInfo {
     pub lattice_generator: u32,
     /// A [`PointWarp`] code.
     pub warp: u32,
+    /// The network's instance slots `M` ([`Shape::with_instance_slots`]): 0, an
+    /// offset per instance and one embedding row per index; `M >= 1`, instance `k`
+    /// is slot `k mod M`, with its own offset and embedding rows.
+    pub instance_slots: u32,
     /// Reserved, zero.
-    pub reserved: [u32; 2],
+    pub reserved: u32,
 }
 
 /// Size of [`ConditionalInfo`] in bytes.
@@ -325,7 +329,18 @@ impl ConditionalInfo {
         let act = Activation::from_code(self.activation)?;
         let residual = PointWarp::from_code(self.warp)? == PointWarp::BrdfMixture;
         Shape::new(self.n, &self.hidden[..layers], act, self.lattice_generator)
-            .map(|s| s.with_lattice_residual(residual))
+            .map(|s| s.with_lattice_residual(residual))?
+            .with_instance_slots(self.instance_slots)
+    }
+
+    /// [`Self::shape`] before the instance slots are applied: tells a blob whose
+    /// slots overflow the embedding from one whose widths are wrong.
+    pub fn shape_without_slots(&self) -> Option<Shape> {
+        Self {
+            instance_slots: 0,
+            ..*self
+        }
+        .shape()
     }
 
     /// The info's [`PointWarp`], if its code is known.
@@ -449,7 +464,8 @@ mod tests {
             activation: 0,
             lattice_generator: 3,
             warp: 0,
-            reserved: [0; 2],
+            instance_slots: 0,
+            reserved: 0,
         }
     }
 

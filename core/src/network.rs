@@ -21,7 +21,14 @@
 //! * `g` ([`Network::forward`]): a multilayer perceptron. Its first hidden layer adds
 //!   a learned per-index vector `E[i]` (the paper's per-index embedding `e_i`,
 //!   composed with the first layer's weights: an `H`-wide bias per index costs no
-//!   multiply at run time). Hidden activations are [`Activation::Relu`] or
+//!   multiply at run time).
+//! * With `M` [instance slots](Shape::with_instance_slots), instance `k` is slot
+//!   `s = k mod M`: its offset is `z_s` and its row of `E` is `s n + i`, so every
+//!   point of every slot has its own learned bias and the network can place each
+//!   slot's points one by one, as the direction optimizer places one set's, while
+//!   the slots' different offsets (and the trainer's union term) keep them
+//!   different sets. Instances then wrap modulo `M`, as a point table's wrap
+//!   modulo `S`. Hidden activations are [`Activation::Relu`] or
 //!   [`Activation::Silu`]; the output layer has two linear units.
 //! * `sigmoid` maps the two outputs onto the open unit square; `M` is the domain's
 //!   equal-area map (for BRDF samplers the hemisphere map of
@@ -34,7 +41,8 @@
 //! Parameters are one flat array in this order ([`Shape::param_len`]):
 //!
 //! ```text
-//! E        n x h1          per-index bias of the first hidden layer, row i = index i
+//! E        R x h1          per-point bias of the first hidden layer, R = max(M, 1) n
+//!                          rows: row i = index i (M = 0), s n + i = index i of slot s
 //! W1, b1   h1 x INPUTS, h1 first hidden layer, row-major by output unit
 //! Wl, bl   hl x h(l-1), hl further hidden layers l = 2..=L
 //! Wo, bo   2 x hL, 2       output layer
@@ -128,6 +136,7 @@ pub struct Shape {
     activation: Activation,
     lattice_generator: u32,
     lattice_residual: bool,
+    instance_slots: u32,
 }
 
 /// Distance of the clamped shifted lattice point from `0` and `1` in
@@ -177,7 +186,62 @@ impl Shape {
             activation,
             lattice_generator,
             lattice_residual: false,
+            instance_slots: 0,
         })
+    }
+
+    /// The shape with `slots` instance slots (`0`, what [`Shape::new`] makes: every
+    /// instance its own offset and one embedding row per index), or `None` if
+    /// `slots n` or the embedding `slots n h1` does not fit in a `u32`.
+    ///
+    /// With `slots = M >= 1`, instance `k` is slot `s = k mod M`: its offset is
+    /// `z_s` ([`instance_offset`] of `s`) and its first hidden layer adds the row
+    /// `E[s n + i]`, so each slot is a set the network can place point by point
+    /// (the embedding gives every point of every slot its own learned bias), and
+    /// instances wrap modulo `M` as a point table's do.
+    pub fn with_instance_slots(self, slots: u32) -> Option<Self> {
+        // Both products in u128: `M n` alone can come near 2^64.
+        let numbers = slots.max(1) as u128 * self.n as u128 * self.hidden[0] as u128;
+        if numbers > u32::MAX as u128 {
+            return None;
+        }
+        Some(Self {
+            instance_slots: slots,
+            ..self
+        })
+    }
+
+    /// Instance slots `M` ([`Shape::with_instance_slots`]; 0: none).
+    pub fn instance_slots(&self) -> u32 {
+        self.instance_slots
+    }
+
+    /// The instance whose offset instance `k` uses: `k` itself without slots,
+    /// else its slot `k mod M`.
+    #[inline]
+    pub fn instance_key(&self, k: u32) -> u32 {
+        match self.instance_slots {
+            0 => k,
+            m => k % m,
+        }
+    }
+
+    /// The row of `E` that index `i` of instance `k` adds: `i mod n` without
+    /// slots, else `(k mod M) n + (i mod n)`. What [`Network::forward`] takes.
+    #[inline]
+    pub fn embedding_row(&self, k: u32, i: u32) -> u32 {
+        let i = i % self.n;
+        match self.instance_slots {
+            0 => i,
+            // `M n` fits in a u32 (checked by `with_instance_slots`).
+            m => (k % m) * self.n + i,
+        }
+    }
+
+    /// Rows of `E`: `max(M, 1) n`.
+    #[inline]
+    pub fn embedding_rows(&self) -> usize {
+        self.instance_slots.max(1) as usize * self.n as usize
     }
 
     /// The shape with the outputs a residual on [`lattice_logit`] (`true`) or plain
@@ -194,7 +258,7 @@ impl Shape {
         self.lattice_residual
     }
 
-    /// Points per set `n` (the number of per-index rows of `E`).
+    /// Points per set `n` (the number of per-index rows of `E` per slot).
     pub fn n(&self) -> u32 {
         self.n
     }
@@ -214,7 +278,7 @@ impl Shape {
         self.lattice_generator
     }
 
-    /// Number of parameters: `n h1 +` [`Shape::multiply_adds`].
+    /// Number of parameters: `max(M, 1) n h1 +` [`Shape::multiply_adds`].
     pub fn param_len(&self) -> usize {
         self.first_layer_offset() + self.multiply_adds()
     }
@@ -256,15 +320,16 @@ impl Shape {
         })
     }
 
-    /// Offset of the per-index row `E[i mod n]` in the parameter array.
+    /// Offset of row `row mod rows` of `E` ([`Shape::embedding_row`],
+    /// [`Shape::embedding_rows`]) in the parameter array.
     #[inline]
-    pub fn embedding_offset(&self, i: u32) -> usize {
-        (i % self.n) as usize * self.hidden[0] as usize
+    pub fn embedding_offset(&self, row: u32) -> usize {
+        (row as usize % self.embedding_rows()) * self.hidden[0] as usize
     }
 
     /// Offset of the first hidden layer's weights (its biases follow the weights).
     pub fn first_layer_offset(&self) -> usize {
-        self.n as usize * self.hidden[0] as usize
+        self.embedding_rows() * self.hidden[0] as usize
     }
 }
 
@@ -447,16 +512,17 @@ pub struct Network<W> {
 }
 
 impl<W> Network<W> {
-    /// Evaluates the network for index `i` (taken modulo `n`) on `input`
+    /// Evaluates the network for the embedding row `row` ([`Shape::embedding_row`]
+    /// of the instance and index; taken modulo the rows) on `input`
     /// ([`input_features`]) and records what a backward pass needs. `params(j)` must
     /// exist for `j < param_len()` (missing ones read as 0); `O(multiply_adds)`, no allocation.
     #[inline]
-    pub fn forward<T: Real>(&self, i: u32, input: [T; INPUTS]) -> Trace<T>
+    pub fn forward<T: Real>(&self, row: u32, input: [T; INPUTS]) -> Trace<T>
     where
         W: Parameters<T>,
     {
         let mut pre = [[T::ZERO; MAX_WIDTH]; MAX_HIDDEN_LAYERS];
-        let output = self.run(i, &input, |l, o, z| {
+        let output = self.run(row, &input, |l, o, z| {
             if let Some(slot) = pre.get_mut(l).and_then(|p| p.get_mut(o)) {
                 *slot = z;
             }
@@ -468,32 +534,32 @@ impl<W> Network<W> {
     /// (the same operations in the same order, hence the same bits) without
     /// recording a [`Trace`]: what samplers call.
     #[inline]
-    pub fn evaluate<T: Real>(&self, i: u32, input: [T; INPUTS]) -> [T; OUTPUTS]
+    pub fn evaluate<T: Real>(&self, row: u32, input: [T; INPUTS]) -> [T; OUTPUTS]
     where
         W: Parameters<T>,
     {
-        self.run(i, &input, |_, _, _| {})
+        self.run(row, &input, |_, _, _| {})
     }
 
     /// The point of the unit square: `sigmoid` of each output of
     /// [`Network::evaluate`].
     #[inline]
-    pub fn square_point<T: Real>(&self, i: u32, input: [T; INPUTS]) -> [T; 2]
+    pub fn square_point<T: Real>(&self, row: u32, input: [T; INPUTS]) -> [T; 2]
     where
         W: Parameters<T>,
     {
-        self.evaluate(i, input).map(sigmoid)
+        self.evaluate(row, input).map(sigmoid)
     }
 
     /// The forward pass, in this order of operations (which readers in other
-    /// languages reproduce): per unit `acc = b[o]`, then `acc += E[i][o]` in the
+    /// languages reproduce): per unit `acc = b[o]`, then `acc += E[row][o]` in the
     /// first hidden layer, then `acc += dot(W[o], x)` ([`dot`]); with a lattice
     /// residual, each output then `+= lattice_logit(input)[o]`.
     /// `record(layer, unit, pre_activation)` sees every hidden pre-activation.
     #[inline(always)]
     fn run<T: Real>(
         &self,
-        i: u32,
+        row: u32,
         input: &[T; INPUTS],
         mut record: impl FnMut(usize, usize, T),
     ) -> [T; OUTPUTS]
@@ -510,7 +576,7 @@ impl<W> Network<W> {
         // cleared once per evaluation rather than per layer.
         let mut scratch = [T::ZERO; UNIT_BLOCK * MAX_WIDTH];
         a[..INPUTS].copy_from_slice(input);
-        let embedding = shape.embedding_offset(i);
+        let embedding = shape.embedding_offset(row);
         let hidden = shape.layers as usize;
         let mut out = [T::ZERO; OUTPUTS];
         for (l, span) in shape.layers().enumerate() {
@@ -731,11 +797,12 @@ pub fn lattice_features<T: Real>(p: [T; 2], l: [T; 2]) -> [T; 4] {
 }
 
 /// The network input of index `i`, instance `k`, normalized condition `c` (in
-/// `[0,1]^2`): `[condition_features(c), 2 z_k - 1, lattice_features(p, l_i)]` with
-/// `p` the [`shifted_lattice_point`] and `l_i` the [`lattice_point`].
+/// `[0,1]^2`): `[condition_features(c), 2 z - 1, lattice_features(p, l_i)]` with
+/// `z` the offset of [`Shape::instance_key`]`(k)` (`z_k` without slots), `p` the
+/// [`shifted_lattice_point`] and `l_i` the [`lattice_point`].
 #[inline]
 pub fn input_features<T: Real>(shape: &Shape, c: [T; 2], k: u32, i: u32) -> [T; INPUTS] {
-    let z = instance_offset::<T>(k);
+    let z = instance_offset::<T>(shape.instance_key(k));
     let (n, g) = (shape.n, shape.lattice_generator);
     let p = shifted_lattice_point(i, n, g, z);
     let cf = condition_features(c);
@@ -875,6 +942,49 @@ mod tests {
             };
             assert!(close(&net.square_point(i, x), &p, 1e-12));
         }
+    }
+
+    /// With `M` instance slots, instance `k` reads the offset of `k mod M` and the
+    /// embedding row `(k mod M) n + i mod n`, placed before the first layer: the
+    /// outputs against explicit matrix products with that row; without slots the
+    /// row is `i mod n` whatever the instance.
+    #[test]
+    fn instance_slots_give_each_slot_its_own_rows_and_offset() {
+        let base = Shape::new(4, &[3], Activation::Relu, 3).unwrap();
+        assert_eq!(base.with_instance_slots(0), Some(base));
+        assert_eq!((base.instance_key(9), base.embedding_row(9, 6)), (9, 2));
+        let s = base.with_instance_slots(3).unwrap();
+        assert_eq!(s.instance_slots(), 3);
+        // E 12 x 3, W1 3 x 11 + 3, Wo 2 x 3 + 2.
+        assert_eq!(s.param_len(), 36 + 36 + 8);
+        assert_eq!(s.first_layer_offset(), 36);
+        let (k, i) = (5u32, 6u32);
+        assert_eq!(s.instance_key(k), 2);
+        assert_eq!(s.embedding_row(k, i), 2 * 4 + 2);
+        assert_eq!(s.embedding_offset(s.embedding_row(k, i)), 30);
+        // Instance 5 is slot 2: the same input as instance 2, not instance 5's own.
+        let c = [0.3, 0.8];
+        let x = input_features::<f64>(&s, c, k, i);
+        assert_eq!(x, input_features::<f64>(&s, c, 2, i));
+        assert_ne!(x, input_features::<f64>(&base, c, k, i));
+        let p: Vec<f64> = (0..s.param_len()).map(|j| noise(j) / 2.0).collect();
+        let net = Network {
+            shape: s,
+            params: &p[..],
+        };
+        let (e, w1, b1, wo, bo) = (&p[30..33], &p[36..69], &p[69..72], &p[72..78], &p[78..80]);
+        let h: [f64; 3] = core::array::from_fn(|o| {
+            let z = b1[o] + e[o] + (0..INPUTS).map(|j| w1[o * INPUTS + j] * x[j]).sum::<f64>();
+            z.max(0.0)
+        });
+        let want: [f64; 2] =
+            core::array::from_fn(|o| bo[o] + (0..3).map(|j| wo[o * 3 + j] * h[j]).sum::<f64>());
+        let got = net.evaluate(s.embedding_row(k, i), x);
+        assert!(close(&got, &want, 1e-14), "{got:?} vs {want:?}");
+        // An embedding of 2^32 numbers or more is no shape.
+        let wide = Shape::new(65_536, &[128], Activation::Relu, 1).unwrap();
+        assert!(wide.with_instance_slots(511).is_some());
+        assert!(wide.with_instance_slots(512).is_none());
     }
 
     #[test]

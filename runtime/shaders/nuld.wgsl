@@ -77,6 +77,7 @@ const NULD_INFO_HIDDEN: u32 = 48u;
 const NULD_INFO_ACTIVATION: u32 = 60u;
 const NULD_INFO_LATTICE_GENERATOR: u32 = 64u;
 const NULD_INFO_WARP: u32 = 68u;
+const NULD_INFO_INSTANCE_SLOTS: u32 = 72u;
 
 // `nuld_core::network`: `INPUTS`, `MAX_WIDTH`, `MAX_HIDDEN_LAYERS`, `OUTPUTS`, and
 // the dot product's partial sums (`DOT_LANES`).
@@ -384,6 +385,7 @@ struct NuldConditionalInfo {
     activation: u32,
     lattice_generator: u32,
     warp: u32,
+    instance_slots: u32,
 }
 
 // Rust: `ConditionalSampler::info` (the info section read from the buffer).
@@ -407,6 +409,7 @@ fn nuld_info() -> NuldConditionalInfo {
     info.activation = nuld_u32(o + NULD_INFO_ACTIVATION);
     info.lattice_generator = nuld_u32(o + NULD_INFO_LATTICE_GENERATOR);
     info.warp = nuld_u32(o + NULD_INFO_WARP);
+    info.instance_slots = nuld_u32(o + NULD_INFO_INSTANCE_SLOTS);
     return info;
 }
 
@@ -634,10 +637,28 @@ fn nuld_lattice_point(i0: u32, n0: u32, g: u32) -> vec2<f32> {
     return vec2<f32>(f32(i) / nf, f32(j) / nf);
 }
 
+// Rust: `Shape::instance_key`: the instance whose offset instance `k` uses, `k`
+// itself without slots, else its slot `k mod M`.
+fn nuld_instance_key(info: NuldConditionalInfo, k: u32) -> u32 {
+    if info.instance_slots == 0u {
+        return k;
+    }
+    return k % info.instance_slots;
+}
+
+// Rust: `Shape::embedding_row`: the row of `E` index `i` of instance `k` adds.
+fn nuld_embedding_row(info: NuldConditionalInfo, k: u32, i: u32) -> u32 {
+    let row = i % info.n;
+    if info.instance_slots == 0u {
+        return row;
+    }
+    return (k % info.instance_slots) * info.n + row;
+}
+
 // Rust: `input_features`: the network's 11 inputs (condition, instance offset,
 // shifted lattice point, lattice point), each mapped by `2x - 1`.
 fn nuld_input_features(info: NuldConditionalInfo, c: vec2<f32>, k: u32, i: u32) -> array<f32, 11> {
-    let z = nuld_instance_offset(k);
+    let z = nuld_instance_offset(nuld_instance_key(info, k));
     let l = nuld_lattice_point(i, info.n, info.lattice_generator);
     // `shifted_lattice_point`: `frac(l + z)` with `frac(x) = x - floor(x)`.
     let lz = l + z;
@@ -722,7 +743,7 @@ fn nuld_dot(params: u32, w: u32, x: ptr<function, array<f32, 128>>, len: u32) ->
 // Rust: `Network::evaluate`: the two outputs (before the sigmoid) of the network on
 // `input` for index `i`: hidden layer 1 `act((b1[o] + E[i][o]) + dot(W1[o], a))`,
 // further layers `act(b[o] + dot(W[o], a))`, outputs `bo[o] + dot(Wo[o], a)`.
-fn nuld_network_evaluate(cs: NuldConditional, i: u32, input: array<f32, 11>) -> vec2<f32> {
+fn nuld_network_evaluate(cs: NuldConditional, row: u32, input: array<f32, 11>) -> vec2<f32> {
     let info = cs.info;
     let params = cs.params;
     var a: array<f32, 128>;
@@ -732,9 +753,10 @@ fn nuld_network_evaluate(cs: NuldConditional, i: u32, input: array<f32, 11>) -> 
     }
     var fan_in = NULD_INPUTS;
     let h1 = info.hidden[0];
-    // `Shape::first_layer_offset` and `Shape::embedding_offset`.
-    var off = info.n * h1;
-    let embedding = (i % info.n) * h1;
+    // `Shape::first_layer_offset` and `Shape::embedding_offset` (`row` is below
+    // the rows, `nuld_embedding_row`).
+    var off = max(info.instance_slots, 1u) * info.n * h1;
+    let embedding = row * h1;
     for (var l = 0u; l < NULD_MAX_HIDDEN_LAYERS; l++) {
         let h = min(info.hidden[l], NULD_MAX_WIDTH);
         if h == 0u {
@@ -771,7 +793,7 @@ fn nuld_network_evaluate(cs: NuldConditional, i: u32, input: array<f32, 11>) -> 
 }
 
 // Rust: `ConditionalSampler::network_square_point` (network mode): the network's
-// outputs through the sigmoid, for any u32 instance.
+// outputs through the sigmoid, for any u32 instance (`nuld_instance_key`).
 fn nuld_network_square_point(cond: vec2<f32>, instance: u32, i: u32) -> vec2<f32> {
     let cs = nuld_conditional();
     return nuld_network_square_point_of(cs, nuld_normalize(cs.info, cond), instance, i);
@@ -779,7 +801,8 @@ fn nuld_network_square_point(cond: vec2<f32>, instance: u32, i: u32) -> vec2<f32
 
 // `nuld_network_square_point` at the normalized condition `u` of the sampler `cs`.
 fn nuld_network_square_point_of(cs: NuldConditional, u: vec2<f32>, instance: u32, i: u32) -> vec2<f32> {
-    let out = nuld_network_evaluate(cs, i, nuld_input_features(cs.info, u, instance, i));
+    let row = nuld_embedding_row(cs.info, instance, i);
+    let out = nuld_network_evaluate(cs, row, nuld_input_features(cs.info, u, instance, i));
     return vec2<f32>(nuld_sigmoid(out.x), nuld_sigmoid(out.y));
 }
 
@@ -827,8 +850,8 @@ fn nuld_table_direction_of(cs: NuldConditional, u: vec2<f32>, instance: u32, i: 
     return d00;
 }
 
-// Rust: `ConditionalSampler::sample_network` (network mode): as `nuld_sample`, every
-// u32 instance its own set.
+// Rust: `ConditionalSampler::sample_network` (network mode): as `nuld_sample`;
+// instances wrap modulo the instance slots (without slots every u32 is its own set).
 fn nuld_sample_network(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
     let cs = nuld_conditional();
     let u = nuld_normalize(cs.info, cond);

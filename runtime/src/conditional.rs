@@ -143,8 +143,14 @@ impl<'a> ConditionalSampler<'a> {
         if Activation::from_code(info.activation).is_none() {
             return Err(BlobError::UnknownActivation(info.activation));
         }
-        let shape = info.shape().ok_or(BlobError::NetworkWidths(info.hidden))?;
-        if info.reserved != [0; 2] {
+        let shape = info
+            .shape()
+            .ok_or(if info.shape_without_slots().is_some() {
+                BlobError::InstanceSlots(info.instance_slots)
+            } else {
+                BlobError::NetworkWidths(info.hidden)
+            })?;
+        if info.reserved != 0 {
             return Err(BlobError::ConditionalReserved(info.reserved));
         }
 
@@ -153,11 +159,12 @@ impl<'a> ConditionalSampler<'a> {
             SectionTag::NetworkParams,
             BlobError::ParamElementSize,
             || {
-                // Counted in u64: `Shape::param_len` multiplies `n h1` in `usize`,
-                // which a hostile `n` could overflow on a 32-bit target;
-                // `multiply_adds` does not depend on `n`.
+                // Counted in u64: `Shape::param_len` multiplies `max(M, 1) n h1`
+                // in `usize`, which a hostile `n` could overflow on a 32-bit
+                // target; `multiply_adds` does not depend on `n`.
                 let h1 = shape.hidden().first().copied().unwrap_or(0) as u64;
-                Ok(info.n as u64 * h1 + shape.multiply_adds() as u64)
+                let rows = info.instance_slots.max(1) as u64 * info.n as u64;
+                Ok(rows * h1 + shape.multiply_adds() as u64)
             },
             |expected, got| BlobError::ParamsLength { expected, got },
         )?;
@@ -175,7 +182,9 @@ impl<'a> ConditionalSampler<'a> {
             layout,
             SectionTag::WeightTable,
             BlobError::WeightElementSize,
-            || Ok(info.weight_table_len() * info.weight_tables()),
+            // Saturating: two grid counts near 2^32 make a length near 2^64, whose
+            // double would overflow (no section is that long, so it is refused).
+            || Ok(info.weight_table_len().saturating_mul(info.weight_tables())),
             |expected, got| BlobError::WeightTableLength { expected, got },
         )?;
         Ok(Self {
@@ -224,9 +233,16 @@ impl<'a> ConditionalSampler<'a> {
     }
 
     /// Instances `S` stored in the point table (at least 1); table mode wraps the
-    /// instance modulo `S`, network mode serves every `u32` instance.
+    /// instance modulo `S`, network mode modulo [`Self::instance_slots`].
     pub fn instances(&self) -> u32 {
         self.info.instances
+    }
+
+    /// The network's instance slots `M`: network mode serves `M` different sets
+    /// per condition and wraps the instance modulo `M`; 0 means every `u32`
+    /// instance is its own set (`nuld_core::network::Shape::with_instance_slots`).
+    pub fn instance_slots(&self) -> u32 {
+        self.info.instance_slots
     }
 
     /// The blob's info record: grids, condition ranges (blob units; for
@@ -351,14 +367,15 @@ impl<'a> ConditionalSampler<'a> {
     fn network_square_point_at(&self, u: [f32; 2], instance: u32, i: u32) -> Vec2 {
         let input = input_features::<f32>(&self.shape, u, instance, i);
         let shape = self.shape;
+        let row = shape.embedding_row(instance, i);
         Vec2::from_array(match self.params {
             // Every index below `param_len` exists and is finite (`validate`).
             NetworkParams::F16(params) => Network {
                 shape,
                 params: F16Params(params),
             }
-            .square_point(i, input),
-            NetworkParams::F32(params) => Network { shape, params }.square_point(i, input),
+            .square_point(row, input),
+            NetworkParams::F32(params) => Network { shape, params }.square_point(row, input),
         })
     }
 
@@ -482,8 +499,10 @@ impl<'a> ConditionalSampler<'a> {
         self.sample_network(normal_condition(normal), instance, i)
     }
 
-    /// Network mode: as [`Self::sample`] with [`Self::network_square_point`]; every
-    /// `u32` instance is a different set (its offset is hashed from the instance).
+    /// Network mode: as [`Self::sample`] with [`Self::network_square_point`]. With
+    /// [`Self::instance_slots`] `M >= 1` instance `k` is the set of slot `k mod M`
+    /// (instances wrap as table mode's do modulo [`Self::instances`]); with none,
+    /// every `u32` instance is a different set (its offset hashed from it).
     /// `O(multiply_adds)`, never panics.
     #[inline]
     pub fn sample_network(&self, cond: Vec2, instance: u32, i: u32) -> Sample {
@@ -673,7 +692,8 @@ mod tests {
             activation: Activation::Silu as u32,
             lattice_generator: 2,
             warp: 0,
-            reserved: [0; 2],
+            instance_slots: 0,
+            reserved: 0,
         };
         let len = info.shape().unwrap().param_len();
         let params = (0..len as u32)
@@ -1016,7 +1036,7 @@ mod tests {
     fn each_validation_failure_has_its_error() {
         assert_eq!(with(|_| {}), Ok(()));
         type Change = fn(&mut Parts);
-        let cases: [(Change, BlobError); 26] = [
+        let cases: [(Change, BlobError); 28] = [
             (|p| p.info.n = 0, BlobError::ConditionalNoPoints),
             (|p| p.info.instances = 0, BlobError::ConditionalNoInstances),
             (|p| p.info.domain = 0, BlobError::ConditionalDomain(0)),
@@ -1070,9 +1090,19 @@ mod tests {
                 |p| p.info.hidden = [129, 3, 0],
                 BlobError::NetworkWidths([129, 3, 0]),
             ),
+            (|p| p.info.reserved = 1, BlobError::ConditionalReserved(1)),
+            // 5 n x 4 h1 x M embedding numbers reach 2^32 at M = 2^32 / 20.
             (
-                |p| p.info.reserved[1] = 1,
-                BlobError::ConditionalReserved([0, 1]),
+                |p| p.info.instance_slots = u32::MAX / 16,
+                BlobError::InstanceSlots(u32::MAX / 16),
+            ),
+            // Slots that fit the counts but not the parameters: M n h1 more rows.
+            (
+                |p| p.info.instance_slots = 2,
+                BlobError::ParamsLength {
+                    expected: 2 * 5 * 4 + 4 * 12 + 3 * 5 + 2 * 4,
+                    got: 91,
+                },
             ),
             (|p| p.info.warp = 7, BlobError::UnknownPointWarp(7)),
             (

@@ -41,7 +41,8 @@
 //!     let radiance = 1.0; // L(s.direction) in a renderer
 //!     estimate += s.weight * radiance / cs.len() as f32;
 //! }
-//! // Network mode: the same model evaluated per sample, any u32 instance.
+//! // Network mode: the same model evaluated per sample (instances wrap modulo the
+//! // network's instance slots, or each u32 is its own set for a network without).
 //! let s = cs.sample_network(Vec2::new(roughness, 30.0), instance, 0);
 //! assert!(estimate > 0.0 && s.weight > 0.0);
 //! # Ok::<(), nuld_runtime::BlobError>(())
@@ -289,7 +290,8 @@ pub fn doc_example_conditional_blob() -> Aligned<[u8; 400]> {
         activation: 0,
         lattice_generator: 1,
         warp: 0,
-        reserved: [0; 2],
+        instance_slots: 0,
+        reserved: 0,
     };
     // 2 x 1 embedding, 1 x 11 + 1 first layer, 2 x 1 + 2 output: 18 parameters.
     let params: [u16; 18] =

@@ -17,7 +17,7 @@ mod shader_sample;
 use nuld_core::conditional::PointWarp;
 use nuld_core::network::Activation;
 use nuld_runtime::shader::{kernel_wgsl, KernelMode, KernelParams, KERNEL_ENTRY_POINT};
-use nuld_tests::{conditional_parts, META};
+use nuld_tests::{conditional_parts, shape, META};
 use shader_sample::Gpu;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -33,7 +33,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     // The table modes read no network: they run on the [32, 32] blob.
     let blob = |hidden: &[u32], act| {
-        conditional_parts(64, hidden, act, 16, [10, 9], PointWarp::BrdfMixture, 2).to_blob(&META)
+        conditional_parts(
+            shape(64, hidden, act, PointWarp::BrdfMixture, 64),
+            16,
+            [10, 9],
+            2,
+        )
+        .to_blob(&META)
     };
     let relu = blob(&[32, 32], Activation::Relu)?;
     let silu = blob(&[64, 64], Activation::Silu)?;

@@ -33,17 +33,27 @@ pub fn sobol_blob(domain: Domain, n: usize, sets: usize, seed: u64) -> (PointSet
 
 /// A conditional sampler (kind 3) with random contents, as a stand-in for a trained
 /// one ([`nuld_build_tool::runtime_speed::random_parts`]; the benchmark times the
-/// same blobs).
+/// same blobs), of a network [`shape`].
 pub fn conditional_parts(
+    shape: nuld_core::network::Shape,
+    instances: u32,
+    grid: [u32; 2],
+    seed: u64,
+) -> nuld_build_tool::conditional::blob::ConditionalParts {
+    nuld_build_tool::runtime_speed::random_parts(shape, instances, grid, seed)
+        .expect("a valid fixture")
+}
+
+/// The network shape of a [`conditional_parts`] fixture
+/// ([`nuld_build_tool::runtime_speed::random_shape`]).
+pub fn shape(
     n: u32,
     hidden: &[u32],
     activation: nuld_core::network::Activation,
-    instances: u32,
-    grid: [u32; 2],
     warp: nuld_core::conditional::PointWarp,
-    seed: u64,
-) -> nuld_build_tool::conditional::blob::ConditionalParts {
-    nuld_build_tool::runtime_speed::random_parts(n, hidden, activation, instances, grid, warp, seed)
+    instance_slots: u32,
+) -> nuld_core::network::Shape {
+    nuld_build_tool::runtime_speed::random_shape(n, hidden, activation, warp, instance_slots)
         .expect("a valid fixture shape")
 }
 

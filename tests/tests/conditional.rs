@@ -12,20 +12,25 @@ use nuld_core::quantize::f16_decode;
 use nuld_core::real::Real;
 use nuld_core::sphere::square_to_hemisphere_real;
 use nuld_runtime::{Blob, ConditionalSampler};
-use nuld_tests::{conditional_parts, META};
+use nuld_tests::{conditional_parts, shape, META};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
-/// The two shapes of the runtime benchmark: n 64, hidden [32, 32], ReLU and SiLU,
-/// with the equal-area map and (ReLU) with the BRDF mixture warp.
+/// The shapes of the runtime benchmark: n 64, hidden [32, 32], ReLU and SiLU,
+/// with the equal-area map and (ReLU) with the BRDF mixture warp, without
+/// instance slots and (the default bake's) with 64, and 7 slots (instances wrap
+/// at another count than the table's 16).
 fn fixtures() -> Vec<ConditionalParts> {
     [
-        (Activation::Relu, PointWarp::EqualArea, 1),
-        (Activation::Silu, PointWarp::EqualArea, 2),
-        (Activation::Relu, PointWarp::BrdfMixture, 3),
+        (Activation::Relu, PointWarp::EqualArea, 0, 1),
+        (Activation::Silu, PointWarp::EqualArea, 7, 2),
+        (Activation::Relu, PointWarp::BrdfMixture, 0, 3),
+        (Activation::Relu, PointWarp::BrdfMixture, 64, 4),
     ]
     .into_iter()
-    .map(|(act, warp, seed)| conditional_parts(64, &[32, 32], act, 16, [10, 9], warp, seed))
+    .map(|(act, warp, slots, seed)| {
+        conditional_parts(shape(64, &[32, 32], act, warp, slots), 16, [10, 9], seed)
+    })
     .collect()
 }
 
@@ -103,7 +108,10 @@ fn network_mode_equals_the_tools_f64_evaluation_of_the_f16_weights() {
                 let i = rng.random_range(0..200);
                 let u = normalize::<f64>(&parts, c);
                 let input = input_features::<f64>(&shape, u, k, i);
-                let p = DVec2::from(tool.forward(i, input).square_point());
+                let p = DVec2::from(
+                    tool.forward(shape.embedding_row(k, i), input)
+                        .square_point(),
+                );
                 let got = cs.network_square_point(c, k, i).as_dvec2();
                 worst_square = worst_square.max((got - p).abs().max_element());
                 let d = match parts.info.point_warp().unwrap() {

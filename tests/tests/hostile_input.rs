@@ -12,7 +12,7 @@ use nuld_core::network::Activation;
 use nuld_core::quantize::f16_decode;
 use nuld_runtime::glam::{Vec2, Vec3};
 use nuld_runtime::{Blob, BlobKind};
-use nuld_tests::{conditional_parts, sobol_blob, META};
+use nuld_tests::{conditional_parts, shape, sobol_blob, META};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -76,33 +76,19 @@ fn check_sample(s: nuld_runtime::Sample) {
 }
 
 /// A small conditional blob with random contents (n 4, hidden [3, 2], 2 instances,
-/// a 3 x 2 grid).
+/// a 3 x 2 grid, 3 instance slots).
 fn conditional_blob() -> AlignedBytes {
-    conditional_parts(
-        4,
-        &[3, 2],
-        Activation::Silu,
-        2,
-        [3, 2],
-        PointWarp::BrdfMixture,
-        5,
-    )
-    .to_blob(&META)
-    .unwrap()
+    let shape = shape(4, &[3, 2], Activation::Silu, PointWarp::BrdfMixture, 3);
+    conditional_parts(shape, 2, [3, 2], 5)
+        .to_blob(&META)
+        .unwrap()
 }
 
 /// [`conditional_blob`]'s shape as an environment sampler (sphere, condition
 /// the octahedral square, the equal-area output).
 fn envmap_blob() -> AlignedBytes {
-    let mut parts = conditional_parts(
-        4,
-        &[3, 2],
-        Activation::Relu,
-        2,
-        [3, 2],
-        PointWarp::EqualArea,
-        6,
-    );
+    let shape = shape(4, &[3, 2], Activation::Relu, PointWarp::EqualArea, 0);
+    let mut parts = conditional_parts(shape, 2, [3, 2], 6);
     parts.info.domain = Domain::Sphere as u32;
     parts.info.target = nuld_core::conditional::ConditionalTarget::EnvmapNormal as u32;
     parts.info.cond_min = [0.0; 2];
@@ -518,7 +504,8 @@ struct ConditionalFields {
     hidden: [u32; 3],
     activation: u32,
     warp: u32,
-    reserved: [u32; 2],
+    instance_slots: u32,
+    reserved: u32,
 }
 
 /// What a parsed conditional blob promises (core/FORMAT.md, "Validation"), checked
@@ -555,7 +542,8 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
         hidden: [word(48), word(52), word(56)],
         activation: word(60),
         warp: word(68),
-        reserved: [word(72), word(76)],
+        instance_slots: word(72),
+        reserved: word(76),
     };
     let h = info.hidden;
     let layers = h.iter().take_while(|&&w| w > 0).count();
@@ -576,12 +564,17 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
         && widths_ok
         // Warp 1 (the BRDF mixture) exists for the glTF BRDF on the hemisphere only.
         && (info.warp == 0 || (info.warp == 1 && info.domain == 2))
-        && info.reserved == [0; 2])
+        && info.reserved == 0)
     {
         return false;
     }
-    // n h1 + sum over layers (out (in + 1)) + 2 (last + 1), inputs 11.
-    let mut expected_params = info.n as u128 * h[0] as u128;
+    // The embedding, max(M, 1) n rows of h1, counts fewer than 2^32 numbers.
+    let rows = info.instance_slots.max(1) as u128 * info.n as u128;
+    if rows * h[0] as u128 >= 1 << 32 {
+        return false;
+    }
+    // max(M, 1) n h1 + sum over layers (out (in + 1)) + 2 (last + 1), inputs 11.
+    let mut expected_params = rows * h[0] as u128;
     let mut fan_in = 11u128;
     for &w in &h[..layers] {
         expected_params += w as u128 * (fan_in + 1);

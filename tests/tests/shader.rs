@@ -37,7 +37,7 @@ use nuld_core::network::Activation;
 use nuld_runtime::glam::{DVec3, Vec2, Vec3};
 use nuld_runtime::shader::{kernel_wgsl, KernelMode, KernelParams, KERNEL_ENTRY_POINT};
 use nuld_runtime::{Blob, ConditionalSampler, Sample};
-use nuld_tests::{conditional_parts, distilled_parts, sobol_blob, META};
+use nuld_tests::{conditional_parts, distilled_parts, shape, sobol_blob, META};
 use shader_sample::Gpu;
 use std::sync::OnceLock;
 
@@ -373,14 +373,15 @@ fn shader_distilled_brdf_sampler_matches_the_runtime() {
 #[test]
 fn shader_random_samplers_of_every_shape_match_the_runtime() {
     let Some(kernel) = kernel() else { return };
-    let shapes: [(u32, &[u32], Activation, u32); 3] = [
-        (37, &[5, 3, 9], Activation::Silu, 3_000_000_019),
-        (8, &[128], Activation::Relu, 3),
-        (33, &[20, 12], Activation::Silu, 7),
+    let shapes: [(u32, &[u32], Activation, u32, u32); 3] = [
+        (37, &[5, 3, 9], Activation::Silu, 3_000_000_019, 64),
+        (8, &[128], Activation::Relu, 3, 3),
+        (33, &[20, 12], Activation::Silu, 7, 0),
     ];
-    for (s, (n, hidden, act, g)) in shapes.into_iter().enumerate() {
+    for (s, (n, hidden, act, g, slots)) in shapes.into_iter().enumerate() {
         for warp in [PointWarp::EqualArea, PointWarp::BrdfMixture] {
-            let mut parts = conditional_parts(n, hidden, act, 2, [4, 3], warp, s as u64);
+            let shape = shape(n, hidden, act, warp, slots);
+            let mut parts = conditional_parts(shape, 2, [4, 3], s as u64);
             // A generator whose products `i g` overflow 32 bits: the shader's
             // 64-bit-free `(i g) mod n`.
             parts.info.lattice_generator = g;

@@ -48,9 +48,15 @@ pub struct BakeArgs {
     /// SiLU hidden units instead of ReLU.
     #[arg(long)]
     pub silu: bool,
-    /// Weight of the union-of-instances term.
-    #[arg(long, default_value_t = TrainConfig::default().union_weight)]
-    pub union_weight: f64,
+    /// Instance slots M of the network: instance k is slot k mod M, a set with its own
+    /// offset and learned per-point biases (0: every instance its own offset, no
+    /// per-instance biases). Keep --instances <= M: table instances beyond M repeat
+    /// sets [default: 64 for --brdf, 0 for --envmap].
+    #[arg(long, allow_negative_numbers = true, value_parser = super::count)]
+    pub instance_slots: Option<usize>,
+    /// Weight of the union-of-instances term [default: 0.5 for --brdf, 4 for --envmap].
+    #[arg(long)]
+    pub union_weight: Option<f64>,
     /// Initial Adam step.
     #[arg(long, default_value_t = TrainConfig::default().learning_rate)]
     pub lr: f64,
@@ -95,8 +101,16 @@ pub fn run(a: BakeArgs) -> Result<()> {
         "--grid must be two node counts in 2..=256, like 10,12"
     );
     ensure!(a.steps >= 1, "--steps must be at least 1");
+    let instance_slots = a
+        .instance_slots
+        .unwrap_or(defaults.train.instance_slots as usize);
     ensure!(
-        a.union_weight.is_finite() && a.union_weight >= 0.0,
+        instance_slots <= 1 << 16,
+        "--instance-slots must be in 0..=65536, got {instance_slots}"
+    );
+    let union_weight = a.union_weight.unwrap_or(defaults.train.union_weight);
+    ensure!(
+        union_weight.is_finite() && union_weight >= 0.0,
         "--union-weight must be finite and >= 0"
     );
     ensure!(
@@ -107,8 +121,9 @@ pub fn run(a: BakeArgs) -> Result<()> {
         n: a.n as u32,
         hidden: a.hidden,
         silu: a.silu,
+        instance_slots: instance_slots as u32,
         steps: a.steps,
-        union_weight: a.union_weight,
+        union_weight,
         learning_rate: a.lr,
         seed: a.seed,
         ..defaults.train.clone()

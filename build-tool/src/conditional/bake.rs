@@ -120,12 +120,16 @@ impl BakeConfig {
     }
 
     /// These settings for an environment sampler of `target`, with the equal-area
-    /// output (the mixture prior is a warp of the BRDF's primary space).
+    /// output (the mixture prior is a warp of the BRDF's primary space), no
+    /// instance slots ([`ENVMAP_INSTANCE_SLOTS`]) and the union weight
+    /// [`ENVMAP_UNION_WEIGHT`].
     pub fn with_envmap(self, target: TrainTarget) -> Self {
         Self {
             train: TrainConfig {
                 target,
                 mixture_prior: false,
+                instance_slots: ENVMAP_INSTANCE_SLOTS,
+                union_weight: ENVMAP_UNION_WEIGHT,
                 ..self.train
             },
             ..self
@@ -138,6 +142,17 @@ impl BakeConfig {
     }
 }
 
+/// Instance slots of an environment sampler's network: none, every instance its
+/// own offset. The slots were chosen by measurement on the BRDF sampler only
+/// (README.md); environment samplers keep the network their figures were
+/// measured with.
+pub const ENVMAP_INSTANCE_SLOTS: u32 = 0;
+
+/// Weight of the union term for an environment sampler: without instance slots
+/// the network needs the strong union term to keep instances apart (the BRDF
+/// sampler's weight was lowered with the slots, README.md).
+pub const ENVMAP_UNION_WEIGHT: f64 = 4.0;
+
 /// The checkpoint's path in `dir`.
 pub fn checkpoint_path(dir: &Path) -> PathBuf {
     dir.join("checkpoint.bin")
@@ -148,7 +163,8 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     let started = Instant::now();
     if config.train.shape().is_none() {
         bail!(
-            "network shape out of range: 1 to 3 hidden layers of 1 to {} units",
+            "network shape out of range: 1 to 3 hidden layers of 1 to {} units, and \
+             max(instance slots, 1) x n x the first width below 2^32",
             nuld_core::network::MAX_WIDTH
         );
     }

@@ -54,7 +54,8 @@ pub fn info(
         activation: shape.activation() as u32,
         lattice_generator: shape.lattice_generator(),
         warp: PointWarp::of_shape(shape) as u32,
-        reserved: [0; 2],
+        instance_slots: shape.instance_slots(),
+        reserved: 0,
     }
 }
 

@@ -2,14 +2,14 @@
 //! sigmoid onto the square after it (the map from the square to a direction is the
 //! caller's: its Jacobian chains in front of [`output_gradient`]).
 //!
-//! With `a_0` the input, `z_l = W_l a_(l-1) + b_l (+ E[i] for l = 1)`,
+//! With `a_0` the input, `z_l = W_l a_(l-1) + b_l (+ E[row] for l = 1)`,
 //! `a_l = act(z_l)`, `o = W_o a_L + b_o`, `p = sigmoid(o)`, `x = M(p)`:
 //!
 //! ```text
 //! dL/do   = dL/dp * p (1 - p)
 //! dL/dW_o = dL/do a_L^T,   dL/db_o = dL/do,   dL/da_L = W_o^T dL/do
 //! dL/dz_l = dL/da_l * act'(z_l)
-//! dL/dW_l = dL/dz_l a_(l-1)^T,  dL/db_l = dL/dz_l (= dL/dE[i] for l = 1)
+//! dL/dW_l = dL/dz_l a_(l-1)^T,  dL/db_l = dL/dz_l (= dL/dE[row] for l = 1)
 //! dL/da_(l-1) = W_l^T dL/dz_l
 //! ```
 
@@ -28,8 +28,8 @@ pub fn output_gradient(trace: &Trace<f64>, d_square: DVec2) -> [f64; OUTPUTS] {
     })
 }
 
-/// Adds `dL/dparams` to `grad` (length `shape.param_len()`) for index `i` whose
-/// forward pass left `trace`, given `d_output = dL/do` (module formulas).
+/// Adds `dL/dparams` to `grad` (length `shape.param_len()`) for the embedding row
+/// `embedding_row` ([`Shape::embedding_row`]) whose forward pass left `trace`, given `d_output = dL/do` (module formulas).
 /// `O(multiply_adds)`.
 ///
 /// # Panics
@@ -38,7 +38,7 @@ pub fn backward(
     shape: &Shape,
     params: &[f64],
     trace: &Trace<f64>,
-    i: u32,
+    embedding_row: u32,
     d_output: [f64; OUTPUTS],
     grad: &mut [f64],
 ) {
@@ -108,7 +108,7 @@ pub fn backward(
             }
             grad[bias + o] += d;
             if l == 0 {
-                grad[shape.embedding_offset(i) + o] += d;
+                grad[shape.embedding_offset(embedding_row) + o] += d;
             }
         }
         delta_a = next;
@@ -179,7 +179,14 @@ mod tests {
                 // differences.
                 let (jx, jy) = map_jacobian(Domain::Hemisphere, sq);
                 let d_out = output_gradient(&t, DVec2::new(jx.dot(g3), jy.dot(g3)));
-                backward(&shape, &p.values, &t, i, d_out, &mut grad);
+                backward(
+                    &shape,
+                    &p.values,
+                    &t,
+                    shape.embedding_row(k, i),
+                    d_out,
+                    &mut grad,
+                );
             }
             let h = 1e-6;
             let mut worst: f64 = 0.0;

@@ -42,7 +42,7 @@ macro_rules! at {
 /// Each [`ConditionalInfo`] field: the WGSL constant `nuld_info` reads it at, the
 /// `NuldConditionalInfo` member it lands in, and its Rust offset (the two WGSL
 /// names of one offset, listed once).
-fn info_fields() -> [(&'static str, &'static str, u64); 12] {
+fn info_fields() -> [(&'static str, &'static str, u64); 13] {
     [
         (
             "NULD_INFO_N",
@@ -103,6 +103,11 @@ fn info_fields() -> [(&'static str, &'static str, u64); 12] {
             "NULD_INFO_WARP",
             "NuldConditionalInfo.warp",
             at!(ConditionalInfo, warp),
+        ),
+        (
+            "NULD_INFO_INSTANCE_SLOTS",
+            "NuldConditionalInfo.instance_slots",
+            at!(ConditionalInfo, instance_slots),
         ),
     ]
 }

@@ -3,8 +3,9 @@
 //!
 //! A step draws `B` conditions from the [`ConditionPool`] (half uniformly, half by
 //! tournament toward the conditions whose running loss is worst relative to the
-//! warped Owen-Sobol baseline) and `S` random instances of each, evaluates the
-//! network for every index of every set, and minimizes
+//! warped Owen-Sobol baseline) and `S` instances of each (distinct slots of a
+//! network with [instance slots](Shape::with_instance_slots), else random u32s),
+//! evaluates the network for every index of every set, and minimizes
 //!
 //! ```text
 //! L = (1 / (B S)) sum_{b,s} loss(X_bs) + lambda (1 / B) sum_b loss(X_b1 u ... u X_bS)
@@ -88,6 +89,10 @@ pub struct TrainConfig {
     pub alpha_start: f64,
     /// Sigmoid sharpness at the end, in inverse point spacings.
     pub alpha_end: f64,
+    /// Instance slots `M` of the network ([`Shape::with_instance_slots`]; 0: an
+    /// offset per instance and no per-instance embedding).
+    #[serde(default)]
+    pub instance_slots: u32,
     /// Fixes the initialization, the pool and every draw.
     pub seed: u64,
 }
@@ -104,7 +109,7 @@ impl Default for TrainConfig {
             pretrain_steps: 300,
             conditions_per_step: 8,
             instances_per_condition: 8,
-            union_weight: 4.0,
+            union_weight: 0.5,
             pool_conditions: 256,
             pool_caps: 2048,
             caps_per_step: 256,
@@ -112,6 +117,7 @@ impl Default for TrainConfig {
             final_learning_rate_ratio: 0.03,
             alpha_start: 8.0,
             alpha_end: 64.0,
+            instance_slots: 64,
             seed: 0,
         }
     }
@@ -127,6 +133,7 @@ impl TrainConfig {
         };
         Shape::new(self.n, &self.hidden, act, lattice_generator(self.n))
             .map(|s| s.with_lattice_residual(self.mixture_prior))
+            .and_then(|s| s.with_instance_slots(self.instance_slots))
     }
 }
 
@@ -269,9 +276,7 @@ impl Trainer {
                     }
                 }
             }
-            let instances: Vec<u32> = (0..cfg.instances_per_condition)
-                .map(|_| r.random())
-                .collect();
+            let instances = draw_instances(&mut r, cfg.instances_per_condition, cfg.instance_slots);
             let start = r.random_range(0..cfg.pool_caps);
             batch.push((pick, instances, start));
         }
@@ -330,6 +335,23 @@ impl Trainer {
     }
 }
 
+/// `count` instances for one condition of a batch: distinct slots when the network
+/// has `slots >= count` of them (a repeated slot is the same set, which the union
+/// term could not tell apart), else random `u32`s.
+fn draw_instances(r: &mut impl Rng, count: usize, slots: u32) -> Vec<u32> {
+    if (slots as usize) < count {
+        return (0..count).map(|_| r.random()).collect();
+    }
+    // A partial Fisher-Yates shuffle of 0..slots.
+    let mut all: Vec<u32> = (0..slots).collect();
+    for j in 0..count {
+        let pick = r.random_range(j..all.len());
+        all.swap(j, pick);
+    }
+    all.truncate(count);
+    all
+}
+
 /// A pretraining step for one condition: the squared distance of the network's
 /// square points to the warp's ([`PoolCondition::warp_targets`]) for the
 /// pretraining instance `instances[j] mod PRETRAIN_INSTANCES`; returns
@@ -352,7 +374,8 @@ fn pretrain_step(
             let d = DVec2::new(s[0], s[1]) - pc.warp_targets[k as usize * n + i as usize];
             loss += d.length_squared() / (instances.len() * n) as f64;
             let d_out = output_gradient(&t, 2.0 * w * d);
-            backward(&params.shape, &params.values, &t, i, d_out, &mut grad);
+            let row = params.shape.embedding_row(k, i);
+            backward(&params.shape, &params.values, &t, row, d_out, &mut grad);
         }
     }
     (loss, 0.0, grad)
@@ -429,8 +452,8 @@ fn condition_step(
     let mut grad = vec![0.0; params.values.len()];
     for (j, ((t, &(jx, jy)), &g3)) in traces.iter().zip(&jacobians).zip(&grad3).enumerate() {
         let d_out = output_gradient(t, DVec2::new(jx.dot(g3), jy.dot(g3)));
-        let i = (j % n) as u32;
-        backward(&params.shape, &params.values, t, i, d_out, &mut grad);
+        let row = params.shape.embedding_row(instances[j / n], (j % n) as u32);
+        backward(&params.shape, &params.values, t, row, d_out, &mut grad);
     }
     (set_loss, union_loss, grad)
 }
@@ -545,6 +568,21 @@ mod tests {
         );
         // Cap loss.
         assert!(mean(&losses[110..]) < mean(&losses[60..70]), "{losses:?}");
+    }
+
+    #[test]
+    fn a_batch_draws_distinct_slots_when_there_are_enough() {
+        let mut r = rng(3, 1);
+        for _ in 0..200 {
+            let mut k = draw_instances(&mut r, 8, 10);
+            k.sort_unstable();
+            k.dedup();
+            assert_eq!(k.len(), 8, "{k:?}");
+            assert!(k.iter().all(|&s| s < 10));
+        }
+        // Fewer slots than instances (or none): any u32.
+        let k = draw_instances(&mut r, 8, 0);
+        assert!(k.iter().any(|&s| s >= 1 << 16), "{k:?}");
     }
 
     #[test]

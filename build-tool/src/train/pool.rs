@@ -159,7 +159,7 @@ fn warp_targets(target: &BrdfTarget, shape: &Shape) -> Vec<DVec2> {
     let residual = shape.lattice_residual();
     (0..PRETRAIN_INSTANCES)
         .flat_map(|k| {
-            let z = instance_offset::<f64>(k);
+            let z = instance_offset::<f64>(shape.instance_key(k));
             (0..shape_n).map(move |i| {
                 let u = shifted_lattice_point(i, shape_n, g, z);
                 let u = DVec2::new(u[0], u[1]);
@@ -318,7 +318,7 @@ fn envmap_condition(
     let share = irradiance / map.integral();
     let warp_targets = (0..PRETRAIN_INSTANCES)
         .flat_map(|k| {
-            let z = instance_offset::<f64>(k);
+            let z = instance_offset::<f64>(shape.instance_key(k));
             let g = shape.lattice_generator();
             let lit = &lit;
             (0..shape.n()).map(move |i| {
