@@ -602,6 +602,28 @@ fn envmap_bake_and_sample_reject_bad_input_with_one_line() {
     assert!(e.contains("cannot be used with"), "{e}");
     let e = failure(&["bake"], &out);
     assert!(e.contains("--brdf or --envmap MAP"), "{e}");
+    // Slots whose embedding (M n h1 numbers) would not fit in a u32, a negative
+    // slot count, a union weight that is no number: one line, nothing written.
+    let e = failure(
+        &[
+            "bake",
+            "--brdf",
+            "--n",
+            "65536",
+            "--hidden",
+            "128",
+            "--instance-slots",
+            "512",
+        ],
+        &out,
+    );
+    assert!(e.contains("max(instance slots, 1) x n"), "{e}");
+    assert_eq!(e.trim().lines().count(), 1, "{e}");
+    let e = failure(&["bake", "--brdf", "--instance-slots", "-1"], &out);
+    assert!(e.contains("negative"), "{e}");
+    let e = failure(&["bake", "--brdf", "--union-weight", "nan"], &out);
+    assert!(e.contains("--union-weight must be finite"), "{e}");
+    assert!(!out.exists());
     // A map that exists but does not decode fails in the pool, after the output
     // directory was made: it goes again.
     let junk = dir.join("junk.hdr");
