@@ -2,9 +2,10 @@
 //! optimizer's cap loss.
 //!
 //! A step draws `B` conditions from the [`ConditionPool`] (half uniformly, half by
-//! tournament toward the conditions whose running loss is worst relative to the
-//! warped Owen-Sobol baseline) and `S` instances of each (distinct slots of a
-//! network with [instance slots](Shape::with_instance_slots), else random u32s),
+//! tournament toward the conditions whose running loss is worst relative to
+//! Owen-Sobol points through the target's exact inverse CDF,
+//! [`PoolCondition::baseline_loss`]) and `S` instances of each (distinct slots of
+//! a network with [instance slots](Shape::with_instance_slots), else random u32s),
 //! evaluates the network for every index of every set, and minimizes
 //!
 //! ```text
