@@ -322,6 +322,13 @@ impl ConditionalInfo {
 
     /// The network architecture the info describes, if its counts are valid.
     pub fn shape(&self) -> Option<Shape> {
+        self.shape_without_slots()?
+            .with_instance_slots(self.instance_slots)
+    }
+
+    /// [`Self::shape`] before the instance slots are applied: tells a blob whose
+    /// slots overflow the embedding from one whose widths are wrong.
+    pub fn shape_without_slots(&self) -> Option<Shape> {
         let layers = self.hidden.iter().take_while(|&&h| h != 0).count();
         if self.hidden[layers..].iter().any(|&h| h != 0) {
             return None;
@@ -329,18 +336,7 @@ impl ConditionalInfo {
         let act = Activation::from_code(self.activation)?;
         let residual = PointWarp::from_code(self.warp)? == PointWarp::BrdfMixture;
         Shape::new(self.n, &self.hidden[..layers], act, self.lattice_generator)
-            .map(|s| s.with_lattice_residual(residual))?
-            .with_instance_slots(self.instance_slots)
-    }
-
-    /// [`Self::shape`] before the instance slots are applied: tells a blob whose
-    /// slots overflow the embedding from one whose widths are wrong.
-    pub fn shape_without_slots(&self) -> Option<Shape> {
-        Self {
-            instance_slots: 0,
-            ..*self
-        }
-        .shape()
+            .map(|s| s.with_lattice_residual(residual))
     }
 
     /// The info's [`PointWarp`], if its code is known.

@@ -234,7 +234,7 @@ impl Shape {
         match self.instance_slots {
             0 => i,
             // `M n` fits in a u32 (checked by `with_instance_slots`).
-            m => (k % m) * self.n + i,
+            _ => self.instance_key(k) * self.n + i,
         }
     }
 

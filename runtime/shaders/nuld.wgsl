@@ -652,7 +652,7 @@ fn nuld_embedding_row(info: NuldConditionalInfo, k: u32, i: u32) -> u32 {
     if info.instance_slots == 0u {
         return row;
     }
-    return (k % info.instance_slots) * info.n + row;
+    return nuld_instance_key(info, k) * info.n + row;
 }
 
 // Rust: `input_features`: the network's 11 inputs (condition, instance offset,

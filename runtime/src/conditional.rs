@@ -144,12 +144,10 @@ impl<'a> ConditionalSampler<'a> {
             return Err(BlobError::UnknownActivation(info.activation));
         }
         let shape = info
-            .shape()
-            .ok_or(if info.shape_without_slots().is_some() {
-                BlobError::InstanceSlots(info.instance_slots)
-            } else {
-                BlobError::NetworkWidths(info.hidden)
-            })?;
+            .shape_without_slots()
+            .ok_or(BlobError::NetworkWidths(info.hidden))?
+            .with_instance_slots(info.instance_slots)
+            .ok_or(BlobError::InstanceSlots(info.instance_slots))?;
         if info.reserved != 0 {
             return Err(BlobError::ConditionalReserved(info.reserved));
         }
@@ -159,12 +157,10 @@ impl<'a> ConditionalSampler<'a> {
             SectionTag::NetworkParams,
             BlobError::ParamElementSize,
             || {
-                // Counted in u64: `Shape::param_len` multiplies `max(M, 1) n h1`
-                // in `usize`, which a hostile `n` could overflow on a 32-bit
-                // target; `multiply_adds` does not depend on `n`.
-                let h1 = shape.hidden().first().copied().unwrap_or(0) as u64;
-                let rows = info.instance_slots.max(1) as u64 * info.n as u64;
-                Ok(rows * h1 + shape.multiply_adds() as u64)
+                // The embedding `max(M, 1) n h1` is below 2^32 (checked by
+                // `with_instance_slots`), so it fits a 32-bit `usize`; the sum is
+                // taken in u64, where `param_len` could overflow one.
+                Ok(shape.first_layer_offset() as u64 + shape.multiply_adds() as u64)
             },
             |expected, got| BlobError::ParamsLength { expected, got },
         )?;

@@ -223,7 +223,7 @@ impl ConditionPool {
                 let seed = derive_seed(seed, p as u64);
                 let cond = loaded.condition(u);
                 match &loaded {
-                    LoadedTarget::GltfBrdf => Ok(condition(cond, caps, window, shape, seed)),
+                    LoadedTarget::GltfBrdf => condition(cond, caps, window, shape, seed),
                     LoadedTarget::Envmap(map) => {
                         envmap_condition(map, cond, caps, window, shape, seed)
                     }
@@ -253,7 +253,7 @@ fn condition(
     window: usize,
     shape: &Shape,
     seed: u64,
-) -> PoolCondition {
+) -> Result<PoolCondition> {
     let n = shape.n() as usize;
     let target = BrdfTarget::coarse(cond[0], cond[1], POOL_RULE_POINTS)
         .expect("pool conditions lie in the condition range");
@@ -277,16 +277,12 @@ fn condition(
         lobe_probability: target.lobe_probability(),
         warp: PointWarp::of_shape(shape),
     };
-    // The mixture warp only if the tabulation fails (a density of no mass, which
-    // the glTF BRDF never is).
-    let pts = match TabulatedWarp::new(&target, POOL_BASELINE_TABULATION, 2) {
-        Ok(exact) => exact.warp_all(&seeded_owen_sobol(n, seed)),
-        Err(_) => warped_owen_sobol_directions(&target, n, seed),
-    };
-    PoolCondition {
+    let exact = TabulatedWarp::new(&target, POOL_BASELINE_TABULATION, 2)?;
+    let pts = exact.warp_all(&seeded_owen_sobol(n, seed));
+    Ok(PoolCondition {
         baseline_loss: pc.window_loss(&pts, window),
         ..pc
-    }
+    })
 }
 
 impl PoolCondition {
@@ -383,7 +379,7 @@ mod tests {
     fn brdf_baselines_are_the_exact_inverse_cdf() {
         let shape = Shape::new(64, &[4], Activation::Relu, 5).unwrap();
         for cond in [[0.13, 85.0], [0.25, 80.0], [0.5, 30.0]] {
-            let pc = condition(cond, 512, 256, &shape, 3);
+            let pc = condition(cond, 512, 256, &shape, 3).unwrap();
             let target = BrdfTarget::coarse(cond[0], cond[1], POOL_RULE_POINTS).unwrap();
             let exact = TabulatedWarp::new(&target, POOL_BASELINE_TABULATION, 2).unwrap();
             let u = seeded_owen_sobol(64, 3);
