@@ -90,9 +90,9 @@ pub fn random_parts(
     })
 }
 
-fn sampler(b: &AlignedBytes) -> Result<nuld_runtime::ConditionalSampler<'_>> {
+fn sampler(b: &AlignedBytes) -> Result<nuld_runtime::BrdfSampler<'_>> {
     Blob::parse(b.as_slice())
-        .and_then(|b| b.conditional())
+        .and_then(|b| b.brdf())
         .map_err(|e| anyhow!("{e}"))
 }
 
@@ -204,15 +204,15 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
         }),
     ));
     rows.push((
-        "table: sample".into(),
+        "table: ConditionalSampler::sample".into(),
         ns_per_sample(samples, |s| {
-            black_box(relu.sample(conds[at(s)], s / n, s % n));
+            black_box(relu.conditional().sample(conds[at(s)], s / n, s % n));
         }),
     ));
     rows.push((
-        "table: sample_brdf".into(),
+        "table: BrdfSampler::sample".into(),
         ns_per_sample(samples, |s| {
-            black_box(relu.sample_brdf(views[at(s)], conds[at(s)].x, s / n, s % n));
+            black_box(relu.sample(views[at(s)], conds[at(s)].x, s / n, s % n));
         }),
     ));
     for (name, cs) in [
@@ -220,19 +220,24 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
         ("network [64,64] silu", &silu),
     ] {
         rows.push((
-            format!("{name}: sample_network"),
+            format!("{name}: zero-copy, NetworkSampler::sample"),
             ns_per_sample(samples / 10, |s| {
-                black_box(cs.sample_network(conds[at(s)], s / n, s % n));
+                black_box(
+                    cs.conditional()
+                        .network()
+                        .sample(conds[at(s)], s / n, s % n),
+                );
             }),
         ));
         let mut buf = vec![0.0f32; cs.decoded_network_len()];
         let decoded = cs
+            .conditional()
             .decode_network(&mut buf)
             .ok_or_else(|| anyhow!("decode_network refused a buffer of its own length"))?;
         rows.push((
-            format!("{name}: decoded, sample_network"),
+            format!("{name}: decoded, NetworkSampler::sample"),
             ns_per_sample(samples / 10, |s| {
-                black_box(decoded.sample_network(conds[at(s)], s / n, s % n));
+                black_box(decoded.sample(conds[at(s)], s / n, s % n));
             }),
         ));
     }

@@ -525,7 +525,7 @@ fn sample_prints_what_the_runtime_serves_and_rejects_bad_input() {
         for (i, row) in rows.iter().enumerate() {
             let s = match mode {
                 "table" => cs.sample(c, k, i as u32),
-                _ => cs.sample_network(c, k, i as u32),
+                _ => cs.network().sample(c, k, i as u32),
             };
             let want = [
                 i as f32,
@@ -551,6 +551,20 @@ fn sample_prints_what_the_runtime_serves_and_rejects_bad_input() {
     let s = cs.sample(Vec2::new(1.0, 0.0), 0, 0);
     let d = s.direction;
     assert_eq!(first, format!("0,{},{},{},{}", d.x, d.y, d.z, s.weight));
+    // A condition outside the blob's range is clamped, and stderr says so in one
+    // line; one inside the range prints nothing there.
+    for (cond, warned) in [("2,-10", true), ("0.35,47.5", false)] {
+        let out = build_tool()
+            .arg("sample")
+            .arg(&file)
+            .args(["--cond", cond])
+            .output()
+            .unwrap();
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert!(out.status.success(), "{err}");
+        assert_eq!(err.lines().count(), usize::from(warned), "{cond}: {err}");
+        assert_eq!(err.contains("outside the blob's range"), warned, "{err}");
+    }
 
     let sobol = dir.join("sobol.nuld");
     let st = build_tool()

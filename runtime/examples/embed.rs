@@ -23,10 +23,11 @@ fn main() -> Result<(), BlobError> {
     let blob = Blob::parse(SAMPLES)?; // validates everything once, no allocation
     let set = set_of_pixel(17, 4);
     // A renderer's estimate: the mean of f/q over the set's points, q the target.
-    let mut sum = 0.0;
+    let (mut sum, mut sets) = (0.0, 1);
     match blob.kind() {
         BlobKind::PointSet2D => {
             let pts = blob.point_set_2d()?;
+            sets = pts.set_count();
             for i in 0..pts.len() {
                 let p: Vec2 = pts.point(set, i); // O(1), in (0,1)^2, indices wrap
                 sum += p.x * p.y; // stands for f(p) / q(p)
@@ -35,6 +36,7 @@ fn main() -> Result<(), BlobError> {
         }
         BlobKind::DirectionSet => {
             let dirs = blob.direction_set()?;
+            sets = dirs.set_count();
             for i in 0..dirs.len() {
                 let w: Vec3 = dirs.direction(set, i); // O(1), unit length
                 sum += w.z.max(0.0); // stands for f(w) / q(w)
@@ -44,6 +46,7 @@ fn main() -> Result<(), BlobError> {
         // Conditional samplers take a condition per sample; this blob is not one.
         BlobKind::Conditional => {}
     }
-    println!("set {set}: estimate {sum}");
+    // The set the lookups used: `set` wraps modulo the blob's set count.
+    println!("set {} of {sets}: estimate {sum}", set % sets);
     Ok(())
 }

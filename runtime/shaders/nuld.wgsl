@@ -26,7 +26,7 @@
 
 // ---- Blob layout (core/FORMAT.md): byte offsets and codes ----------------------
 
-// `Header::kind` (core/src/blob.rs).
+// `Header::kind` (core/src/blob/mod.rs).
 const NULD_HEADER_KIND: u32 = 12u;
 // `Header::section_count`.
 const NULD_HEADER_SECTION_COUNT: u32 = 40u;
@@ -89,7 +89,7 @@ const NULD_DOT_LANES: u32 = 8u;
 // `Activation` codes.
 const NULD_ACTIVATION_RELU: u32 = 0u;
 const NULD_ACTIVATION_SILU: u32 = 1u;
-// `PointWarp` codes (core/src/conditional.rs).
+// `PointWarp` codes (core/src/conditional/mod.rs).
 const NULD_WARP_EQUAL_AREA: u32 = 0u;
 const NULD_WARP_BRDF_MIXTURE: u32 = 1u;
 // `ConditionalTarget::EnvmapNormal`: table mode interpolates directions.
@@ -100,7 +100,7 @@ const NULD_TARGET_ENVMAP_NORMAL: u32 = 2u;
 // `FRAC_PI_4`, `FRAC_PI_2` rounded to f32.
 const NULD_FRAC_PI_4: f32 = 0.78539818525314331055;
 const NULD_FRAC_PI_2: f32 = 1.57079637050628662109;
-// `DEGREES_PER_RADIAN` of runtime/src/conditional.rs: `180 / PI` divided in f32.
+// `DEGREES_PER_RADIAN` of runtime/src/brdf.rs: `180 / PI` divided in f32.
 const NULD_DEGREES_PER_RADIAN: f32 = 57.2957763671875;
 // `f32::consts::PI` and `(pi / 180) as f32` (bits 0x40490fdb, 0x3c8efa35).
 const NULD_PI: f32 = 3.14159274101257324219;
@@ -111,11 +111,11 @@ const NULD_MIN_ROUGHNESS: f32 = 0.10000000149011611938;
 const NULD_MAX_ROUGHNESS: f32 = 1.0;
 const NULD_MAX_THETA_O_DEG: f32 = 89.0;
 // `2^-20`: the clamp of the shifted lattice point before its logit
-// (core/src/network.rs `LATTICE_LOGIT_EPS`).
+// (core/src/network/features.rs `LATTICE_LOGIT_EPS`).
 const NULD_LATTICE_LOGIT_EPS: f32 = 0.00000095367431640625;
 // `1 / UNORM16_CELLS` (core/src/quantize.rs).
 const NULD_UNORM16_SCALE: f32 = 0.0000152587890625;
-// `2^-24`: the instance offset's unit (core/src/network.rs `instance_offset`).
+// `2^-24`: the instance offset's unit (core/src/network/features.rs `instance_offset`).
 const NULD_INSTANCE_UNIT: f32 = 0.000000059604644775390625;
 // `2^-24`: the smallest binary16 subnormal (`f16_decode_finite(1)`).
 const NULD_F16_SUBNORMAL: f32 = 0.000000059604644775390625;
@@ -132,12 +132,12 @@ fn nuld_f32(byte: u32) -> f32 {
     return bitcast<f32>(nuld_blob[byte / 4u]);
 }
 
-// Rust: `Layout::header().kind` (core/src/blob.rs).
+// Rust: `Layout::header().kind` (core/src/blob/layout.rs).
 fn nuld_kind() -> u32 {
     return nuld_u32(NULD_HEADER_KIND);
 }
 
-// Rust: `Layout::section` (core/src/blob.rs): the byte offset of the first section
+// Rust: `Layout::section` (core/src/blob/layout.rs): the byte offset of the first section
 // with this tag; 0 (the header) if there is none, which a valid blob of the kind
 // that needs the section never has.
 fn nuld_section(tag: u32) -> u32 {
@@ -158,7 +158,7 @@ fn nuld_unorm16_decode(q: u32) -> f32 {
     return (f32(q) + 0.5) * NULD_UNORM16_SCALE;
 }
 
-// Rust: `unpack_point` (core/src/conditional.rs): the u16 codes
+// Rust: `unpack_point` (core/src/conditional/mod.rs): the u16 codes
 // `(w & 0xffff, w >> 16)` of a word holding a point (its two little-endian u16).
 fn nuld_unpack_point(w: u32) -> vec2<u32> {
     return vec2<u32>(w & 0xffffu, w >> 16u);
@@ -296,7 +296,7 @@ fn nuld_sample_ggx_vndf(wo: vec3<f32>, alpha: f32, u: vec2<f32>) -> vec3<f32> {
     return nuld_normalize3(vec3<f32>(alpha * nh.x, alpha * nh.y, max(nh.z, 0.0)));
 }
 
-// Rust: `brdf_mixture_direction` (core/src/conditional.rs) and `brdf_mixture_real`
+// Rust: `brdf_mixture_direction` (core/src/conditional/mod.rs) and `brdf_mixture_real`
 // (core/src/warp.rs): the point `p` warped by the renderer's mixture at the BRDF
 // condition `c = (roughness, theta_o in degrees)` with lobe probability `p_s`:
 // `p.x < p_s` picks the GGX lobe (visible normals at `(p.x / p_s, p.y)`, reflected),
@@ -366,9 +366,9 @@ fn nuld_direction(set_index: u32, i: u32) -> vec3<f32> {
     return nuld_to_direction(nuld_domain(), nuld_point(set_index, i));
 }
 
-// ---- Conditional samplers (kind 3; core/src/conditional.rs) -------------------
+// ---- Conditional samplers (kind 3; core/src/conditional/) -------------------
 
-// Rust: `ConditionalInfo` (core/src/conditional.rs), field for field at the same
+// Rust: `ConditionalInfo` (core/src/conditional/mod.rs), field for field at the same
 // byte offsets and of the same size (`target` is a reserved word in WGSL; `hidden`
 // is a vector and the zero `reserved` tail is left to the struct's padding, since
 // naga's GLSL front end does not read back arrays in struct constructors).
@@ -564,7 +564,7 @@ fn nuld_corner_point(cs: NuldConditional, cell: NuldGridCell, dx: u32, dy: u32, 
     return vec2<f32>(nuld_unorm16_decode(q.x), nuld_unorm16_decode(q.y));
 }
 
-// ---- Network mode (core/src/network.rs) ----------------------------------------
+// ---- Network mode (core/src/network/) ----------------------------------------
 
 // Rust: `sigmoid`: `1 / (1 + exp(-x))`.
 fn nuld_sigmoid(x: f32) -> f32 {
@@ -704,7 +704,7 @@ fn nuld_param(params: u32, j: u32) -> f32 {
     return nuld_f16_decode((word >> (16u * (j & 1u))) & 0xffffu);
 }
 
-// Rust: `dot` (core/src/network.rs): `sum_k w[k] x[k]` over `len` terms, the
+// Rust: `dot` (core/src/network/kernels.rs): `sum_k w[k] x[k]` over `len` terms, the
 // weights from parameter `w`, in eight partial sums `s[k mod 8]` (k ascending),
 // combined as `((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7))`.
 fn nuld_dot(params: u32, w: u32, x: ptr<function, array<f32, 128>>, len: u32) -> f32 {
@@ -792,7 +792,7 @@ fn nuld_network_evaluate(cs: NuldConditional, row: u32, input: array<f32, 11>) -
     return out;
 }
 
-// Rust: `ConditionalSampler::network_square_point` (network mode): the network's
+// Rust: `NetworkSampler::square_point` (network mode): the network's
 // outputs through the sigmoid, for any u32 instance (`nuld_instance_key`).
 fn nuld_network_square_point(cond: vec2<f32>, instance: u32, i: u32) -> vec2<f32> {
     let cs = nuld_conditional();
@@ -806,7 +806,7 @@ fn nuld_network_square_point_of(cs: NuldConditional, u: vec2<f32>, instance: u32
     return vec2<f32>(nuld_sigmoid(out.x), nuld_sigmoid(out.y));
 }
 
-// ---- Samples (runtime/src/conditional.rs) -------------------------------------
+// ---- Samples (runtime/src/brdf.rs) -------------------------------------
 
 // Rust: `Sample`: a unit direction (local frame, `z` = normal) and the estimator
 // weight of its condition. 16 bytes in a storage buffer.
@@ -850,7 +850,7 @@ fn nuld_table_direction_of(cs: NuldConditional, u: vec2<f32>, instance: u32, i: 
     return d00;
 }
 
-// Rust: `ConditionalSampler::sample_network` (network mode): as `nuld_sample`;
+// Rust: `NetworkSampler::sample` (network mode): as `nuld_sample`;
 // instances wrap modulo the instance slots (without slots every u32 is its own set).
 fn nuld_sample_network(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
     let cs = nuld_conditional();
@@ -926,7 +926,7 @@ fn nuld_acos(x: f32) -> f32 {
     return 2.0 * (df + w);
 }
 
-// Rust: `view_condition` (runtime/src/conditional.rs): the condition
+// Rust: `view_condition` (runtime/src/brdf.rs): the condition
 // `(roughness, theta_o in degrees)` of the view `wo` (any length; scaled by its
 // largest component first) and its azimuth `(cos phi, sin phi)`; a zero, infinite
 // or NaN view reads as normal incidence with azimuth `(1, 0)`.
@@ -953,7 +953,7 @@ fn nuld_view_condition(wo: vec3<f32>, roughness: f32) -> NuldView {
     return NuldView(vec2<f32>(roughness, theta), azimuth);
 }
 
-// Rust: `rotate` (runtime/src/conditional.rs): the sample turned about `z` by the
+// Rust: `rotate` (runtime/src/brdf.rs): the sample turned about `z` by the
 // azimuth `(cos phi, sin phi)`.
 fn nuld_rotate(s: NuldSample, azimuth: vec2<f32>) -> NuldSample {
     let d = s.direction;
@@ -962,7 +962,7 @@ fn nuld_rotate(s: NuldSample, azimuth: vec2<f32>) -> NuldSample {
     return NuldSample(vec3<f32>(c * d.x - sn * d.y, sn * d.x + c * d.y, d.z), s.weight);
 }
 
-// Rust: `ConditionalSampler::sample_brdf` (table mode, glTF BRDF samplers): the set
+// Rust: `BrdfSampler::sample` (table mode, glTF BRDF samplers): the set
 // at `(roughness, theta_o)` of the view `wo` (local frame, `z` = normal, any length),
 // turned about `z` to the view's azimuth.
 fn nuld_sample_brdf(wo: vec3<f32>, roughness: f32, instance: u32, i: u32) -> NuldSample {
@@ -970,7 +970,7 @@ fn nuld_sample_brdf(wo: vec3<f32>, roughness: f32, instance: u32, i: u32) -> Nul
     return nuld_rotate(nuld_sample(view.cond, instance, i), view.azimuth);
 }
 
-// Rust: `ConditionalSampler::sample_brdf_network` (network mode): as
+// Rust: `BrdfNetwork::sample` (network mode): as
 // `nuld_sample_brdf` with `nuld_sample_network`.
 fn nuld_sample_brdf_network(wo: vec3<f32>, roughness: f32, instance: u32, i: u32) -> NuldSample {
     let view = nuld_view_condition(wo, roughness);

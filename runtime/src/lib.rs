@@ -23,29 +23,26 @@
 //! # Ok::<(), nuld_runtime::BlobError>(())
 //! ```
 //!
-//! A conditional sampler ([`BlobKind::Conditional`], paper §4) serves, for a
-//! condition known only at run time, the directions of a low-discrepancy set and the
-//! estimator weight:
+//! A conditional sampler ([`BlobKind::Conditional`]) serves, for a condition known
+//! only at run time, the directions of a low-discrepancy set and the estimator
+//! weight. The blob's target decides the view: [`Blob::brdf`] gives a
+//! [`BrdfSampler`] (a view direction and a roughness in), [`Blob::envmap`] an
+//! [`EnvmapSampler`] (a surface normal in), and asking one blob for the other view
+//! is an error ([`BlobError::WrongTarget`]). Each view samples in table mode;
+//! `network()` is the same model in network mode, a view of its own:
 //!
 //! ```
-//! use nuld_runtime::{Blob, glam::{Vec2, Vec3}};
+//! use nuld_runtime::{Blob, BlobError, glam::Vec3};
 //! # let bytes = nuld_runtime::doc_example_conditional_blob();
 //! # let bytes: &[u8] = &bytes.0;
-//! let cs = Blob::parse(bytes)?.conditional()?;
-//! let (roughness, instance) = (0.4, 17); // instance: e.g. a hash of the pixel
-//! let wo = Vec3::new(0.3, 0.4, 0.866).normalize(); // view, local frame (z = normal)
-//! let mut estimate = 0.0;
-//! for i in 0..cs.len() {
-//!     let s = cs.sample_brdf(wo, roughness, instance, i); // table mode
-//!     assert!((s.direction.length() - 1.0).abs() < 1e-5 && s.direction.z >= 0.0);
-//!     let radiance = 1.0; // L(s.direction) in a renderer
-//!     estimate += s.weight * radiance / cs.len() as f32;
-//! }
-//! // Network mode: the same model evaluated per sample (instances wrap modulo the
-//! // network's instance slots, or each u32 is its own set for a network without).
-//! let s = cs.sample_network(Vec2::new(roughness, 30.0), instance, 0);
-//! assert!(estimate > 0.0 && s.weight > 0.0);
-//! # Ok::<(), nuld_runtime::BlobError>(())
+//! let blob = Blob::parse(bytes)?;
+//! let brdf = blob.brdf()?; // a blob of `build-tool bake --brdf`
+//! let wo = Vec3::new(0.3, 0.4, 0.866); // view, local frame (z = normal)
+//! let s = brdf.sample(wo, 0.4, 17, 0); // table mode: roughness 0.4, instance 17, index 0
+//! let t = brdf.network().sample(wo, 0.4, 17, 0); // network mode
+//! assert!(s.weight > 0.0 && t.weight > 0.0);
+//! assert!(matches!(blob.envmap(), Err(BlobError::WrongTarget { .. })));
+//! # Ok::<(), BlobError>(())
 //! ```
 //!
 //! Where the bytes come from:
@@ -73,7 +70,9 @@ extern crate std;
 mod aligned;
 #[cfg(feature = "alloc")]
 mod aligned_buf;
+mod brdf;
 mod conditional;
+mod envmap;
 mod points;
 pub mod shader;
 
@@ -84,8 +83,12 @@ pub use glam;
 pub use aligned::Aligned;
 #[cfg(feature = "alloc")]
 pub use aligned_buf::AlignedBuf;
-pub use conditional::{ConditionalSampler, Sample};
-pub use nuld_core::blob::{BlobError, BlobKind, Domain, Metadata};
+pub use brdf::{BrdfNetwork, BrdfSampler};
+pub use conditional::{ConditionalSampler, NetworkSampler, Sample};
+pub use envmap::{EnvmapNetwork, EnvmapSampler};
+pub use nuld_core::blob::{
+    BlobError, BlobKind, ConditionalError, Domain, LayoutError, Metadata, PointSetError,
+};
 pub use nuld_core::conditional::{ConditionalInfo, ConditionalTarget};
 pub use points::{DirectionSet, PointSet2D};
 
@@ -110,9 +113,9 @@ impl<'a> Blob<'a> {
     /// kind's sections (sizes, counts, domain codes). Never panics, never allocates.
     ///
     /// ```
-    /// # use nuld_runtime::{Blob, BlobError, Aligned};
+    /// # use nuld_runtime::{Blob, BlobError, LayoutError, Aligned};
     /// let junk = Aligned([0u8; 64]);
-    /// assert_eq!(Blob::parse(&junk.0).unwrap_err(), BlobError::BadMagic);
+    /// assert_eq!(Blob::parse(&junk.0).unwrap_err(), BlobError::Layout(LayoutError::BadMagic));
     /// ```
     pub fn parse(bytes: &'a [u8]) -> Result<Self, BlobError> {
         let layout = Layout::read(bytes)?;
@@ -167,8 +170,27 @@ impl<'a> Blob<'a> {
         ))
     }
 
-    /// The conditional sampler of a [`BlobKind::Conditional`] blob (table and
-    /// network mode, see [`ConditionalSampler`]).
+    /// The BRDF sampler of a blob of `build-tool bake --brdf`
+    /// ([`ConditionalTarget::GltfBrdf`]).
+    ///
+    /// Errors with [`BlobError::WrongKind`] for a point or direction set and
+    /// [`BlobError::WrongTarget`] for another conditional sampler.
+    pub fn brdf(&self) -> Result<BrdfSampler<'a>, BlobError> {
+        self.conditional()?.try_into()
+    }
+
+    /// The environment-map sampler of a blob of `build-tool bake --envmap`
+    /// ([`ConditionalTarget::EnvmapNormal`]).
+    ///
+    /// Errors with [`BlobError::WrongKind`] for a point or direction set and
+    /// [`BlobError::WrongTarget`] for another conditional sampler.
+    pub fn envmap(&self) -> Result<EnvmapSampler<'a>, BlobError> {
+        self.conditional()?.try_into()
+    }
+
+    /// The target-agnostic view of a [`BlobKind::Conditional`] blob, conditions
+    /// in the blob's units (see [`ConditionalSampler`]); renderers want
+    /// [`Self::brdf`] or [`Self::envmap`].
     ///
     /// Errors with [`BlobError::WrongKind`] for any other kind.
     pub fn conditional(&self) -> Result<ConditionalSampler<'a>, BlobError> {
@@ -192,46 +214,50 @@ impl<'a> Blob<'a> {
         let (_, info_bytes) = self.layout.section(SectionTag::PointSetInfo)?;
         let info_len = core::mem::size_of::<PointSetInfo>();
         if info_bytes.len() != info_len {
-            return Err(BlobError::PointSetInfoSize {
+            return Err(PointSetError::InfoSize {
                 got: info_bytes.len() as u64,
                 expected: info_len as u64,
-            });
+            }
+            .into());
         }
         let info: PointSetInfo = bytemuck::pod_read_unaligned(info_bytes);
         if info.len == 0 {
-            return Err(BlobError::NoPoints);
+            return Err(PointSetError::NoPoints.into());
         }
         if info.set_count == 0 {
-            return Err(BlobError::NoSets);
+            return Err(PointSetError::NoSets.into());
         }
-        let domain = Domain::from_code(info.domain).ok_or(BlobError::UnknownDomain(info.domain))?;
+        let domain =
+            Domain::from_code(info.domain).ok_or(PointSetError::UnknownDomain(info.domain))?;
         let domain_ok = match self.kind {
             BlobKind::PointSet2D => domain == Domain::Square,
             BlobKind::DirectionSet => domain != Domain::Square,
             BlobKind::Conditional => false,
         };
         if !domain_ok {
-            return Err(BlobError::DomainMismatch {
+            return Err(PointSetError::DomainMismatch {
                 kind: self.kind,
                 domain,
-            });
+            }
+            .into());
         }
         let (entry, bytes) = self.layout.section(SectionTag::Points)?;
         if entry.elem_size != 4 {
-            return Err(BlobError::PointElementSize(entry.elem_size));
+            return Err(PointSetError::ElementSize(entry.elem_size).into());
         }
         let expected = (info.len as u64) * (info.set_count as u64) * 4;
         if bytes.len() as u64 != expected {
-            return Err(BlobError::PointsLength {
+            return Err(PointSetError::Length {
                 expected,
                 got: bytes.len() as u64,
-            });
+            }
+            .into());
         }
         // The length is a whole number of 4-byte elements (checked above) and the
         // section starts 16-byte aligned in an aligned blob (`Layout::read`), so the
         // cast cannot fail; were the bytes misaligned, that would be the cause.
         let coords: &[[u16; 2]] =
-            bytemuck::try_cast_slice(bytes).map_err(|_| BlobError::Misaligned)?;
+            bytemuck::try_cast_slice(bytes).map_err(|_| LayoutError::Misaligned)?;
         Ok((info, coords))
     }
 }
@@ -270,22 +296,37 @@ pub fn doc_example_blob() -> Aligned<[u8; 160]> {
     out
 }
 
-/// A small valid conditional blob for the crate's documentation examples: `n = 2`,
-/// 2 instances, 2 x 2 grids over roughness `[0.1, 1]` x `theta_o` `[0°, 89°]`, a
-/// one-unit network.
+/// A small valid conditional BRDF blob for the crate's documentation examples:
+/// `n = 2`, 2 instances, 2 x 2 grids over roughness `[0.1, 1]` x `theta_o`
+/// `[0°, 89°]`, a one-unit network.
 #[doc(hidden)]
 pub fn doc_example_conditional_blob() -> Aligned<[u8; 400]> {
+    doc_example_sampler(ConditionalTarget::GltfBrdf, [0.1, 0.0], [1.0, 89.0])
+}
+
+/// [`doc_example_conditional_blob`] as an environment sampler: conditions the
+/// normal's octahedral square point in `[0, 1]^2`, directions on the sphere.
+#[doc(hidden)]
+pub fn doc_example_envmap_blob() -> Aligned<[u8; 400]> {
+    doc_example_sampler(ConditionalTarget::EnvmapNormal, [0.0, 0.0], [1.0, 1.0])
+}
+
+fn doc_example_sampler(
+    target: ConditionalTarget,
+    cond_min: [f32; 2],
+    cond_max: [f32; 2],
+) -> Aligned<[u8; 400]> {
     use nuld_core::blob::write;
     use nuld_core::conditional::pack_point;
     let info = ConditionalInfo {
         n: 2,
         instances: 2,
-        domain: Domain::Hemisphere as u32,
-        target: ConditionalTarget::GltfBrdf as u32,
+        domain: target.domain() as u32,
+        target: target as u32,
         grid: [2, 2],
         weight_grid: [2, 2],
-        cond_min: [0.1, 0.0],
-        cond_max: [1.0, 89.0],
+        cond_min,
+        cond_max,
         hidden: [1, 0, 0],
         activation: 0,
         lattice_generator: 1,

@@ -4,6 +4,7 @@
 //!
 //! [`WGSL`] is a library of functions, one per runtime function, each named
 //! `nuld_` + the Rust name (`nuld_sample` is [`ConditionalSampler::sample`],
+//! `nuld_sample_brdf` is `BrdfSampler::sample`,
 //! `nuld_direction` is [`DirectionSet::direction`], ...), with a comment naming its
 //! Rust twin. It reads the blob from a storage buffer that the including shader
 //! declares under the name [`BLOB_VARIABLE`], at any group and binding:
@@ -87,13 +88,13 @@ const KERNEL_SOURCE: &str = concat!(
 pub enum KernelMode {
     /// `nuld_sample`: table mode at the condition ([`crate::ConditionalSampler::sample`]).
     Table = 0,
-    /// `nuld_sample_network` ([`crate::ConditionalSampler::sample_network`]).
+    /// `nuld_sample_network` ([`crate::NetworkSampler::sample`]).
     Network = 1,
     /// `nuld_sample_brdf` at [`KernelParams::view`] with roughness = the
-    /// condition's first coordinate ([`crate::ConditionalSampler::sample_brdf`]).
+    /// condition's first coordinate ([`crate::BrdfSampler::sample`]).
     BrdfTable = 2,
     /// `nuld_sample_brdf_network`
-    /// ([`crate::ConditionalSampler::sample_brdf_network`]).
+    /// ([`crate::BrdfNetwork::sample`]).
     BrdfNetwork = 3,
 }
 

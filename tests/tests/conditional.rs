@@ -112,7 +112,7 @@ fn network_mode_equals_the_tools_f64_evaluation_of_the_f16_weights() {
                     tool.forward(shape.embedding_row(k, i), input)
                         .square_point(),
                 );
-                let got = cs.network_square_point(c, k, i).as_dvec2();
+                let got = cs.network().square_point(c, k, i).as_dvec2();
                 worst_square = worst_square.max((got - p).abs().max_element());
                 let d = match parts.info.point_warp().unwrap() {
                     PointWarp::EqualArea => Domain::Hemisphere.to_direction(p),
@@ -127,7 +127,7 @@ fn network_mode_equals_the_tools_f64_evaluation_of_the_f16_weights() {
                         DVec3::from_array(brdf_mixture_direction(cond, p_s, p.to_array()))
                     }
                 };
-                let s = cs.sample_network(c, k, i);
+                let s = cs.network().sample(c, k, i);
                 worst_direction = worst_direction.max((s.direction.as_dvec3() - d).length());
             }
         });
@@ -217,7 +217,7 @@ fn weights_equal_the_reference_bilinear_interpolation() {
                 let got = cs.weight(c);
                 assert_eq!(got, want, "{c}");
                 assert_eq!(cs.sample(c, 3, 5).weight, want);
-                assert_eq!(cs.sample_network(c, 3, 5).weight, want);
+                assert_eq!(cs.network().sample(c, 3, 5).weight, want);
                 // The same interpolation in f64, from the f64 normalized condition.
                 let u = normalize::<f64>(&parts, c);
                 let g = info.weight_grid;
@@ -240,17 +240,19 @@ fn weights_equal_the_reference_bilinear_interpolation() {
     }
 }
 
-/// `sample_brdf` in the xz-plane on the `+x` side is `sample` at `theta_o`: the
-/// sets are made for that view.
+/// `BrdfSampler::sample` in the xz-plane on the `+x` side is `sample` at
+/// `theta_o`: the sets are made for that view.
 #[test]
 fn brdf_view_in_the_xz_plane_is_the_stored_condition() {
     let parts = &fixtures()[0];
+    let bytes = parts.to_blob(&META).unwrap();
+    let brdf = Blob::parse(bytes.as_slice()).unwrap().brdf().unwrap();
     with_sampler(parts, |cs| {
         for deg in [0.0f64, 30.0, 45.0, 60.0, 75.0, 85.0] {
             let t = deg.to_radians();
             let wo = DVec3::new(t.sin(), 0.0, t.cos()).as_vec3();
             for i in 0..cs.len() {
-                let got = cs.sample_brdf(wo, 0.4, 2, i);
+                let got = brdf.sample(wo, 0.4, 2, i);
                 let want = cs.sample(Vec2::new(0.4, deg as f32), 2, i);
                 assert!(
                     (got.direction - want.direction).length() < 1e-4,

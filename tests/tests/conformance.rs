@@ -4,7 +4,7 @@
 use glam::{DVec2, DVec3};
 use nuld_core::blob::{BlobKind, Domain};
 use nuld_core::quantize::{unorm16_decode_f64, unorm16_encode, UNORM16_MAX_ERROR};
-use nuld_runtime::{Blob, BlobError};
+use nuld_runtime::{Blob, BlobError, LayoutError};
 use nuld_tests::sobol_blob;
 
 #[test]
@@ -107,6 +107,6 @@ fn embedded_blob_through_the_aligned_helper() {
     shifted.as_mut_slice()[1..].copy_from_slice(EMBEDDED);
     assert_eq!(
         Blob::parse(&shifted.as_slice()[1..]).unwrap_err(),
-        BlobError::Misaligned
+        BlobError::Layout(LayoutError::Misaligned)
     );
 }

@@ -49,7 +49,7 @@ fn table_mode_follows_network_mode_within_a_measured_bound() {
     let cs = distilled();
     let n = cs.len();
     let gap = |c: Vec2, k: u32, i: u32| {
-        (cs.square_point(c, k, i) - cs.network_square_point(c, k, i))
+        (cs.square_point(c, k, i) - cs.network().square_point(c, k, i))
             .abs()
             .max_element()
     };
@@ -106,7 +106,10 @@ fn weights_equal_the_albedo_at_the_weight_grid_nodes() {
         for j0 in 0..WEIGHT_GRID[0] {
             let c = node(cs.info().weight_grid_condition([j0, j1]));
             let want = directional_albedo(BrdfModel::Gltf, c.x as f64, c.y as f64).total();
-            for got in [cs.sample(c, 0, 0).weight, cs.sample_network(c, 5, 1).weight] {
+            for got in [
+                cs.sample(c, 0, 0).weight,
+                cs.network().sample(c, 5, 1).weight,
+            ] {
                 assert!(
                     (got as f64 - want).abs() < 1e-4,
                     "({}, {}): {got} vs {want}",

@@ -4,8 +4,8 @@
 
 use nuld_build_tool::pointset::AlignedBytes;
 use nuld_core::blob::{
-    checksum, encoded_len, write, BlobError, Domain, Layout, SectionSpec, SectionTag,
-    CHECKSUM_OFFSET, MAX_SECTIONS,
+    checksum, encoded_len, write, BlobError, Domain, Layout, LayoutError, PointSetError,
+    SectionSpec, SectionTag, WriteError, CHECKSUM_OFFSET, MAX_SECTIONS,
 };
 use nuld_core::conditional::{PointWarp, CONDITIONAL_INFO_LEN};
 use nuld_core::network::Activation;
@@ -54,13 +54,20 @@ fn parse_and_touch(bytes: &[u8]) -> Result<(), BlobError> {
             }
             let c = Vec2::new(0.55, 33.0);
             let wo = Vec3::new(-0.3, 0.5, 0.7);
+            // The typed view of the blob's target; the other one is refused.
+            let (brdf, envmap) = (blob.brdf().ok(), blob.envmap().ok());
+            assert!(brdf.is_some() != envmap.is_some());
             for i in 0..=cs.len() {
                 for k in [0, u32::MAX] {
-                    check_sample(cs.sample_network(c, k, i));
-                    check_sample(cs.sample_brdf(wo, c.x, k, i));
-                    check_sample(cs.sample_brdf_network(wo, c.x, k, i));
-                    check_sample(cs.sample_envmap(wo, k, i));
-                    check_sample(cs.sample_envmap_network(wo, k, i));
+                    check_sample(cs.network().sample(c, k, i));
+                    if let Some(b) = brdf {
+                        check_sample(b.sample(wo, c.x, k, i));
+                        check_sample(b.network().sample(wo, c.x, k, i));
+                    }
+                    if let Some(e) = envmap {
+                        check_sample(e.sample(wo, k, i));
+                        check_sample(e.network().sample(wo, k, i));
+                    }
                 }
             }
         }
@@ -131,7 +138,7 @@ fn every_truncation_and_extension_is_rejected() {
         for cut in 0..bytes.len() {
             let err = parse_and_touch(&bytes[..cut]).unwrap_err();
             assert!(
-                matches!(err, BlobError::Truncated { .. }),
+                matches!(err, BlobError::Layout(LayoutError::Truncated { .. })),
                 "cut {cut}: {err:?}"
             );
         }
@@ -139,7 +146,7 @@ fn every_truncation_and_extension_is_rejected() {
         longer.as_mut_slice()[..bytes.len()].copy_from_slice(bytes);
         assert!(matches!(
             parse_and_touch(longer.as_slice()),
-            Err(BlobError::TrailingBytes { .. })
+            Err(BlobError::Layout(LayoutError::TrailingBytes { .. }))
         ));
     }
 }
@@ -271,102 +278,105 @@ fn each_error_variant_is_produced_by_the_corruption_it_names() {
     let mut cases: Vec<(BlobError, BlobError)> = vec![
         (
             parse_and_touch(&b[..b.len() - 1]).unwrap_err(),
-            BlobError::Truncated {
+            BlobError::Layout(LayoutError::Truncated {
                 needed: n,
                 got: n - 1,
-            },
+            }),
         ),
         (
             parse_and_touch(&b[..20]).unwrap_err(),
-            BlobError::Truncated {
+            BlobError::Layout(LayoutError::Truncated {
                 needed: 48,
                 got: 20,
-            },
+            }),
         ),
-        (damaged(&blob, |x| x[0] ^= 1), BlobError::BadMagic),
+        (
+            damaged(&blob, |x| x[0] ^= 1),
+            BlobError::Layout(LayoutError::BadMagic),
+        ),
         (
             damaged(&blob, |x| put_u32(x, VERSION, 2)),
-            BlobError::UnsupportedVersion(2),
+            BlobError::Layout(LayoutError::UnsupportedVersion(2)),
         ),
         (
             damaged(&blob, |x| put_u32(x, SECTION_COUNT, MAX_SECTIONS + 1)),
-            BlobError::TooManySections {
+            BlobError::Layout(LayoutError::TooManySections {
                 count: 65,
                 max: MAX_SECTIONS,
-            },
+            }),
         ),
         (
             damaged(&blob, |x| put_u32(x, SECTION_COUNT, MAX_SECTIONS)),
-            BlobError::SectionTablePastEnd {
+            BlobError::Layout(LayoutError::SectionTablePastEnd {
                 table_end: row(64) as u64,
                 len: n,
-            },
+            }),
         ),
         (
             damaged(&blob, |x| put_u32(x, META_OFFSET, 100)),
-            BlobError::MetadataOverlapsTable {
+            BlobError::Layout(LayoutError::MetadataOverlapsTable {
                 meta_offset: 100,
                 table_end: row(2) as u64,
-            },
+            }),
         ),
         (
             damaged(&blob, |x| put_u32(x, META_LEN, n as u32)),
-            BlobError::MetadataPastEnd {
+            BlobError::Layout(LayoutError::MetadataPastEnd {
                 meta_end: row(2) as u64 + n,
                 len: n,
-            },
+            }),
         ),
         (
             damaged(&blob, |x| put_u64(x, row(0) + LEN, u64::MAX)),
-            BlobError::SectionRangeOverflow { index: 0 },
+            BlobError::Layout(LayoutError::SectionRangeOverflow { index: 0 }),
         ),
         (
             damaged(&blob, |x| put_u64(x, row(0) + OFFSET, 0)),
-            BlobError::SectionOverlapsMetadata {
+            BlobError::Layout(LayoutError::SectionOverlapsMetadata {
                 index: 0,
                 offset: 0,
                 meta_end,
-            },
+            }),
         ),
         (
             damaged(&blob, |x| put_u64(x, row(1) + LEN, points_len + 4)),
-            BlobError::SectionPastEnd {
+            BlobError::Layout(LayoutError::SectionPastEnd {
                 index: 1,
                 end: n + 4,
                 len: n,
-            },
+            }),
         ),
         (
             damaged(&blob, |x| {
                 put_u64(x, row(1) + OFFSET, points_at + 4);
                 put_u64(x, row(1) + LEN, points_len - 4);
             }),
-            BlobError::SectionMisaligned {
+            BlobError::Layout(LayoutError::SectionMisaligned {
                 index: 1,
                 offset: points_at + 4,
-            },
+            }),
         ),
         (
             damaged(&blob, |x| put_u32(x, row(0) + ELEM_SIZE, 0)),
-            BlobError::ZeroElementSize { index: 0 },
+            BlobError::Layout(LayoutError::ZeroElementSize { index: 0 }),
         ),
         (
             damaged(&blob, |x| put_u32(x, row(0) + ELEM_SIZE, 3)),
-            BlobError::PartialElement {
+            BlobError::Layout(LayoutError::PartialElement {
                 index: 0,
                 len: 16,
                 elem_size: 3,
-            },
+            }),
         ),
         (
             damaged(&blob, |x| {
                 put_u64(x, row(1) + OFFSET, info as u64);
                 put_u64(x, row(1) + LEN, 16);
             }),
-            BlobError::SectionsOverlap {
+            BlobError::Layout(LayoutError::SectionsOverlap {
                 first: 0,
                 second: 1,
-            },
+            }),
         ),
         (
             damaged(&blob, |x| put_u32(x, KIND, 9)),
@@ -382,37 +392,40 @@ fn each_error_variant_is_produced_by_the_corruption_it_names() {
         ),
         (
             damaged(&blob, |x| put_u64(x, row(0) + LEN, 0)),
-            BlobError::PointSetInfoSize {
+            BlobError::PointSet(PointSetError::InfoSize {
                 got: 0,
                 expected: 16,
-            },
+            }),
         ),
-        (damaged(&blob, |x| put_u32(x, info, 0)), BlobError::NoPoints),
+        (
+            damaged(&blob, |x| put_u32(x, info, 0)),
+            BlobError::PointSet(PointSetError::NoPoints),
+        ),
         (
             damaged(&blob, |x| put_u32(x, info + 4, 0)),
-            BlobError::NoSets,
+            BlobError::PointSet(PointSetError::NoSets),
         ),
         (
             damaged(&blob, |x| put_u32(x, info + 8, 7)),
-            BlobError::UnknownDomain(7),
+            BlobError::PointSet(PointSetError::UnknownDomain(7)),
         ),
         (
             damaged(&blob, |x| put_u32(x, info + 8, Domain::Square as u32)),
-            BlobError::DomainMismatch {
+            BlobError::PointSet(PointSetError::DomainMismatch {
                 kind: BlobKind::DirectionSet,
                 domain: Domain::Square,
-            },
+            }),
         ),
         (
             damaged(&blob, |x| put_u32(x, row(1) + ELEM_SIZE, 2)),
-            BlobError::PointElementSize(2),
+            BlobError::PointSet(PointSetError::ElementSize(2)),
         ),
         (
             damaged(&blob, |x| put_u32(x, info, 15)),
-            BlobError::PointsLength {
+            BlobError::PointSet(PointSetError::Length {
                 expected: 60,
                 got: 64,
-            },
+            }),
         ),
         (
             Blob::parse(b).unwrap().point_set_2d().unwrap_err(),
@@ -428,22 +441,22 @@ fn each_error_variant_is_produced_by_the_corruption_it_names() {
     shifted.as_mut_slice()[1..].copy_from_slice(b);
     cases.push((
         parse_and_touch(&shifted.as_slice()[1..]).unwrap_err(),
-        BlobError::Misaligned,
+        BlobError::Layout(LayoutError::Misaligned),
     ));
     let mut longer = AlignedBytes::zeroed(b.len() + 16);
     longer.as_mut_slice()[..b.len()].copy_from_slice(b);
     cases.push((
         parse_and_touch(longer.as_slice()).unwrap_err(),
-        BlobError::TrailingBytes {
+        BlobError::Layout(LayoutError::TrailingBytes {
             declared: n,
             got: n + 16,
-        },
+        }),
     ));
     let mut flipped = blob.clone();
     flipped.as_mut_slice()[b.len() - 1] ^= 1;
     assert!(matches!(
         parse_and_touch(flipped.as_slice()),
-        Err(BlobError::ChecksumMismatch { .. })
+        Err(BlobError::Layout(LayoutError::ChecksumMismatch { .. }))
     ));
 
     // The writer's failures.
@@ -455,20 +468,24 @@ fn each_error_variant_is_produced_by_the_corruption_it_names() {
     let too_many = [spec; MAX_SECTIONS as usize + 1];
     let mut out = vec![0u8; encoded_len(&[], &too_many)];
     cases.push((
-        write(&mut out, BlobKind::PointSet2D, &[], &too_many).unwrap_err(),
-        BlobError::TooManySections {
+        write(&mut out, BlobKind::PointSet2D, &[], &too_many)
+            .unwrap_err()
+            .into(),
+        BlobError::Write(WriteError::TooManySections {
             count: 65,
             max: MAX_SECTIONS,
-        },
+        }),
     ));
     let need = encoded_len(&[], &[spec]);
     let mut out = vec![0u8; need + 16];
     cases.push((
-        write(&mut out, BlobKind::PointSet2D, &[], &[spec]).unwrap_err(),
-        BlobError::BufferSize {
+        write(&mut out, BlobKind::PointSet2D, &[], &[spec])
+            .unwrap_err()
+            .into(),
+        BlobError::Write(WriteError::BufferSize {
             needed: need as u64,
             got: need as u64 + 16,
-        },
+        }),
     ));
 
     for (got, want) in &cases {
@@ -485,7 +502,10 @@ fn blob_errors_convert_into_boxed_std_errors_with_question_mark() {
     }
     let junk = AlignedBytes::zeroed(64);
     let e = len(junk.as_slice()).unwrap_err();
-    assert_eq!(e.downcast_ref::<BlobError>(), Some(&BlobError::BadMagic));
+    assert_eq!(
+        e.downcast_ref::<BlobError>(),
+        Some(&BlobError::Layout(LayoutError::BadMagic))
+    );
     assert_eq!(e.to_string(), "not a nuld blob (bad magic)");
     let blob = sobol_blob(Domain::Square, 5, 1, 1).1;
     assert_eq!(len(blob.as_slice()).unwrap(), 5);

@@ -12,7 +12,7 @@
 //! Tolerances, in absolute terms on unit-vector components and weights:
 //! * 2D point sets: exact;
 //! * directions and weights in table mode, at conditions and at BRDF views
-//!   (`sample_brdf`): [`TABLE_TOLERANCE`] = 8 f32 ulps of 1.0 (`8 * 2^-23`, 9.5e-7):
+//!   (`BrdfSampler::sample`): [`TABLE_TOLERANCE`] = 8 f32 ulps of 1.0 (`8 * 2^-23`, 9.5e-7):
 //!   both sides evaluate the same `f32` operations in the same order (the shader
 //!   ports libm's `acosf`), and differ by the driver's rounding of `sin`, `cos`,
 //!   `sqrt` and division (and, for direction sets, the runtime's `f64` map). On
@@ -36,7 +36,7 @@ use nuld_core::conditional::PointWarp;
 use nuld_core::network::Activation;
 use nuld_runtime::glam::{DVec3, Vec2, Vec3};
 use nuld_runtime::shader::{kernel_wgsl, KernelMode, KernelParams, KERNEL_ENTRY_POINT};
-use nuld_runtime::{Blob, ConditionalSampler, Sample};
+use nuld_runtime::{Blob, BrdfSampler, ConditionalSampler, Sample};
 use nuld_tests::{conditional_parts, distilled_parts, shape, sobol_blob, META};
 use shader_sample::Gpu;
 use std::sync::OnceLock;
@@ -193,7 +193,7 @@ fn warp_gain(cs: &ConditionalSampler, cond: Vec2, p: Vec2) -> f32 {
 }
 
 /// `theta_o` in degrees of a BRDF view `wo` (any length; zero, infinite or NaN:
-/// normal incidence), in `f64`: the condition `sample_brdf` samples at.
+/// normal incidence), in `f64`: the condition `BrdfSampler::sample` samples at.
 fn view_theta_deg(wo: Vec3) -> f64 {
     let w = wo.as_dvec3();
     let len = w.length();
@@ -242,14 +242,14 @@ fn runtime_sample(cs: &ConditionalSampler, p: &KernelParams, e: u32) -> (Sample,
     let (want, cond, point) = match mode {
         KernelMode::Table => (cs.sample(c, k, i), c, cs.square_point(c, k, i)),
         KernelMode::Network => (
-            cs.sample_network(c, k, i),
+            cs.network().sample(c, k, i),
             c,
-            cs.network_square_point(c, k, i),
+            cs.network().square_point(c, k, i),
         ),
         KernelMode::BrdfTable => {
             let cond = brdf_cond();
             (
-                cs.sample_brdf(wo, c.x, k, i),
+                BrdfSampler::try_from(*cs).unwrap().sample(wo, c.x, k, i),
                 cond,
                 cs.square_point(cond, k, i),
             )
@@ -257,9 +257,12 @@ fn runtime_sample(cs: &ConditionalSampler, p: &KernelParams, e: u32) -> (Sample,
         KernelMode::BrdfNetwork => {
             let cond = brdf_cond();
             (
-                cs.sample_brdf_network(wo, c.x, k, i),
+                BrdfSampler::try_from(*cs)
+                    .unwrap()
+                    .network()
+                    .sample(wo, c.x, k, i),
                 cond,
-                cs.network_square_point(cond, k, i),
+                cs.network().square_point(cond, k, i),
             )
         }
     };
@@ -279,7 +282,7 @@ fn compare(kernel: &Kernel, bytes: &[u8], cs: &ConditionalSampler, p: &KernelPar
 
 /// Compares the kernel with the runtime in table and network mode on a grid of
 /// conditions that runs past the blob's range on every side (clamping), instances
-/// and indices past the stored counts (wrapping), and on views for `sample_brdf`.
+/// and indices past the stored counts (wrapping), and on views for `BrdfSampler::sample`.
 /// Each difference is divided by the warp's gain at the sample ([`warp_gain`]; 1
 /// for the equal-area maps) before it is held to the tolerance.
 fn check_conditional(kernel: &Kernel, bytes: &[u8], label: &str) {
@@ -398,7 +401,7 @@ fn shader_random_samplers_of_every_shape_match_the_runtime() {
 }
 
 /// The README's shader (tests/examples/shader_sample.wgsl, run by the host code of
-/// tests/examples/shader_sample.rs) gives the runtime's `sample_brdf` samples. Its
+/// tests/examples/shader_sample.rs) gives the runtime's `BrdfSampler::sample` samples. Its
 /// view is normalized by the driver's `normalize`, a few ulps from glam's, which the
 /// table interpolation carries through: within 1e-5.
 #[test]
@@ -425,7 +428,10 @@ fn shader_readme_example_gives_the_runtime_samples() {
     let mut worst = 0.0f32;
     for (e, got) in out.iter().enumerate() {
         let (pixel, i) = (e as u32 / cs.len(), e as u32 % cs.len());
-        worst = worst.max(gap(got, cs.sample_brdf(wo, 0.4, pixel, i)));
+        worst = worst.max(gap(
+            got,
+            BrdfSampler::try_from(cs).unwrap().sample(wo, 0.4, pixel, i),
+        ));
     }
     println!("shader README example: max |gpu - cpu| {worst:.2e} (tolerance 1e-5)");
     assert!(worst <= 1e-5, "{worst}");

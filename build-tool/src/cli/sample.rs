@@ -5,7 +5,7 @@ use crate::pointset::AlignedBytes;
 use anyhow::{anyhow, bail, Result};
 use clap::{Args, ValueEnum};
 use nuld_runtime::glam::{Vec2, Vec3};
-use nuld_runtime::{Blob, ConditionalTarget};
+use nuld_runtime::{Blob, BlobError, ConditionalSampler, EnvmapSampler};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -44,16 +44,16 @@ pub struct Normal(pub [f32; 3]);
 pub enum At {
     /// `--cond`.
     Condition(Condition),
-    /// `--normal` ([`nuld_runtime::ConditionalSampler::sample_envmap`]).
+    /// `--normal` ([`nuld_runtime::EnvmapSampler::sample`]).
     Normal(Normal),
 }
 
 /// `--mode` values.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum SampleMode {
-    /// Interpolated point table (`ConditionalSampler::sample`).
+    /// Interpolated point table (the runtime's table-mode views).
     Table,
-    /// The f16 network (`ConditionalSampler::sample_network`).
+    /// The f16 network (the runtime's network-mode views).
     Network,
 }
 
@@ -92,26 +92,66 @@ pub fn write_csv(
     out: &mut impl Write,
 ) -> Result<()> {
     let blob = Blob::parse(bytes).map_err(|e| anyhow!("{e}"))?;
-    let cs = blob.conditional().map_err(|e| anyhow!("{e}"))?;
-    if matches!(at, At::Normal(_)) && cs.target() != ConditionalTarget::EnvmapNormal {
-        bail!("--normal needs an environment sampler; this blob's condition is --cond ROUGHNESS,THETA_O_DEG");
-    }
+    // The runtime's view for the place asked for; a normal needs an environment
+    // sampler, refused before anything is written.
+    let view = match at {
+        At::Normal(n) => {
+            let env = blob.envmap().map_err(|e| match e {
+                BlobError::WrongTarget { .. } => anyhow!(
+                    "--normal needs an environment sampler; this blob's condition is --cond ROUGHNESS,THETA_O_DEG"
+                ),
+                e => anyhow!("{e}"),
+            })?;
+            View::Normal(env, Vec3::from(n.0))
+        }
+        At::Condition(c) => {
+            let cs = blob.conditional().map_err(|e| anyhow!("{e}"))?;
+            View::Condition(cs, Vec2::from(c.0))
+        }
+    };
+    let len = match view {
+        View::Normal(env, _) => env.len(),
+        View::Condition(cs, _) => cs.len(),
+    };
     writeln!(out, "index,x,y,z,weight")?;
-    for i in 0..cs.len() {
-        let s = match (at, mode) {
-            (At::Normal(n), SampleMode::Table) => cs.sample_envmap(Vec3::from(n.0), instance, i),
-            (At::Normal(n), SampleMode::Network) => {
-                cs.sample_envmap_network(Vec3::from(n.0), instance, i)
-            }
-            (At::Condition(c), SampleMode::Table) => cs.sample(Vec2::from(c.0), instance, i),
-            (At::Condition(c), SampleMode::Network) => {
-                cs.sample_network(Vec2::from(c.0), instance, i)
-            }
+    for i in 0..len {
+        let s = match (view, mode) {
+            (View::Normal(env, n), SampleMode::Table) => env.sample(n, instance, i),
+            (View::Normal(env, n), SampleMode::Network) => env.network().sample(n, instance, i),
+            (View::Condition(cs, c), SampleMode::Table) => cs.sample(c, instance, i),
+            (View::Condition(cs, c), SampleMode::Network) => cs.network().sample(c, instance, i),
         };
         let d = s.direction;
         writeln!(out, "{i},{},{},{},{}", d.x, d.y, d.z, s.weight)?;
     }
     Ok(())
+}
+
+/// The runtime view `sample` reads and where: an environment sampler at a normal,
+/// or any conditional sampler at a condition in the blob's units.
+#[derive(Clone, Copy)]
+enum View<'a> {
+    Normal(EnvmapSampler<'a>, Vec3),
+    Condition(ConditionalSampler<'a>, Vec2),
+}
+
+/// The one-line warning for a `--cond` outside the blob's condition range, which
+/// the runtime clamps (`None` inside the range or for another blob).
+pub fn clamp_warning(bytes: &[u8], at: At) -> Option<String> {
+    let At::Condition(Condition(c)) = at else {
+        return None;
+    };
+    let cs = Blob::parse(bytes).ok()?.conditional().ok()?;
+    let info = cs.info();
+    let inside = (0..2).all(|a| (info.cond_min[a]..=info.cond_max[a]).contains(&c[a]));
+    let clamped = info.denormalize(info.normalize(c));
+    (!inside).then(|| {
+        format!(
+            "warning: --cond {},{} is outside the blob's range [{}, {}] x [{}, {}]; sampling at the clamped {},{}",
+            c[0], c[1], info.cond_min[0], info.cond_max[0], info.cond_min[1], info.cond_max[1],
+            clamped[0], clamped[1]
+        )
+    })
 }
 
 /// Runs `build-tool sample`. A reader that stops early closes the pipe; the
@@ -125,6 +165,9 @@ pub fn run(a: SampleArgs) -> Result<()> {
         (None, Some(n)) => At::Normal(n),
         (None, None) => bail!("sample needs --cond ROUGHNESS,THETA_O_DEG or --normal X,Y,Z"),
     };
+    if let Some(warning) = clamp_warning(bytes.as_slice(), at) {
+        eprintln!("{warning}");
+    }
     let written = write_csv(bytes.as_slice(), at, a.instance, a.mode, &mut out)
         .and_then(|()| Ok(out.flush()?));
     match written {
@@ -145,7 +188,7 @@ mod tests {
         }
     }
 
-    /// `--normal` rows are the runtime's `sample_envmap`; a BRDF blob refuses a
+    /// `--normal` rows are the runtime's `EnvmapSampler`; a BRDF blob refuses a
     /// normal with a one-line error.
     #[test]
     fn a_normal_reads_an_environment_blob_and_is_refused_by_a_brdf_blob() {
@@ -156,11 +199,11 @@ mod tests {
         let mut out = Vec::new();
         write_csv(blob.as_slice(), at, 3, SampleMode::Network, &mut out).unwrap();
         let text = String::from_utf8(out).unwrap();
-        let cs = Blob::parse(blob.as_slice()).unwrap().conditional().unwrap();
+        let env = Blob::parse(blob.as_slice()).unwrap().envmap().unwrap();
         let rows: Vec<&str> = text.lines().collect();
         assert_eq!(rows[0], "index,x,y,z,weight");
         for i in 0..4u32 {
-            let s = cs.sample_envmap_network(Vec3::new(0.2, 0.9, -0.3), 3, i);
+            let s = env.network().sample(Vec3::new(0.2, 0.9, -0.3), 3, i);
             let d = s.direction;
             let want = format!("{i},{},{},{},{}", d.x, d.y, d.z, s.weight);
             assert_eq!(rows[1 + i as usize], want);

@@ -427,7 +427,7 @@ mod tests {
 
     /// An environment bake of a constant sky: its weight table is the irradiance
     /// of a constant map, `pi L` at every normal (the closed form; the pixel-centre
-    /// cosine sum is within 1e-3 of it), sets serve through `sample_envmap`, and a
+    /// cosine sum is within 1e-3 of it), sets serve through `EnvmapSampler::sample`, and a
     /// resumed finished run writes the same blob.
     #[test]
     fn an_envmap_bake_tabulates_pi_l_for_a_constant_sky_and_resumes() {
@@ -450,16 +450,16 @@ mod tests {
         assert_eq!(blob.as_slice().len(), report.blob_bytes);
         let cs = nuld_runtime::Blob::parse(blob.as_slice())
             .unwrap()
-            .conditional()
+            .envmap()
             .unwrap();
-        assert_eq!(cs.domain(), Domain::Sphere);
+        assert_eq!(cs.conditional().domain(), Domain::Sphere);
         let pi_l = std::f64::consts::PI * lum as f64;
         for n in [
             DVec3::Z,
             DVec3::NEG_Z,
             DVec3::new(0.3, -0.8, 0.1).normalize(),
         ] {
-            let s = cs.sample_envmap(n.as_vec3(), 1, 2);
+            let s = cs.sample(n.as_vec3(), 1, 2);
             assert!(
                 (s.weight as f64 / pi_l - 1.0).abs() < 1e-3,
                 "{n}: {}",

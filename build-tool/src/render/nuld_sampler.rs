@@ -1,17 +1,18 @@
 //! Ours: the conditional samplers of baked blobs, reached only through
 //! `nuld-runtime`'s public API on the blob's bytes, exactly as a renderer that
-//! links the runtime would: `Blob::parse(bytes)?.conditional()?` once, then per
-//! sample, with the pixel's instance (its key's high 32 bits) and the index:
+//! links the runtime would: `Blob::parse(bytes)?.brdf()?` (or `.envmap()?`) once,
+//! then per sample, with the pixel's instance (its key's high 32 bits) and the
+//! index:
 //!
 //! Network mode reads the weights decoded once per blob into a buffer of the
-//! caller's ([`NuldSampler::decoded`], [`ConditionalSampler::decode_network`]; the
+//! caller's ([`NuldSampler::decoded`], [`BrdfSampler::decode_network`]; the
 //! same bits as the zero-copy f16 path, faster), as a CPU renderer would.
 //!
-//! * BRDF sampling: [`ConditionalSampler::sample_brdf`] (table mode) or
-//!   [`ConditionalSampler::sample_brdf_network`] (network mode) at the local view
+//! * BRDF sampling: [`BrdfSampler::sample`] (table mode) or
+//!   [`BrdfNetwork::sample`] (network mode) at the local view
 //!   direction and the roughness; the weight is the sample's own (the albedo `A`);
-//! * environment sampling: [`ConditionalSampler::sample_envmap`] or
-//!   [`ConditionalSampler::sample_envmap_network`] at the world normal; the sample
+//! * environment sampling: [`EnvmapSampler::sample`] or
+//!   [`EnvmapNetwork::sample`] at the world normal; the sample
 //!   weight is the irradiance `E(n)`, and since the set follows
 //!   `q(l) = L(l) max(0, n.l) / E(n)`, the estimator's weight is
 //!   `f(wo, l) cos / q(l) = f(wo, l) cos E(n) / (L(l) cos)` (0 where `L` or the
@@ -22,7 +23,10 @@ use super::sampler::{DirectionSampler, PixelKey, Sample, ShadingPoint, Technique
 use glam::{DVec2, DVec3};
 use nuld_core::sphere::square_to_sphere;
 use nuld_runtime::glam::Vec2;
-use nuld_runtime::{Blob, BlobError, BlobKind, ConditionalSampler, ConditionalTarget};
+use nuld_runtime::{
+    Blob, BlobError, BlobKind, BrdfNetwork, BrdfSampler, ConditionalSampler, EnvmapNetwork,
+    EnvmapSampler,
+};
 
 /// Table mode or network mode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,11 +51,13 @@ pub enum NuldBlobError {
     Target(u32, &'static str),
 }
 
-/// What ours samples.
+/// What ours samples, through the runtime's typed view of the mode.
 #[derive(Clone, Copy, Debug)]
 enum Kind<'a> {
-    Brdf,
-    Envmap(&'a Environment),
+    Brdf(BrdfSampler<'a>),
+    BrdfNetwork(BrdfNetwork<'a>),
+    Envmap(EnvmapSampler<'a>, &'a Environment),
+    EnvmapNetwork(EnvmapNetwork<'a>, &'a Environment),
 }
 
 /// Ours (see the module docs): a view on the blob's bytes.
@@ -62,21 +68,13 @@ pub struct NuldSampler<'a> {
     kind: Kind<'a>,
 }
 
-/// The conditional sampler of `bytes` if it is one for `target`.
-fn conditional<'a>(
-    bytes: &'a [u8],
-    target: ConditionalTarget,
-    name: &'static str,
-) -> Result<ConditionalSampler<'a>, NuldBlobError> {
-    let blob = Blob::parse(bytes).map_err(NuldBlobError::Parse)?;
-    if blob.kind() != BlobKind::Conditional {
-        return Err(NuldBlobError::Kind(blob.kind()));
+/// The runtime's refusal of a view as the reason a blob cannot serve.
+fn refused(e: BlobError, name: &'static str) -> NuldBlobError {
+    match e {
+        BlobError::WrongKind { found, .. } => NuldBlobError::Kind(found),
+        BlobError::WrongTarget { found, .. } => NuldBlobError::Target(found as u32, name),
+        e => NuldBlobError::Parse(e),
     }
-    let sampler = blob.conditional().map_err(NuldBlobError::Parse)?;
-    if sampler.target() != target {
-        return Err(NuldBlobError::Target(sampler.info().target, name));
-    }
-    Ok(sampler)
 }
 
 impl<'a> NuldSampler<'a> {
@@ -84,11 +82,15 @@ impl<'a> NuldSampler<'a> {
     /// `nuld_runtime::AlignedBuf`) in `mode`; an error unless they hold a
     /// conditional glTF-BRDF sampler.
     pub fn new(bytes: &'a [u8], mode: NuldMode) -> Result<Self, NuldBlobError> {
-        let sampler = conditional(bytes, ConditionalTarget::GltfBrdf, "the glTF BRDF")?;
+        let blob = Blob::parse(bytes).map_err(NuldBlobError::Parse)?;
+        let brdf = blob.brdf().map_err(|e| refused(e, "the glTF BRDF"))?;
         Ok(Self {
-            sampler,
+            sampler: brdf.conditional(),
             mode,
-            kind: Kind::Brdf,
+            kind: match mode {
+                NuldMode::Table => Kind::Brdf(brdf),
+                NuldMode::Network => Kind::BrdfNetwork(brdf.network()),
+            },
         })
     }
 
@@ -101,11 +103,17 @@ impl<'a> NuldSampler<'a> {
         mode: NuldMode,
         env: &'a Environment,
     ) -> Result<Self, NuldBlobError> {
-        let sampler = conditional(bytes, ConditionalTarget::EnvmapNormal, "an environment map")?;
+        let blob = Blob::parse(bytes).map_err(NuldBlobError::Parse)?;
+        let sampler = blob
+            .envmap()
+            .map_err(|e| refused(e, "an environment map"))?;
         Ok(Self {
-            sampler,
+            sampler: sampler.conditional(),
             mode,
-            kind: Kind::Envmap(env),
+            kind: match mode {
+                NuldMode::Table => Kind::Envmap(sampler, env),
+                NuldMode::Network => Kind::EnvmapNetwork(sampler.network(), env),
+            },
         })
     }
 
@@ -137,11 +145,19 @@ impl<'a> NuldSampler<'a> {
         }
         buf.clear();
         buf.resize(self.sampler.decoded_network_len(), 0.0);
-        match self.sampler.decode_network(buf) {
-            Some(sampler) => Self { sampler, ..self },
-            // Unreachable: the buffer has the length asked for.
-            None => self,
-        }
+        let kind = match self.kind {
+            Kind::BrdfNetwork(_) => BrdfSampler::try_from(self.sampler)
+                .ok()
+                .and_then(|b| b.decode_network(buf))
+                .map(Kind::BrdfNetwork),
+            Kind::EnvmapNetwork(_, env) => EnvmapSampler::try_from(self.sampler)
+                .ok()
+                .and_then(|e| e.decode_network(buf))
+                .map(|n| Kind::EnvmapNetwork(n, env)),
+            _ => None,
+        };
+        // `None` is unreachable: the buffer has the length asked for.
+        kind.map_or(self, |kind| Self { kind, ..self })
     }
 
     /// Points per set `N` of the blob.
@@ -158,8 +174,8 @@ impl<'a> NuldSampler<'a> {
 impl DirectionSampler for NuldSampler<'_> {
     fn technique(&self) -> Technique {
         match self.kind {
-            Kind::Brdf => Technique::Brdf,
-            Kind::Envmap(_) => Technique::Envmap,
+            Kind::Brdf(_) | Kind::BrdfNetwork(_) => Technique::Brdf,
+            Kind::Envmap(..) | Kind::EnvmapNetwork(..) => Technique::Envmap,
         }
     }
 
@@ -174,44 +190,47 @@ impl DirectionSampler for NuldSampler<'_> {
     /// evaluation (indices wrap modulo `N` otherwise).
     fn samples(&self, at: &ShadingPoint, key: PixelKey, n: u32, out: &mut Vec<Sample>) {
         out.clear();
-        if let Kind::Envmap(env) = self.kind {
-            let normal = at.frame.to_world(DVec3::Z).as_vec3();
-            let k = key.instance();
-            out.extend((0..n).map(|i| {
-                let s = match self.mode {
-                    NuldMode::Table => self.sampler.sample_envmap(normal, k, i),
-                    NuldMode::Network => self.sampler.sample_envmap_network(normal, k, i),
-                };
-                let l = s.direction.as_dvec3();
-                let local = at.frame.to_local(l);
-                let radiance = env.radiance(l);
-                // f cos / q with q = L cos / E: the cosines cancel.
-                let weight = if local.z > 0.0 && radiance > 0.0 {
-                    nuld_core::brdf::brdf(at.wo, local, at.roughness) * s.weight as f64 / radiance
-                } else {
-                    0.0
-                };
-                Sample {
-                    direction: l,
-                    weight,
-                }
-            }));
-            return;
-        }
-        let wo = at.wo.as_vec3();
-        let r = at.roughness as f32;
         let k = key.instance();
-        out.extend((0..n).map(|i| {
-            let s = match self.mode {
-                NuldMode::Table => self.sampler.sample_brdf(wo, r, k, i),
-                NuldMode::Network => self.sampler.sample_brdf_network(wo, r, k, i),
-            };
-            // The runtime's directions are unit to f32 rounding; used as they come.
-            Sample {
-                direction: at.frame.to_world(s.direction.as_dvec3()),
-                weight: s.weight as f64,
+        let normal = at.frame.to_world(DVec3::Z).as_vec3();
+        let (wo, r) = (at.wo.as_vec3(), at.roughness as f32);
+        match self.kind {
+            Kind::Brdf(t) => out.extend((0..n).map(|i| brdf_sample(at, t.sample(wo, r, k, i)))),
+            Kind::BrdfNetwork(t) => {
+                out.extend((0..n).map(|i| brdf_sample(at, t.sample(wo, r, k, i))))
             }
-        }));
+            Kind::Envmap(t, env) => {
+                out.extend((0..n).map(|i| envmap_sample(at, env, t.sample(normal, k, i))))
+            }
+            Kind::EnvmapNetwork(t, env) => {
+                out.extend((0..n).map(|i| envmap_sample(at, env, t.sample(normal, k, i))))
+            }
+        }
+    }
+}
+
+/// A BRDF sample in the world frame with the runtime's weight, the albedo. The
+/// runtime's directions are unit to f32 rounding; used as they come.
+fn brdf_sample(at: &ShadingPoint, s: nuld_runtime::Sample) -> Sample {
+    Sample {
+        direction: at.frame.to_world(s.direction.as_dvec3()),
+        weight: s.weight as f64,
+    }
+}
+
+/// An environment sample (world frame) with the estimator's weight
+/// `f cos / q = f E / L`, `q = L cos / E`: the cosines cancel.
+fn envmap_sample(at: &ShadingPoint, env: &Environment, s: nuld_runtime::Sample) -> Sample {
+    let l = s.direction.as_dvec3();
+    let local = at.frame.to_local(l);
+    let radiance = env.radiance(l);
+    let weight = if local.z > 0.0 && radiance > 0.0 {
+        nuld_core::brdf::brdf(at.wo, local, at.roughness) * s.weight as f64 / radiance
+    } else {
+        0.0
+    };
+    Sample {
+        direction: l,
+        weight,
     }
 }
 
@@ -228,7 +247,7 @@ mod tests {
     #[test]
     fn samples_are_the_runtimes_bit_for_bit() {
         let blob = tiny_blob(8);
-        let cs = Blob::parse(blob.as_slice()).unwrap().conditional().unwrap();
+        let cs = Blob::parse(blob.as_slice()).unwrap().brdf().unwrap();
         for (mode, name) in [
             (NuldMode::Table, "nuld-table"),
             (NuldMode::Network, "nuld-network"),
@@ -251,8 +270,8 @@ mod tests {
             ours.samples(&at, key, 8, &mut out);
             for (i, s) in out.iter().enumerate() {
                 let want = match mode {
-                    NuldMode::Table => cs.sample_brdf(wo, 0.4, key.instance(), i as u32),
-                    NuldMode::Network => cs.sample_brdf_network(wo, 0.4, key.instance(), i as u32),
+                    NuldMode::Table => cs.sample(wo, 0.4, key.instance(), i as u32),
+                    NuldMode::Network => cs.network().sample(wo, 0.4, key.instance(), i as u32),
                 };
                 let got = s.direction.as_vec3();
                 assert_eq!(
@@ -272,8 +291,8 @@ mod tests {
             ours.samples(&tilted, key, 8, &mut out);
             for (i, s) in out.iter().enumerate() {
                 let want = match mode {
-                    NuldMode::Table => cs.sample_brdf(wo, 0.4, key.instance(), i as u32),
-                    NuldMode::Network => cs.sample_brdf_network(wo, 0.4, key.instance(), i as u32),
+                    NuldMode::Table => cs.sample(wo, 0.4, key.instance(), i as u32),
+                    NuldMode::Network => cs.network().sample(wo, 0.4, key.instance(), i as u32),
                 };
                 let local = tilted.frame.to_local(s.direction);
                 assert!((local - want.direction.as_dvec3()).length() < 1e-12);
@@ -282,7 +301,7 @@ mod tests {
         }
     }
 
-    /// Ours for the environment is the runtime's `sample_envmap` at the world
+    /// Ours for the environment is the runtime's `EnvmapSampler::sample` at the world
     /// normal, bit for bit, and each sample contributes `weight x L(l) = E(n)
     /// f(wo, l)` (0 below the surface): the estimator of a set that follows
     /// `L max(0, n.l) / E`.
@@ -294,7 +313,7 @@ mod tests {
         let map = tiny_map(&dir);
         let env = Environment::from_file(&map).unwrap();
         let blob = tiny_envmap_blob(8, &map);
-        let cs = Blob::parse(blob.as_slice()).unwrap().conditional().unwrap();
+        let cs = Blob::parse(blob.as_slice()).unwrap().envmap().unwrap();
         let n = DVec3::new(0.3, -0.5, 0.6).normalize();
         let at = ShadingPoint {
             frame: Frame::new(n),
@@ -313,10 +332,8 @@ mod tests {
             ours.samples(&at, key, 8, &mut out);
             for (i, s) in out.iter().enumerate() {
                 let want = match mode {
-                    NuldMode::Table => cs.sample_envmap(n.as_vec3(), key.instance(), i as u32),
-                    NuldMode::Network => {
-                        cs.sample_envmap_network(n.as_vec3(), key.instance(), i as u32)
-                    }
+                    NuldMode::Table => cs.sample(n.as_vec3(), key.instance(), i as u32),
+                    NuldMode::Network => cs.network().sample(n.as_vec3(), key.instance(), i as u32),
                 };
                 assert_eq!(s.direction, want.direction.as_dvec3());
                 let l = s.direction;

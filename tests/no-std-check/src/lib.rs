@@ -74,11 +74,11 @@ pub unsafe extern "C" fn nuld_check_direction(
 
 /// Writes sample `i` of instance `instance` of the conditional blob to
 /// `out[0..4]` (direction, weight) in the given mode: 0 table mode at
-/// `(c0, c1)`, 1 network mode at `(c0, c1)`, 2 `sample_brdf` with the view
-/// `(c1, 0, 1)` and roughness `c0`, 3 `sample_envmap` at the normal `(c0, c1, 1)`,
-/// 4 network mode at `(c0, c1)` on weights decoded into a stack buffer
-/// (`decode_network`). Returns 0 on success, 1 otherwise (also for a network
-/// too large for the buffer in mode 4).
+/// `(c0, c1)`, 1 network mode at `(c0, c1)`, 2 `BrdfSampler::sample` with the
+/// view `(c1, 0, 1)` and roughness `c0`, 3 `EnvmapSampler::sample` at the normal
+/// `(c0, c1, 1)`, 4 network mode at `(c0, c1)` on weights decoded into a stack
+/// buffer (`decode_network`). Returns 0 on success, 1 otherwise (also for a
+/// network too large for the buffer in mode 4, and for a view of another target).
 ///
 /// # Safety
 /// `ptr` must be valid for `len` bytes and `out` for four `f32` writes.
@@ -101,13 +101,19 @@ pub unsafe extern "C" fn nuld_check_conditional(
             let mut decoded = [0.0f32; 8192];
             let s = match mode {
                 0 => cs.sample(Vec2::new(c0, c1), instance, i),
-                1 => cs.sample_network(Vec2::new(c0, c1), instance, i),
-                2 => cs.sample_brdf(Vec3::new(c1, 0.0, 1.0), c0, instance, i),
+                1 => cs.network().sample(Vec2::new(c0, c1), instance, i),
+                2 => match nuld_runtime::BrdfSampler::try_from(cs) {
+                    Ok(brdf) => brdf.sample(Vec3::new(c1, 0.0, 1.0), c0, instance, i),
+                    Err(_) => return 1,
+                },
                 4 => match cs.decode_network(&mut decoded) {
-                    Some(fast) => fast.sample_network(Vec2::new(c0, c1), instance, i),
+                    Some(fast) => fast.sample(Vec2::new(c0, c1), instance, i),
                     None => return 1,
                 },
-                _ => cs.sample_envmap(Vec3::new(c0, c1, 1.0), instance, i),
+                _ => match nuld_runtime::EnvmapSampler::try_from(cs) {
+                    Ok(env) => env.sample(Vec3::new(c0, c1, 1.0), instance, i),
+                    Err(_) => return 1,
+                },
             };
             *out = s.direction.x;
             *out.add(1) = s.direction.y;

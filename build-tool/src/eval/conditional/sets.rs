@@ -101,23 +101,25 @@ impl ConditionalSets for MixtureOwenSobol {
 
 /// The table-mode and network-mode samplers of a conditional `.nuld` blob, read
 /// through `nuld-runtime` exactly as a renderer reads them:
-/// `Blob::parse(bytes)?.conditional()?`, then
+/// `Blob::parse(bytes)?.brdf()?.conditional()`, then
 /// `sample(Vec2::new(roughness, theta_o_deg), instance, i).direction` (named
-/// `table`) and `sample_network(..)` (named `network`), in that order.
+/// `table`) and `network().sample(..)` (named `network`), in that order.
 pub fn blob_sets(bytes: &[u8]) -> Result<Vec<Box<dyn ConditionalSets + '_>>> {
     let blob = nuld_runtime::Blob::parse(bytes).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let cs = blob.conditional().map_err(|e| anyhow::anyhow!("{e}"))?;
-    anyhow::ensure!(
-        cs.target() == nuld_runtime::ConditionalTarget::GltfBrdf,
-        "eval conditional judges glTF BRDF samplers; this blob samples an environment map (bake --envmap)"
-    );
+    let cs = match blob.brdf() {
+        Ok(brdf) => brdf.conditional(),
+        Err(nuld_runtime::BlobError::WrongTarget { .. }) => anyhow::bail!(
+            "eval conditional judges glTF BRDF samplers; this blob samples an environment map (bake --envmap)"
+        ),
+        Err(e) => anyhow::bail!("{e}"),
+    };
     let n = cs.len() as usize;
     let cond = |r: f64, t: f64| nuld_runtime::glam::Vec2::new(r as f32, t as f32);
     let table = SampleFnSets::new("table", n, move |r, t, k, i| {
         cs.sample(cond(r, t), k, i).direction.as_dvec3()
     });
     let network = SampleFnSets::new("network", n, move |r, t, k, i| {
-        cs.sample_network(cond(r, t), k, i).direction.as_dvec3()
+        cs.network().sample(cond(r, t), k, i).direction.as_dvec3()
     });
     Ok(vec![Box::new(table), Box::new(network)])
 }

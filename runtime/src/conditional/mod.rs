@@ -1,0 +1,347 @@
+//! The conditional sampler of a [`BlobKind::Conditional`](crate::BlobKind) blob
+//! (paper §4): for a condition known only at run time, an instance and an index, a
+//! direction of a low-discrepancy set for the condition's target, and the
+//! estimator weight.
+//!
+//! Everything here is `f32` arithmetic (transcendentals through `libm`), in the
+//! order of operations `core/FORMAT.md` documents, so that a shader reproduces it.
+
+use glam::{Vec2, Vec3};
+use nuld_core::blob::Domain;
+use nuld_core::conditional::{
+    unpack_point, ConditionalInfo, ConditionalTarget, GridCell, PointWarp,
+};
+use nuld_core::network::{input_features, F16Params, Network, Parameters, Shape};
+use nuld_core::quantize::unorm16_decode;
+
+mod network;
+#[cfg(test)]
+mod tests;
+mod validate;
+
+pub use network::NetworkSampler;
+
+/// One sample: a unit direction and the estimator weight of every sample of its
+/// condition (for BRDF samplers the directional albedo `A`, so that
+/// `∫ L f cos ≈ (A / N) Σ L(direction_i)`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// A unit vector (`z >= 0` on the hemisphere), in the local frame (`z` = normal).
+    pub direction: Vec3,
+    /// The estimator weight, finite and `>= 0`.
+    pub weight: f32,
+}
+
+/// A conditional sampler in **table mode** ([`Self::sample`]: stored square points
+/// interpolated between the four grid conditions around the condition), with
+/// conditions in the blob's units, whatever its target; [`Self::network`] is the
+/// same trained model in **network mode** (the f16 network evaluated per sample).
+/// Renderers use the typed views instead, [`crate::BrdfSampler`] and
+/// [`crate::EnvmapSampler`], which take a view direction or a normal.
+///
+/// Obtained from [`crate::Blob::conditional`]; a copyable view on the blob's bytes.
+/// Every method is `O(1)` in the number of points (network mode costs
+/// [`Shape::multiply_adds`] multiply-adds), allocates nothing, and never panics:
+/// conditions are clamped into the blob's range (NaN reads as the lower end),
+/// indices wrap modulo [`Self::len`], table-mode instances modulo
+/// [`Self::instances`].
+#[derive(Clone, Copy, Debug)]
+pub struct ConditionalSampler<'a> {
+    info: ConditionalInfo,
+    shape: Shape,
+    domain: Domain,
+    target: ConditionalTarget,
+    warp: PointWarp,
+    params: NetworkParams<'a>,
+    table: &'a [u32],
+    weights: &'a [f32],
+}
+
+/// Where network mode reads its parameters: the blob's f16 bits (zero-copy), or
+/// the caller's buffer holding them decoded ([`ConditionalSampler::decode_network`]).
+#[derive(Clone, Copy, Debug)]
+enum NetworkParams<'a> {
+    F16(&'a [u16]),
+    F32(&'a [f32]),
+}
+
+/// Square point used if a table lookup ever missed (it cannot in a parsed blob).
+const CENTRE_CODE: u16 = 1 << 15;
+
+impl<'a> ConditionalSampler<'a> {
+    /// Points per set `n` (at least 1); indices wrap modulo `n`.
+    pub fn len(&self) -> u32 {
+        self.info.n
+    }
+
+    /// Always `false`: a parsed blob has at least one point per set.
+    pub fn is_empty(&self) -> bool {
+        self.info.n == 0
+    }
+
+    /// Instances `S` stored in the point table (at least 1); table mode wraps the
+    /// instance modulo `S`, network mode modulo [`Self::instance_slots`].
+    pub fn instances(&self) -> u32 {
+        self.info.instances
+    }
+
+    /// The network's instance slots `M`: network mode serves `M` different sets
+    /// per condition and wraps the instance modulo `M`; 0 means every `u32`
+    /// instance is its own set (`nuld_core::network::Shape::with_instance_slots`).
+    pub fn instance_slots(&self) -> u32 {
+        self.info.instance_slots
+    }
+
+    /// The blob's info record: grids, condition ranges (blob units; for
+    /// [`ConditionalTarget::GltfBrdf`] roughness and `theta_o` in degrees), network
+    /// architecture.
+    pub fn info(&self) -> &ConditionalInfo {
+        &self.info
+    }
+
+    /// The network architecture of network mode.
+    pub fn shape(&self) -> Shape {
+        self.shape
+    }
+
+    /// Where the directions live: [`Domain::Hemisphere`] or [`Domain::Sphere`].
+    pub fn domain(&self) -> Domain {
+        self.domain
+    }
+
+    /// What the condition means ([`ConditionalTarget`]).
+    pub fn target(&self) -> ConditionalTarget {
+        self.target
+    }
+
+    /// The estimator weight at condition `cond` (blob units): the weight table
+    /// interpolated bilinearly ([`GridCell::lerp`]) on the weight grid at
+    /// `info().normalize(cond)`. Finite and `>= 0`. O(1), never panics.
+    #[inline]
+    pub fn weight(&self, cond: Vec2) -> f32 {
+        self.weight_table_lerp(&self.weight_cell(cond), 0)
+    }
+
+    /// The weight-grid cell of `cond` (blob units, clamped like [`Self::weight`]).
+    #[inline]
+    fn weight_cell(&self, cond: Vec2) -> GridCell {
+        self.weight_cell_at(self.info.normalize(cond.to_array()))
+    }
+
+    /// The weight-grid cell of the normalized condition `u`.
+    #[inline]
+    fn weight_cell_at(&self, u: [f32; 2]) -> GridCell {
+        GridCell::locate(u, self.info.weight_grid)
+    }
+
+    /// Table `table` of the weight section (0: weights, 1: lobe probabilities)
+    /// interpolated bilinearly in `cell`.
+    #[inline]
+    fn weight_table_lerp(&self, cell: &GridCell, table: usize) -> f32 {
+        let base = table * self.info.weight_table_len() as usize;
+        let w = |dx, dy| {
+            let at = base + cell.node(dx, dy);
+            self.weights.get(at).copied().unwrap_or(0.0)
+        };
+        cell.lerp(w(0, 0), w(1, 0), w(0, 1), w(1, 1))
+    }
+
+    /// The lobe probability `p_s` of a [`PointWarp::BrdfMixture`] sampler at
+    /// `cond`: the second table of the weight section, interpolated as the weights.
+    #[inline]
+    pub fn lobe_probability(&self, cond: Vec2) -> f32 {
+        self.weight_table_lerp(&self.weight_cell(cond), 1)
+    }
+
+    /// Table mode's point of the unit square for index `i` (mod `n`) of instance
+    /// `instance` (mod `S`) at condition `cond` (blob units): with
+    /// `u = info().normalize(cond)` and the point-table cell
+    /// `GridCell::locate(u, grid)`, the four stored u16 codes of the cell's corners
+    /// decoded by `(q + 0.5) / 65536` and interpolated bilinearly
+    /// ([`GridCell::lerp`]), x and y separately. In `(0,1)^2`. O(1), never panics.
+    #[inline]
+    pub fn square_point(&self, cond: Vec2, instance: u32, i: u32) -> Vec2 {
+        self.square_point_at(self.info.normalize(cond.to_array()), instance, i)
+    }
+
+    /// [`Self::square_point`] at the normalized condition `u`.
+    #[inline]
+    fn square_point_at(&self, u: [f32; 2], instance: u32, i: u32) -> Vec2 {
+        let (cell, corner) = self.table_corners(u, instance, i);
+        let (p00, p10, p01, p11) = (corner(0, 0), corner(1, 0), corner(0, 1), corner(1, 1));
+        let axis = |a: usize| cell.lerp(p00[a], p10[a], p01[a], p11[a]);
+        Vec2::new(axis(0), axis(1))
+    }
+
+    /// The point-table cell of the normalized condition `u` and the stored square
+    /// point of its corner `(dx, dy)` for index `i` (mod `n`) of instance
+    /// `instance` (mod `S`), decoded by `(q + 0.5) / 65536`: what both table
+    /// modes interpolate.
+    #[inline]
+    fn table_corners(
+        &self,
+        u: [f32; 2],
+        instance: u32,
+        i: u32,
+    ) -> (GridCell, impl Fn(u32, u32) -> [f32; 2] + '_) {
+        let info = &self.info;
+        let cell = GridCell::locate(u, info.grid);
+        let k = instance.checked_rem(info.instances).unwrap_or(0);
+        let j = i.checked_rem(info.n).unwrap_or(0);
+        let corner = move |dx, dy| {
+            let at = info.point_table_index(cell.node(dx, dy), k, j);
+            let q = self
+                .table
+                .get(at)
+                .map_or([CENTRE_CODE; 2], |&w| unpack_point(w));
+            [unorm16_decode(q[0]), unorm16_decode(q[1])]
+        };
+        (cell, corner)
+    }
+
+    /// [`NetworkSampler::square_point`] at the normalized condition `u`.
+    #[inline]
+    pub(crate) fn network_square_point_at(&self, u: [f32; 2], instance: u32, i: u32) -> Vec2 {
+        let input = input_features::<f32>(&self.shape, u, instance, i);
+        let shape = self.shape;
+        let row = shape.embedding_row(instance, i);
+        Vec2::from_array(match self.params {
+            // Every index below `param_len` exists and is finite (`validate`).
+            NetworkParams::F16(params) => Network {
+                shape,
+                params: F16Params(params),
+            }
+            .square_point(row, input),
+            NetworkParams::F32(params) => Network { shape, params }.square_point(row, input),
+        })
+    }
+
+    /// The same trained model in network mode, reading the blob's f16 parameters
+    /// (zero-copy). `O(1)`, never panics.
+    #[inline]
+    pub fn network(&self) -> NetworkSampler<'a> {
+        NetworkSampler(*self)
+    }
+
+    /// Length of the `f32` buffer [`Self::decode_network`] needs:
+    /// [`Shape::param_len`], 4 bytes per parameter.
+    pub fn decoded_network_len(&self) -> usize {
+        self.shape.param_len()
+    }
+
+    /// [`Self::network`] reading the network's parameters decoded to `f32` into
+    /// `buf` (its first [`Self::decoded_network_len`] entries), instead of decoding
+    /// each f16 on every sample. The decode is exact, so every method returns the
+    /// same bits as on [`Self::network`], faster (the f16 decode is most of network
+    /// mode's cost on a CPU without a half-float unit; `build-tool bench --only
+    /// runtime` times both). Decode once per blob, as a renderer uploads tables
+    /// once; size `buf` by [`Self::decoded_network_len`] (it grows with `n` and the
+    /// instance slots). `None` if `buf` is shorter; `O(param_len)`, never panics.
+    ///
+    /// ```
+    /// # let bytes = nuld_runtime::doc_example_conditional_blob();
+    /// use nuld_runtime::glam::Vec2;
+    /// let cs = nuld_runtime::Blob::parse(&bytes.0)?.conditional()?;
+    /// let mut buf = vec![0.0f32; cs.decoded_network_len()];
+    /// let fast = cs.decode_network(&mut buf).expect("a long enough buffer");
+    /// let c = Vec2::new(0.5, 30.0);
+    /// assert_eq!(fast.sample(c, 9, 2), cs.network().sample(c, 9, 2));
+    /// assert!(cs.decode_network(&mut [0.0; 1]).is_none());
+    /// # Ok::<(), nuld_runtime::BlobError>(())
+    /// ```
+    pub fn decode_network<'b>(&self, buf: &'b mut [f32]) -> Option<NetworkSampler<'b>>
+    where
+        'a: 'b,
+    {
+        let len = self.decoded_network_len();
+        let out = buf.get_mut(..len)?;
+        match self.params {
+            NetworkParams::F16(params) => {
+                if params.len() != len {
+                    return None;
+                }
+                F16Params(params).read(0, out);
+            }
+            NetworkParams::F32(params) => out.copy_from_slice(params.get(..len)?),
+        }
+        Some(NetworkSampler(ConditionalSampler {
+            params: NetworkParams::F32(out),
+            ..*self
+        }))
+    }
+
+    /// Table mode: the direction of index `i` of instance `instance` at condition
+    /// `cond` (blob units; for BRDF samplers `(roughness, theta_o in degrees)`, the
+    /// view in the xz-plane on the `+x` side): [`Self::square_point`] through the
+    /// domain's equal-area map in `f32` ([`Domain::to_direction_real`]), with
+    /// [`Self::weight`]. Instances wrap modulo [`Self::instances`], indices modulo
+    /// [`Self::len`], conditions clamp (NaN to the range's lower end). O(1), never
+    /// panics.
+    ///
+    /// ```
+    /// # let bytes = nuld_runtime::doc_example_conditional_blob();
+    /// use nuld_runtime::glam::Vec2;
+    /// let cs = nuld_runtime::Blob::parse(&bytes.0)?.conditional()?;
+    /// let c = Vec2::new(0.5, 30.0);
+    /// assert_eq!(cs.sample(c, 0, 1), cs.sample(c, cs.instances(), 1 + cs.len()));
+    /// assert_eq!(cs.sample(Vec2::new(f32::NAN, -5.0), 0, 0), cs.sample(cs.info().cond_min.into(), 0, 0));
+    /// # Ok::<(), nuld_runtime::BlobError>(())
+    /// ```
+    ///
+    /// An environment sampler ([`ConditionalTarget::EnvmapNormal`]) interpolates
+    /// directions instead: each corner's stored point through the map, the four
+    /// unit vectors blended by [`GridCell::nlerp`] with the cell's bilinear weights
+    /// ([`crate::EnvmapSampler::sample`] takes a normal).
+    #[inline]
+    pub fn sample(&self, cond: Vec2, instance: u32, i: u32) -> Sample {
+        let u = self.info.normalize(cond.to_array());
+        if self.target == ConditionalTarget::EnvmapNormal {
+            return Sample {
+                direction: Vec3::from_array(self.table_direction_at(u, instance, i)),
+                weight: self.weight_table_lerp(&self.weight_cell_at(u), 0),
+            };
+        }
+        self.mapped(self.square_point_at(u, instance, i), u)
+    }
+
+    /// Table mode's direction for an environment sampler: the four corners'
+    /// stored square points decoded by `(q + 0.5) / 65536`, each through the
+    /// domain's equal-area map in `f32`, then [`GridCell::nlerp`].
+    #[inline]
+    fn table_direction_at(&self, u: [f32; 2], instance: u32, i: u32) -> [f32; 3] {
+        let (cell, corner) = self.table_corners(u, instance, i);
+        let d = |dx, dy| self.domain.to_direction_real(corner(dx, dy));
+        cell.nlerp(d(0, 0), d(1, 0), d(0, 1), d(1, 1))
+    }
+
+    /// The sample of point `p` at the normalized condition `u`: the direction of
+    /// [`PointWarp::direction`], the weight of [`Self::weight`]; one weight-grid
+    /// cell serves the weight and the lobe probability.
+    #[inline]
+    pub(crate) fn mapped(&self, p: Vec2, u: [f32; 2]) -> Sample {
+        let cell = self.weight_cell_at(u);
+        // Only the mixture warp reads the condition and `p_s`; the equal-area map
+        // skips their lookups.
+        let (cond, p_s) = match self.warp {
+            PointWarp::EqualArea => ([0.0; 2], 0.0),
+            PointWarp::BrdfMixture => {
+                // The clamped condition in blob units, as the tables see it.
+                (self.info.denormalize(u), self.weight_table_lerp(&cell, 1))
+            }
+        };
+        let direction = self.warp.direction(self.domain, cond, p_s, p.to_array());
+        Sample {
+            direction: Vec3::from_array(direction),
+            weight: self.weight_table_lerp(&cell, 0),
+        }
+    }
+}
+
+/// `v` divided by its largest absolute component, or `None` for a zero, infinite
+/// or NaN `v`. Scaling first keeps `|v|` finite for huge inputs and away from
+/// underflow for tiny ones.
+#[inline]
+pub(crate) fn scaled_to_largest(v: Vec3) -> Option<Vec3> {
+    let m = v.abs().max_element();
+    (v.is_finite() && m > 0.0).then(|| v / m)
+}

@@ -1,0 +1,601 @@
+extern crate std;
+use super::*;
+use crate::Blob;
+use crate::{BrdfNetwork, BrdfSampler, EnvmapNetwork, EnvmapSampler};
+use nuld_core::blob::{encoded_len, write, BlobKind};
+use nuld_core::blob::{BlobError, ConditionalError};
+use nuld_core::conditional::sections;
+use nuld_core::network::Activation;
+use nuld_core::quantize::{f16_decode_finite, f16_encode};
+use std::vec::Vec;
+
+/// The four sections of a conditional blob, owned, for building test blobs.
+#[derive(Clone)]
+struct Parts {
+    info: ConditionalInfo,
+    params: Vec<u16>,
+    table: Vec<u32>,
+    weights: Vec<f32>,
+}
+
+/// A 16-byte aligned blob.
+struct Bytes(Vec<u128>, usize);
+
+impl Bytes {
+    fn get(&self) -> &[u8] {
+        &bytemuck::cast_slice(&self.0)[..self.1]
+    }
+}
+
+/// Deterministic pseudo-random numbers for test contents (`hash_u32` chain).
+fn noise(seed: u32, k: u32) -> u32 {
+    nuld_core::network::hash_u32(seed.wrapping_mul(0x9e37_79b9) ^ nuld_core::network::hash_u32(k))
+}
+
+fn parts() -> Parts {
+    let info = ConditionalInfo {
+        n: 5,
+        instances: 3,
+        domain: Domain::Hemisphere as u32,
+        target: ConditionalTarget::GltfBrdf as u32,
+        grid: [5, 3],
+        weight_grid: [4, 6],
+        cond_min: [0.0, 0.0],
+        cond_max: [1.0, 80.0],
+        hidden: [4, 3, 0],
+        activation: Activation::Silu as u32,
+        lattice_generator: 2,
+        warp: 0,
+        instance_slots: 0,
+        reserved: 0,
+    };
+    let len = info.shape().unwrap().param_len();
+    let params = (0..len as u32)
+        .map(|j| f16_encode((noise(1, j) % 2001) as f32 / 1000.0 - 1.0))
+        .collect();
+    let table = (0..info.point_table_len().unwrap() as u32)
+        .map(|e| noise(2, e))
+        .collect();
+    // A bilinear function of the normalized condition, which bilinear
+    // interpolation must reproduce: w = 1 + 0.5 x - 0.25 y + 0.125 x y.
+    let (wx, wy) = (info.weight_grid[0], info.weight_grid[1]);
+    let weights = (0..wx * wy)
+        .map(|e| {
+            let x = (e % wx) as f32 / (wx - 1) as f32;
+            let y = (e / wx) as f32 / (wy - 1) as f32;
+            bilinear_weight(x, y)
+        })
+        .collect();
+    Parts {
+        info,
+        params,
+        table,
+        weights,
+    }
+}
+
+fn bilinear_weight(x: f32, y: f32) -> f32 {
+    1.0 + 0.5 * x - 0.25 * y + 0.125 * x * y
+}
+
+fn encode(p: &Parts) -> Bytes {
+    let sections = sections(&p.info, &p.params, &p.table, &p.weights);
+    let meta = [0u8, 0, 0];
+    let len = encoded_len(&meta, &sections);
+    let mut buf = std::vec![0u128; len.div_ceil(16)];
+    let out = &mut bytemuck::cast_slice_mut::<u128, u8>(&mut buf)[..len];
+    write(out, BlobKind::Conditional, &meta, &sections).unwrap();
+    Bytes(buf, len)
+}
+
+fn with(change: impl FnOnce(&mut Parts)) -> Result<(), BlobError> {
+    let mut p = parts();
+    change(&mut p);
+    let bytes = encode(&p);
+    Blob::parse(bytes.get()).map(|_| ())
+}
+
+#[test]
+fn a_decoded_network_samples_the_same_bits() {
+    let bytes = encode(&parts());
+    let cs = Blob::parse(bytes.get()).unwrap().conditional().unwrap();
+    let len = cs.decoded_network_len();
+    assert_eq!(len, cs.shape().param_len());
+    assert!(cs.decode_network(&mut std::vec![0.0; len - 1]).is_none());
+    let mut buf = std::vec![f32::NAN; len + 3];
+    let fast = cs.decode_network(&mut buf).unwrap();
+    for k in 0..2000u32 {
+        let c = Vec2::new(
+            (noise(3, k) % 1300) as f32 / 1000.0 - 0.1,
+            (noise(4, k) % 900) as f32 / 10.0,
+        );
+        let (instance, i) = (noise(5, k), k % 11);
+        let wo = Vec3::new(c.y.to_radians().sin(), 0.3, c.y.to_radians().cos());
+        let n = Vec3::new(c.x - 0.5, 0.2, 1.0);
+        assert_eq!(
+            fast.sample(c, instance, i),
+            cs.network().sample(c, instance, i)
+        );
+        assert_eq!(
+            BrdfNetwork(fast).sample(wo, c.x, instance, i),
+            BrdfSampler(cs).network().sample(wo, c.x, instance, i)
+        );
+        assert_eq!(
+            EnvmapNetwork(fast).sample(n, instance, i),
+            EnvmapSampler(cs).network().sample(n, instance, i)
+        );
+        // Table mode does not read the network.
+        assert_eq!(
+            fast.table().sample(c, instance, i),
+            cs.sample(c, instance, i)
+        );
+    }
+    // Decoding a decoded sampler copies its weights.
+    let mut again = std::vec![0.0; len];
+    let twice = fast.table().decode_network(&mut again).unwrap();
+    let c = Vec2::new(0.4, 33.0);
+    assert_eq!(twice.sample(c, 8, 3), cs.network().sample(c, 8, 3));
+    assert_eq!(again, buf[..len]);
+    // The weights are the f16 values decoded; the rest of the buffer is untouched.
+    let Parts { params, .. } = parts();
+    assert!(params
+        .iter()
+        .zip(&buf)
+        .all(|(&h, &v)| f16_decode_finite(h) == v));
+    assert!(buf[len..].iter().all(|v| v.is_nan()));
+}
+
+#[test]
+fn corners_reproduce_the_stored_points_exactly() {
+    let p = parts();
+    let bytes = encode(&p);
+    let cs = Blob::parse(bytes.get()).unwrap().conditional().unwrap();
+    let info = p.info;
+    for j1 in 0..info.grid[1] {
+        for j0 in 0..info.grid[0] {
+            let c = info.grid_condition([j0, j1]).map(|x| x as f32);
+            let node = (j1 * info.grid[0] + j0) as usize;
+            for k in 0..info.instances {
+                for i in 0..info.n {
+                    let w = p.table[info.point_table_index(node, k, i)];
+                    let q = unpack_point(w);
+                    let want = Vec2::new(unorm16_decode(q[0]), unorm16_decode(q[1]));
+                    assert_eq!(
+                        cs.square_point(Vec2::from(c), k, i),
+                        want,
+                        "{j0} {j1} {k} {i}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// An environment sampler's parts: `parts()` on the sphere, conditions the
+/// octahedral square.
+fn envmap_parts() -> Parts {
+    let mut p = parts();
+    p.info.domain = Domain::Sphere as u32;
+    p.info.target = ConditionalTarget::EnvmapNormal as u32;
+    p.info.cond_min = [0.0; 2];
+    p.info.cond_max = [1.0; 2];
+    p
+}
+
+/// Table mode of an environment sampler: at a node the stored point's
+/// direction (nlerp of one corner), between nodes the normalized bilinear
+/// blend of the corners' directions (not of their square points), and
+/// `EnvmapSampler::sample` reads a normal as its octahedral square point.
+#[test]
+fn envmap_tables_interpolate_directions() {
+    let p = envmap_parts();
+    let bytes = encode(&p);
+    let cs = Blob::parse(bytes.get()).unwrap().conditional().unwrap();
+    assert_eq!(cs.target(), ConditionalTarget::EnvmapNormal);
+    let info = p.info;
+    let stored = |node: u32, k: u32, i: u32| {
+        let q = unpack_point(p.table[info.point_table_index(node as usize, k, i)]);
+        Domain::Sphere.to_direction_real([unorm16_decode(q[0]), unorm16_decode(q[1])])
+    };
+    for j1 in 0..info.grid[1] {
+        for j0 in 0..info.grid[0] {
+            let c = info.grid_condition([j0, j1]).map(|x| x as f32);
+            let node = j1 * info.grid[0] + j0;
+            let got = cs.sample(Vec2::from(c), 2, 4).direction.to_array();
+            let want = stored(node, 2, 4);
+            for a in 0..3 {
+                assert!(
+                    (got[a] - want[a]).abs() < 1e-6,
+                    "{j0} {j1}: {got:?} {want:?}"
+                );
+            }
+        }
+    }
+    // Between nodes (0,0), (1,0), (0,1), (1,1) of the 5 x 3 grid.
+    let u = [0.1f32, 0.3];
+    let (t0, t1) = (u[0] * 4.0, u[1] * 2.0);
+    let corners = [
+        stored(0, 1, 3),
+        stored(1, 1, 3),
+        stored(5, 1, 3),
+        stored(6, 1, 3),
+    ];
+    let want: [f32; 3] = core::array::from_fn(|a| {
+        let lo = corners[0][a] + (corners[1][a] - corners[0][a]) * t0;
+        let hi = corners[2][a] + (corners[3][a] - corners[2][a]) * t0;
+        lo + (hi - lo) * t1
+    });
+    let len = want.iter().map(|x| x * x).sum::<f32>().sqrt();
+    let got = cs.sample(Vec2::from(u), 1, 3);
+    let want = Vec3::from_array(want) / len;
+    assert!((got.direction - want).length() < 1e-6, "{got:?} {want}");
+    assert!((got.direction.length() - 1.0).abs() < 1e-6);
+    assert_eq!(got.weight, cs.weight(Vec2::from(u)));
+    // A normal is read through the octahedral map, at any length; degenerate
+    // normals read as +z.
+    let n = Vec3::new(0.2, -0.7, 0.4);
+    let c = nuld_core::sphere::sphere_to_square_real(n.normalize().to_array());
+    assert_eq!(
+        EnvmapSampler(cs).sample(n * 3.0, 7, 2),
+        cs.sample(Vec2::from(c), 7, 2)
+    );
+    assert_eq!(
+        EnvmapSampler(cs).network().sample(n, 9, 1),
+        cs.network().sample(Vec2::from(c), 9, 1)
+    );
+    for bad in [Vec3::ZERO, Vec3::NAN, Vec3::new(f32::INFINITY, 0.0, 1.0)] {
+        assert_eq!(
+            EnvmapSampler(cs).sample(bad, 0, 0),
+            EnvmapSampler(cs).sample(Vec3::Z, 0, 0)
+        );
+    }
+    let d = cs.network().sample(Vec2::new(0.7, 0.2), 5, 4).direction;
+    assert!((d.length() - 1.0).abs() < 1e-5);
+}
+
+#[test]
+fn indices_and_instances_wrap_and_conditions_clamp() {
+    let p = parts();
+    let bytes = encode(&p);
+    let cs = Blob::parse(bytes.get()).unwrap().conditional().unwrap();
+    let (n, s) = (cs.len(), cs.instances());
+    let c = Vec2::new(0.37, 41.0);
+    for i in 0..2 * n {
+        for k in 0..2 * s {
+            assert_eq!(cs.sample(c, k, i), cs.sample(c, k % s, i % n));
+            assert_eq!(cs.sample(c, k, i), cs.sample(c, k + s * 1000, i + n * 77));
+            assert_eq!(
+                cs.network().sample(c, k, i),
+                cs.network().sample(c, k, i % n)
+            );
+        }
+    }
+    // Network mode hashes the instance: instance S is not instance 0.
+    assert_ne!(cs.network().sample(c, s, 0), cs.network().sample(c, 0, 0));
+    let lo = Vec2::new(0.0, 0.0);
+    let hi = Vec2::new(1.0, 80.0);
+    let network = |cs: &ConditionalSampler, c, k, i| cs.network().sample(c, k, i);
+    for mode in [ConditionalSampler::sample, network] {
+        let at = |x: f32, y: f32| mode(&cs, Vec2::new(x, y), 1, 2);
+        assert_eq!(at(f32::NAN, f32::NAN), mode(&cs, lo, 1, 2));
+        assert_eq!(at(-3.0, f32::NEG_INFINITY), mode(&cs, lo, 1, 2));
+        assert_eq!(at(7.0, 1e30), mode(&cs, hi, 1, 2));
+        assert_eq!(
+            at(f32::INFINITY, f32::NAN),
+            mode(&cs, Vec2::new(1.0, 0.0), 1, 2)
+        );
+    }
+    assert_eq!(
+        cs.sample(Vec2::new(u32::MAX as f32, 0.0), u32::MAX, u32::MAX)
+            .weight,
+        cs.weight(Vec2::new(1.0, 0.0))
+    );
+}
+
+#[test]
+fn weights_interpolate_bilinearly() {
+    let p = parts();
+    let bytes = encode(&p);
+    let cs = Blob::parse(bytes.get()).unwrap().conditional().unwrap();
+    for k in 0..500 {
+        let x = (noise(3, k) % 10_001) as f32 / 10_000.0;
+        let y = (noise(4, k) % 10_001) as f32 / 10_000.0;
+        let w = cs.weight(Vec2::new(x, 80.0 * y));
+        // Bilinear interpolation reproduces a bilinear function up to rounding.
+        assert!((w - bilinear_weight(x, y)).abs() < 1e-6, "{x} {y}: {w}");
+        assert_eq!(cs.sample(Vec2::new(x, 80.0 * y), 0, 0).weight, w);
+        assert_eq!(cs.network().sample(Vec2::new(x, 80.0 * y), 9, 1).weight, w);
+    }
+}
+
+#[test]
+fn directions_are_unit_vectors_on_the_hemisphere() {
+    let p = parts();
+    let bytes = encode(&p);
+    let cs = Blob::parse(bytes.get()).unwrap().conditional().unwrap();
+    let views = [
+        Vec3::new(0.3, -0.2, 0.9),
+        Vec3::ZERO,
+        Vec3::splat(f32::NAN),
+        Vec3::new(f32::INFINITY, 0.0, 1.0),
+        Vec3::new(0.0, 0.0, -1.0),
+        Vec3::new(1e-30, 1e-30, 1e-35),
+        Vec3::new(3e38, -3e38, 3e38),
+        Vec3::Z,
+    ];
+    for k in 0..400 {
+        let c = Vec2::new(
+            (noise(5, k) % 1000) as f32 / 900.0 - 0.05,
+            (noise(6, k) % 1000) as f32 / 10.0 - 10.0,
+        );
+        let wo = views[k as usize % views.len()];
+        for s in [
+            cs.sample(c, k, k / 3),
+            cs.network().sample(c, k, k / 3),
+            BrdfSampler(cs).sample(wo, c.x, k, k / 3),
+            BrdfSampler(cs).network().sample(wo, c.x, k, k / 3),
+        ] {
+            let d = s.direction;
+            assert!(
+                (d.length() - 1.0).abs() < 2e-6 && d.z >= 0.0,
+                "{c} {wo}: {d}"
+            );
+            assert!(s.weight.is_finite() && s.weight > 0.0);
+        }
+    }
+}
+
+/// `BrdfSampler::sample` against an independent frame: `theta_o` and `phi` from `f64`
+/// `acos`/`atan2`, the table sample rotated by `phi` in `f64`.
+#[test]
+fn sample_brdf_rotates_the_xz_plane_set_to_the_view_azimuth() {
+    let p = parts();
+    let bytes = encode(&p);
+    let cs = Blob::parse(bytes.get()).unwrap().conditional().unwrap();
+    for k in 0..300u32 {
+        let theta = (noise(7, k) % 8000) as f64 / 100.0;
+        let phi = ((noise(8, k) % 10_000) as f64 / 5_000.0 - 1.0) * core::f64::consts::PI;
+        let len = 0.5 + (noise(9, k) % 100) as f64 / 20.0;
+        let (t, f) = (theta.to_radians(), phi);
+        let wo = [t.sin() * f.cos(), t.sin() * f.sin(), t.cos()].map(|x| (x * len) as f32);
+        let wo = Vec3::from_array(wo);
+        let wo64 = wo.as_dvec3();
+        let theta_ref = (wo64.z / wo64.length()).clamp(0.0, 1.0).acos().to_degrees();
+        let phi_ref = wo64.y.atan2(wo64.x);
+        let (r, i) = (0.2 + (k % 7) as f32 / 10.0, k / 5);
+        let cond = Vec2::new(r, theta_ref as f32);
+        for (got, plain) in [
+            (BrdfSampler(cs).sample(wo, r, k, i), cs.sample(cond, k, i)),
+            (
+                BrdfSampler(cs).network().sample(wo, r, k, i),
+                cs.network().sample(cond, k, i),
+            ),
+        ] {
+            let d = plain.direction.as_dvec3();
+            let (c, s) = (phi_ref.cos(), phi_ref.sin());
+            let want = glam::DVec3::new(c * d.x - s * d.y, s * d.x + c * d.y, d.z);
+            assert!(
+                (got.direction.as_dvec3() - want).length() < 1e-4,
+                "{wo}: {got:?} vs {want}"
+            );
+            assert!((got.weight - plain.weight).abs() < 1e-5);
+        }
+    }
+    // Degenerate views are normal incidence, azimuth 0.
+    for wo in [Vec3::ZERO, Vec3::NAN, Vec3::INFINITY, Vec3::Z * 2.0] {
+        assert_eq!(
+            BrdfSampler(cs).sample(wo, 0.5, 1, 1),
+            cs.sample(Vec2::new(0.5, 0.0), 1, 1)
+        );
+    }
+    // Below the horizon reads as grazing (clamped to the range's 80°).
+    let below = BrdfSampler(cs).sample(Vec3::new(1.0, 0.0, -0.5), 0.5, 1, 1);
+    assert_eq!(below, cs.sample(Vec2::new(0.5, 90.0), 1, 1));
+}
+
+#[test]
+fn each_validation_failure_has_its_error() {
+    assert_eq!(with(|_| {}), Ok(()));
+    type Change = fn(&mut Parts);
+    let cases: [(Change, ConditionalError); 28] = [
+        (|p| p.info.n = 0, ConditionalError::NoPoints),
+        (|p| p.info.instances = 0, ConditionalError::NoInstances),
+        (|p| p.info.domain = 0, ConditionalError::Domain(0)),
+        (|p| p.info.domain = 9, ConditionalError::Domain(9)),
+        (|p| p.info.target = 0, ConditionalError::UnknownTarget(0)),
+        (
+            |p| p.info.grid[1] = 1,
+            ConditionalError::Grid { axis: 1, nodes: 1 },
+        ),
+        (
+            |p| p.info.weight_grid[0] = 0,
+            ConditionalError::WeightGrid { axis: 0, nodes: 0 },
+        ),
+        (
+            |p| p.info.cond_max[0] = 0.0,
+            ConditionalError::Range {
+                axis: 0,
+                min_bits: 0,
+                max_bits: 0,
+            },
+        ),
+        (
+            |p| p.info.cond_min[1] = f32::NEG_INFINITY,
+            ConditionalError::Range {
+                axis: 1,
+                min_bits: f32::NEG_INFINITY.to_bits(),
+                max_bits: 80f32.to_bits(),
+            },
+        ),
+        (
+            |p| p.info.cond_max[1] = f32::NAN,
+            ConditionalError::Range {
+                axis: 1,
+                min_bits: 0,
+                max_bits: f32::NAN.to_bits(),
+            },
+        ),
+        (
+            |p| p.info.activation = 2,
+            ConditionalError::UnknownActivation(2),
+        ),
+        (
+            |p| p.info.hidden = [4, 0, 3],
+            ConditionalError::NetworkWidths([4, 0, 3]),
+        ),
+        (
+            |p| p.info.hidden = [0, 0, 0],
+            ConditionalError::NetworkWidths([0, 0, 0]),
+        ),
+        (
+            |p| p.info.hidden = [129, 3, 0],
+            ConditionalError::NetworkWidths([129, 3, 0]),
+        ),
+        (|p| p.info.reserved = 1, ConditionalError::Reserved(1)),
+        // 5 n x 4 h1 x M embedding numbers reach 2^32 at M = 2^32 / 20.
+        (
+            |p| p.info.instance_slots = u32::MAX / 16,
+            ConditionalError::InstanceSlots(u32::MAX / 16),
+        ),
+        // Slots that fit the counts but not the parameters: M n h1 more rows.
+        (
+            |p| p.info.instance_slots = 2,
+            ConditionalError::ParamsLength {
+                expected: 2 * 5 * 4 + 4 * 12 + 3 * 5 + 2 * 4,
+                got: 91,
+            },
+        ),
+        (|p| p.info.warp = 7, ConditionalError::UnknownPointWarp(7)),
+        (
+            |p| {
+                p.info.warp = 1;
+                p.info.target = 2;
+                p.info.domain = 1;
+            },
+            ConditionalError::UnknownPointWarp(1),
+        ),
+        // Each target has its domain: the BRDF the hemisphere, maps the sphere.
+        (|p| p.info.domain = 1, ConditionalError::Domain(1)),
+        (
+            |p| {
+                p.info.warp = 0;
+                p.info.target = 2;
+            },
+            ConditionalError::Domain(2),
+        ),
+        (
+            |p| {
+                p.params.pop();
+            },
+            ConditionalError::ParamsLength {
+                expected: 5 * 4 + 4 * 12 + 3 * 5 + 2 * 4,
+                got: 90,
+            },
+        ),
+        (
+            |p| p.params[17] = 0x7c00,
+            ConditionalError::NonFiniteParam {
+                index: 17,
+                bits: 0x7c00,
+            },
+        ),
+        (
+            |p| p.params[3] = 0xfe01,
+            ConditionalError::NonFiniteParam {
+                index: 3,
+                bits: 0xfe01,
+            },
+        ),
+        (
+            |p| {
+                p.table.push(0);
+            },
+            ConditionalError::PointTableLength {
+                expected: 5 * 3 * 3 * 5,
+                got: 226,
+            },
+        ),
+        (
+            |p| {
+                p.info.instances = u32::MAX;
+                p.info.grid = [u32::MAX, u32::MAX];
+            },
+            ConditionalError::PointTableCountOverflow,
+        ),
+        (
+            |p| {
+                p.weights.truncate(3);
+            },
+            ConditionalError::WeightTableLength {
+                expected: 24,
+                got: 3,
+            },
+        ),
+        (
+            |p| p.weights[5] = -0.5,
+            ConditionalError::BadWeight {
+                index: 5,
+                bits: (-0.5f32).to_bits(),
+            },
+        ),
+    ];
+    for (k, (change, want)) in cases.into_iter().enumerate() {
+        assert_eq!(with(change), Err(want.into()), "case {k}");
+        assert!(!std::format!("{want}").contains('\n'));
+    }
+    assert_eq!(
+        with(|p| p.weights[0] = f32::INFINITY),
+        Err(BlobError::Conditional(ConditionalError::BadWeight {
+            index: 0,
+            bits: f32::INFINITY.to_bits()
+        }))
+    );
+    // Another kind asks for the conditional view in vain, and vice versa.
+    let other = crate::doc_example_blob();
+    assert_eq!(
+        Blob::parse(&other.0).unwrap().conditional().unwrap_err(),
+        BlobError::WrongKind {
+            expected: BlobKind::Conditional,
+            found: BlobKind::PointSet2D
+        }
+    );
+}
+
+#[test]
+fn a_view_of_the_other_target_is_refused() {
+    let (brdf, env) = (
+        crate::doc_example_conditional_blob(),
+        crate::doc_example_envmap_blob(),
+    );
+    let (brdf, env) = (Blob::parse(&brdf.0).unwrap(), Blob::parse(&env.0).unwrap());
+    assert!(brdf.brdf().is_ok() && env.envmap().is_ok());
+    assert_eq!(
+        brdf.envmap().unwrap_err(),
+        BlobError::WrongTarget {
+            expected: ConditionalTarget::EnvmapNormal,
+            found: ConditionalTarget::GltfBrdf
+        }
+    );
+    assert_eq!(
+        env.brdf().unwrap_err(),
+        BlobError::WrongTarget {
+            expected: ConditionalTarget::GltfBrdf,
+            found: ConditionalTarget::EnvmapNormal
+        }
+    );
+    let points = crate::doc_example_blob();
+    assert_eq!(
+        Blob::parse(&points.0).unwrap().brdf().unwrap_err(),
+        BlobError::WrongKind {
+            expected: BlobKind::Conditional,
+            found: BlobKind::PointSet2D
+        }
+    );
+}
+
+#[test]
+fn doc_example_conditional_blob_is_exactly_its_array() {
+    let b = crate::doc_example_conditional_blob();
+    let cs = Blob::parse(&b.0).unwrap().conditional().unwrap();
+    assert_eq!((cs.len(), cs.instances()), (2, 2));
+}

@@ -1,0 +1,194 @@
+//! Validation of a conditional blob's sections against each other, once, in
+//! [`crate::Blob::parse`]: each failed check is its own [`ConditionalError`].
+
+use super::{ConditionalSampler, NetworkParams};
+use nuld_core::blob::{BlobError, ConditionalError, Domain, Layout, LayoutError, SectionTag};
+use nuld_core::conditional::{ConditionalInfo, ConditionalTarget, PointWarp, CONDITIONAL_INFO_LEN};
+use nuld_core::network::Activation;
+use nuld_core::quantize::f16_is_finite;
+
+impl<'a> ConditionalSampler<'a> {
+    /// Validates the four sections of a conditional blob against each other (the
+    /// checks of `core/FORMAT.md`, one [`BlobError`] variant each) and returns the
+    /// sampler. Called by [`crate::Blob::parse`], so every sampler holds:
+    /// `n, instances >= 1`; a sphere or hemisphere domain; a known target; grids of
+    /// at least 2 x 2 nodes; finite condition ranges with `min < max`; a valid
+    /// network shape; exactly `param_len` finite f16 parameters,
+    /// `grid[0] grid[1] instances n` table entries, and `weight_grid[0]
+    /// weight_grid[1]` finite, non-negative weights.
+    pub(crate) fn validate(layout: &Layout<'a>) -> Result<Self, BlobError> {
+        let sampler = Self::view(layout)?;
+        sampler.check_values()?;
+        Ok(sampler)
+    }
+
+    /// The sampler over a layout whose values [`Self::validate`] has checked once:
+    /// re-checks the counts and section sizes (`O(1)`), not every value.
+    pub(crate) fn view(layout: &Layout<'a>) -> Result<Self, BlobError> {
+        let (_, info_bytes) = layout.section(SectionTag::ConditionalInfo)?;
+        if info_bytes.len() != CONDITIONAL_INFO_LEN {
+            return fail(ConditionalError::InfoSize {
+                got: info_bytes.len() as u64,
+                expected: CONDITIONAL_INFO_LEN as u64,
+            });
+        }
+        let info: ConditionalInfo = bytemuck::pod_read_unaligned(info_bytes);
+        if info.n == 0 {
+            return fail(ConditionalError::NoPoints);
+        }
+        if info.instances == 0 {
+            return fail(ConditionalError::NoInstances);
+        }
+        let domain = match Domain::from_code(info.domain) {
+            Some(d @ (Domain::Sphere | Domain::Hemisphere)) => d,
+            _ => return fail(ConditionalError::Domain(info.domain)),
+        };
+        let Some(target) = ConditionalTarget::from_code(info.target) else {
+            return fail(ConditionalError::UnknownTarget(info.target));
+        };
+        if domain != target.domain() {
+            return fail(ConditionalError::Domain(info.domain));
+        }
+        let warp = match info.point_warp() {
+            Some(PointWarp::BrdfMixture)
+                if !(target == ConditionalTarget::GltfBrdf && domain == Domain::Hemisphere) =>
+            {
+                return fail(ConditionalError::UnknownPointWarp(info.warp))
+            }
+            Some(w) => w,
+            None => return fail(ConditionalError::UnknownPointWarp(info.warp)),
+        };
+        type GridError = fn(u32, u32) -> ConditionalError;
+        let grids: [([u32; 2], GridError); 2] = [
+            (info.grid, |axis, nodes| ConditionalError::Grid {
+                axis,
+                nodes,
+            }),
+            (info.weight_grid, |axis, nodes| {
+                ConditionalError::WeightGrid { axis, nodes }
+            }),
+        ];
+        for (grid, error) in grids {
+            for (axis, &nodes) in (0u32..).zip(&grid) {
+                if nodes < 2 {
+                    return fail(error(axis, nodes));
+                }
+            }
+        }
+        for axis in 0..2 {
+            let (lo, hi) = (info.cond_min[axis], info.cond_max[axis]);
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                return fail(ConditionalError::Range {
+                    axis: axis as u32,
+                    min_bits: lo.to_bits(),
+                    max_bits: hi.to_bits(),
+                });
+            }
+        }
+        if Activation::from_code(info.activation).is_none() {
+            return fail(ConditionalError::UnknownActivation(info.activation));
+        }
+        let shape = info
+            .shape_without_slots()
+            .ok_or(ConditionalError::NetworkWidths(info.hidden))?
+            .with_instance_slots(info.instance_slots)
+            .ok_or(ConditionalError::InstanceSlots(info.instance_slots))?;
+        if info.reserved != 0 {
+            return fail(ConditionalError::Reserved(info.reserved));
+        }
+
+        let params: &[u16] = typed_section(
+            layout,
+            SectionTag::NetworkParams,
+            ConditionalError::ParamElementSize,
+            || {
+                // The embedding `max(M, 1) n h1` is below 2^32 (checked by
+                // `with_instance_slots`), so it fits a 32-bit `usize`; the sum is
+                // taken in u64, where `param_len` could overflow one.
+                Ok(shape.first_layer_offset() as u64 + shape.multiply_adds() as u64)
+            },
+            |expected, got| ConditionalError::ParamsLength { expected, got },
+        )?;
+        let table: &[u32] = typed_section(
+            layout,
+            SectionTag::PointTable,
+            ConditionalError::PointTableElementSize,
+            || {
+                info.point_table_len()
+                    .ok_or(ConditionalError::PointTableCountOverflow)
+            },
+            |expected, got| ConditionalError::PointTableLength { expected, got },
+        )?;
+        let weights: &[f32] = typed_section(
+            layout,
+            SectionTag::WeightTable,
+            ConditionalError::WeightElementSize,
+            // Saturating: two grid counts near 2^32 make a length near 2^64, whose
+            // double would overflow (no section is that long, so it is refused).
+            || Ok(info.weight_table_len().saturating_mul(info.weight_tables())),
+            |expected, got| ConditionalError::WeightTableLength { expected, got },
+        )?;
+        Ok(Self {
+            info,
+            shape,
+            domain,
+            target,
+            warp,
+            params: NetworkParams::F16(params),
+            table,
+            weights,
+        })
+    }
+
+    /// Every parameter a finite f16 (so [`f16_decode_finite`] applies), every
+    /// weight finite and `>= 0`. `O(param_len + weight_table_len)`.
+    fn check_values(&self) -> Result<(), BlobError> {
+        let NetworkParams::F16(params) = self.params else {
+            return Ok(());
+        };
+        let bad_param = params.iter().enumerate().find(|(_, &h)| !f16_is_finite(h));
+        if let Some((index, &bits)) = bad_param {
+            let index = index as u64;
+            return fail(ConditionalError::NonFiniteParam { index, bits });
+        }
+        let bad_weight = self
+            .weights
+            .iter()
+            .enumerate()
+            .find(|(_, w)| !(w.is_finite() && **w >= 0.0));
+        if let Some((index, w)) = bad_weight {
+            let (index, bits) = (index as u64, w.to_bits());
+            return fail(ConditionalError::BadWeight { index, bits });
+        }
+        Ok(())
+    }
+}
+
+/// Section `tag` of `layout` as a slice of `T`, checked in this order: the section
+/// exists; its `elem_size` is `size_of::<T>()` (else `bad_size(elem_size)`); it holds
+/// exactly `expected()?` elements (else `bad_length(expected, got)`); it is aligned
+/// for `T` (else [`LayoutError::Misaligned`]).
+fn typed_section<'a, T: bytemuck::Pod>(
+    layout: &Layout<'a>,
+    tag: SectionTag,
+    bad_size: fn(u32) -> ConditionalError,
+    expected: impl FnOnce() -> Result<u64, ConditionalError>,
+    bad_length: fn(u64, u64) -> ConditionalError,
+) -> Result<&'a [T], BlobError> {
+    let (entry, bytes) = layout.section(tag)?;
+    let size = core::mem::size_of::<T>();
+    if entry.elem_size as usize != size {
+        return fail(bad_size(entry.elem_size));
+    }
+    let expected = expected()?;
+    let got = (bytes.len() / size) as u64;
+    if got != expected {
+        return fail(bad_length(expected, got));
+    }
+    bytemuck::try_cast_slice(bytes).map_err(|_| LayoutError::Misaligned.into())
+}
+
+/// `Err(e)` as a [`BlobError`].
+fn fail<T>(e: ConditionalError) -> Result<T, BlobError> {
+    Err(e.into())
+}
