@@ -32,7 +32,7 @@ pub fn sobol_blob(domain: Domain, n: usize, sets: usize, seed: u64) -> (PointSet
 }
 
 /// A conditional sampler (kind 3) with random contents, as a stand-in for a trained
-/// one ([`nuld_build_tool::runtime_speed::random_parts`]; the benchmark times the
+/// one ([`nuld_build_tool::lab::bench::runtime::random_parts`]; the benchmark times the
 /// same blobs), of a network [`shape`].
 pub fn conditional_parts(
     shape: nuld_core::network::Shape,
@@ -40,12 +40,12 @@ pub fn conditional_parts(
     grid: [u32; 2],
     seed: u64,
 ) -> nuld_build_tool::conditional::blob::ConditionalParts {
-    nuld_build_tool::runtime_speed::random_parts(shape, instances, grid, seed)
+    nuld_build_tool::lab::bench::runtime::random_parts(shape, instances, grid, seed)
         .expect("a valid fixture")
 }
 
 /// The network shape of a [`conditional_parts`] fixture
-/// ([`nuld_build_tool::runtime_speed::random_shape`]).
+/// ([`nuld_build_tool::lab::bench::runtime::random_shape`]).
 pub fn shape(
     n: u32,
     hidden: &[u32],
@@ -53,7 +53,7 @@ pub fn shape(
     warp: nuld_core::conditional::PointWarp,
     instance_slots: u32,
 ) -> nuld_core::network::Shape {
-    nuld_build_tool::runtime_speed::random_shape(n, hidden, activation, warp, instance_slots)
+    nuld_build_tool::lab::bench::runtime::random_shape(n, hidden, activation, warp, instance_slots)
         .expect("a valid fixture shape")
 }
 

@@ -186,7 +186,7 @@ fn run_training() -> Result<()> {
         "ms/step",
         format!("{bake_steps} steps at that rate, min")
     );
-    for t in crate::train::speed::measure(&TRAINING_SIZES) {
+    for t in crate::lab::bench::training::measure(&TRAINING_SIZES) {
         println!(
             "{:>6} {:>10.1} {:>8} {:>12.1} {:>30.1}",
             t.n,
@@ -205,7 +205,7 @@ const RUNTIME_SAMPLES: u32 = 2_000_000;
 /// Nanoseconds per sample of the conditional sampler's modes and of the incumbent,
 /// one thread, with each method's ratio to the incumbent (direction only).
 fn run_runtime() -> Result<()> {
-    let t = crate::runtime_speed::measure(RUNTIME_SAMPLES)?;
+    let t = crate::lab::bench::runtime::measure(RUNTIME_SAMPLES)?;
     println!("runtime ns per sample, one thread, n = 64 (best of 3)");
     println!("{:<44} {:>10} {:>12}", "method", "ns/sample", "/ incumbent");
     let base = t.rows.first().map_or(f64::NAN, |r| r.1);

@@ -1,7 +1,7 @@
-//! `build-tool eval FIG --out DIR`: the paper's §5 figures (see [`crate::eval`]).
+//! `build-tool eval FIG --out DIR`: the paper's §5 figures (see [`crate::lab::eval`]).
 
-use crate::eval::conditional::{blob_sets, evaluate, ConditionalSettings, MixtureOwenSobol};
-use crate::eval::{run_figure, EvalSettings, Figure};
+use crate::lab::eval::conditional::{blob_sets, evaluate, ConditionalSettings, MixtureOwenSobol};
+use crate::lab::eval::{run_figure, EvalSettings, Figure};
 use crate::pointset::AlignedBytes;
 use anyhow::Result;
 use clap::{Args, ValueEnum};
@@ -179,7 +179,7 @@ fn run_conditional(a: &EvalArgs) -> Result<()> {
     let bytes;
     let calibration;
     let owned;
-    let samplers: Vec<&dyn crate::eval::conditional::ConditionalSets> = match &a.blob {
+    let samplers: Vec<&dyn crate::lab::eval::conditional::ConditionalSets> = match &a.blob {
         Some(path) => {
             bytes = AlignedBytes::read(path)?;
             owned = blob_sets(bytes.as_slice())?;

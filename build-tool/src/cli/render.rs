@@ -1,7 +1,7 @@
 //! `build-tool render`: the rendering evaluation of paper Fig. 8 (library:
-//! [`crate::render`]).
+//! [`crate::lab::render`]).
 
-use crate::render::{render, RenderConfig};
+use crate::lab::render::{render, RenderConfig};
 use anyhow::{bail, Result};
 use clap::Args;
 use std::path::PathBuf;

@@ -193,8 +193,8 @@ mod tests {
     #[test]
     fn a_normal_reads_an_environment_blob_and_is_refused_by_a_brdf_blob() {
         let dir = std::env::temp_dir().join(format!("nuld-sample-cli-{}", std::process::id()));
-        let map = crate::render::blobs::tiny_map(&dir);
-        let blob = crate::render::blobs::tiny_envmap_blob(4, &map);
+        let map = crate::sphere::envmap::tiny_map(&dir);
+        let blob = crate::lab::render::blobs::tiny_envmap_blob(4, &map);
         let at = At::Normal(Normal([0.2, 0.9, -0.3]));
         let mut out = Vec::new();
         write_csv(blob.as_slice(), at, 3, SampleMode::Network, &mut out).unwrap();

@@ -196,24 +196,36 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     }
 
     let t = Instant::now();
-    let progress = Progress::stderr("bake", trainer.total_steps() as u64, "step");
-    progress.inc(trainer.state.step as u64);
+    // Two bars, so that `--steps K` shows K training steps: the pretraining on the
+    // warp first, then the cap-loss steps.
+    let pretrain = trainer.config.pretrain_steps;
     let mut last_save = Instant::now();
-    while !trainer.done() {
-        let r = trainer.step();
-        progress.inc(1);
-        progress.set_message(format!(
-            "loss {:.3e}, sets/baseline {:.3}",
-            r.loss, r.set_ratio
-        ));
-        if last_save.elapsed() >= config.checkpoint_every {
-            trainer.state.save(&ckpt_path)?;
-            last_save = Instant::now();
+    for (phase, first, end) in [
+        ("pretrain", 0, pretrain),
+        ("train", pretrain, trainer.total_steps()),
+    ] {
+        if trainer.state.step >= end {
+            continue;
         }
+        let progress = Progress::stderr(phase, (end - first) as u64, "step");
+        progress.inc((trainer.state.step.max(first) - first) as u64);
+        while trainer.state.step < end {
+            let r = trainer.step();
+            progress.inc(1);
+            progress.set_message(if phase == "pretrain" {
+                format!("distance to the warp {:.3e}", r.loss)
+            } else {
+                format!("loss {:.3e}, sets/baseline {:.3}", r.loss, r.set_ratio)
+            });
+            if last_save.elapsed() >= config.checkpoint_every {
+                trainer.state.save(&ckpt_path)?;
+                last_save = Instant::now();
+            }
+        }
+        progress.finish();
     }
     trainer.state.save(&ckpt_path)?;
     out_dir.keep();
-    progress.finish();
     timings.train_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();

@@ -194,7 +194,7 @@ mod tests {
         assert_eq!(brdf.shape(), Some(shape.with_lattice_residual(true)));
 
         let dir = std::env::temp_dir().join(format!("nuld-distill-info-{}", std::process::id()));
-        let map = crate::train::target::TrainTarget::envmap(&crate::render::blobs::tiny_map(&dir))
+        let map = crate::train::target::TrainTarget::envmap(&crate::sphere::envmap::tiny_map(&dir))
             .unwrap()
             .load()
             .unwrap();

@@ -17,9 +17,9 @@
 //!   (independent Owen-Sobol sets: about 0.65; identical sets: 0).
 
 use crate::baselines::warped_owen_sobol_directions;
-use crate::eval::conditional::diversity;
 use crate::network::Params;
 use crate::progress::Progress;
+use crate::sphere::metrics::diversity;
 use crate::sphere::metrics::{CapRadius, MeasuredCaps};
 use crate::sphere::{BrdfTarget, DirectionDensity};
 use crate::train::target::LoadedTarget;

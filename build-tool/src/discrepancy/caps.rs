@@ -16,6 +16,7 @@
 
 use super::estimator::{sigmoid_slope, sum_partials, SIGMOID_BAND};
 use super::GradientPath;
+use crate::seeding::derive_seed;
 use glam::{DVec2, DVec3};
 use nuld_core::sphere::sphere_to_square;
 use rayon::prelude::*;
@@ -349,6 +350,23 @@ pub fn cap_loss_and_gradient(
     let m = caps.len().max(1) as f64;
     let loss = sum_partials(partials, grad, 2.0 / (m * n.max(1) as f64));
     loss / m
+}
+
+/// The caps of epoch `epoch` for seed `seed`: `count` points of a freshly
+/// scrambled 3D Owen-Sobol set mapped by [`Cap::from_unit_cube`] (independent of
+/// the point count, so every size shares them).
+pub(crate) fn epoch_caps(seed: u64, epoch: usize, count: usize) -> Vec<Cap> {
+    let scramble = derive_seed(seed, 2 * epoch as u64 + 1) as u32;
+    (0..count)
+        .map(|i| {
+            let (idx, dim) = ((i % (1 << 16)) as u32, 3 * (i >> 16) as u32);
+            Cap::from_unit_cube(DVec3::new(
+                sobol_burley::sample(idx, dim, scramble) as f64,
+                sobol_burley::sample(idx, dim + 1, scramble) as f64,
+                sobol_burley::sample(idx, dim + 2, scramble) as f64,
+            ))
+        })
+        .collect()
 }
 
 #[cfg(test)]

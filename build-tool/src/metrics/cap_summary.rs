@@ -162,8 +162,8 @@ impl<'a> CapTarget<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::baselines::owen_sobol;
     use crate::sphere::{cap_l2_theta_uniform_estimate, cap_star_estimate, parse_direction_spec};
+    use glam::DVec2;
     use nuld_core::blob::Domain;
     use nuld_core::sphere::square_to_sphere;
 
@@ -183,9 +183,12 @@ mod tests {
                 .tabulated
                 .then(|| CapMeasureTable::new(&density.quadrature(TABLE_POINTS)));
             for seed in 0..2 {
-                let points: Vec<DVec3> = owen_sobol(64, seed)
-                    .into_iter()
-                    .map(square_to_sphere)
+                // An Owen-scrambled Sobol set (sobol_burley), mapped to the sphere.
+                let points: Vec<DVec3> = (0..64)
+                    .map(|i| {
+                        let u = |d| sobol_burley::sample(i, d, seed) as f64;
+                        square_to_sphere(DVec2::new(u(0), u(1)))
+                    })
                     .collect();
                 let theta = match &table {
                     None => cap_l2_theta_uniform_estimate(

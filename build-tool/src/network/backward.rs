@@ -119,7 +119,7 @@ pub fn backward(
 mod tests {
     use super::*;
     use crate::network::Params;
-    use crate::optimize::directions::map_jacobian;
+    use crate::sphere::geometry::map_jacobian;
     use glam::DVec3;
     use nuld_core::blob::Domain;
     use nuld_core::network::Activation;

@@ -3,16 +3,15 @@
 //! directions, scored by the spherical-cap estimator of
 //! [`crate::discrepancy::caps`], and the gradient is chained back through the map.
 
-use super::adam::Adam;
-use super::{epoch_schedule, AreaOption, EpochReport};
+use super::AreaOption;
 use crate::baselines::warped_owen_sobol_directions;
-use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea, CapTree};
+use crate::descent::{local_factor, Adam, Descent, EpochLoss, EpochReport, Schedule};
+use crate::discrepancy::caps::{cap_loss_and_gradient, epoch_caps, CapArea, CapTree};
 use crate::discrepancy::GradientPath;
-use crate::seeding::{derive_seed, rng};
+use crate::seeding::rng;
+use crate::sphere::geometry::{fold, map_jacobian};
 use crate::sphere::{CapMeasureTable, DirectionDensity};
 use glam::{DVec2, DVec3};
-use nuld_core::blob::Domain;
-use nuld_core::sphere::wrap_octahedral;
 use serde::Serialize;
 
 /// Settings of a direction-set optimization. Defaults chosen by experiment
@@ -75,43 +74,6 @@ impl Default for DirectionConfig {
     }
 }
 
-/// Largest local factor of [`DirectionConfig::local_units`]: a region may be this
-/// many times denser in points (per unit length) than the uniform spacing, i.e.
-/// hold `MAX_LOCAL_FACTOR^2` times the uniform density (far beyond a sun in an
-/// 8-bit-exponent HDR map at 4k).
-pub const MAX_LOCAL_FACTOR: f64 = 1e4;
-
-/// The local factor `f = sqrt(|domain| pdf(x))`, clamped into
-/// `[1, MAX_LOCAL_FACTOR]` ([`DirectionConfig::local_units`]).
-pub(crate) fn local_factor(area_of_domain: f64, pdf: f64) -> f64 {
-    let f = (area_of_domain * pdf).sqrt();
-    if f.is_finite() {
-        f.clamp(1.0, MAX_LOCAL_FACTOR)
-    } else {
-        1.0
-    }
-}
-
-/// Brings a square point that left `[0,1]^2` back: across the octahedral seam for
-/// the sphere, clamped onto the equator's square boundary for the hemisphere.
-fn fold(domain: Domain, p: DVec2) -> DVec2 {
-    match domain {
-        Domain::Hemisphere => p.clamp(DVec2::ZERO, DVec2::ONE),
-        _ => wrap_octahedral(p),
-    }
-}
-
-/// Jacobian columns `(d dir / d p.x, d dir / d p.y)` of the map at `p`, by central
-/// differences through the fold (so the seam is crossed continuously).
-pub(crate) fn map_jacobian(domain: Domain, p: DVec2) -> (DVec3, DVec3) {
-    let h = 1e-7;
-    let f = |q: DVec2| domain.to_direction(fold(domain, q));
-    (
-        (f(p + DVec2::X * h) - f(p - DVec2::X * h)) / (2.0 * h),
-        (f(p + DVec2::Y * h) - f(p - DVec2::Y * h)) / (2.0 * h),
-    )
-}
-
 /// The starting set: Owen-Sobol points warped by the target's standard sampler,
 /// expressed in the domain's equal-area square.
 pub fn initial_square_points(density: &dyn DirectionDensity, n: usize, seed: u64) -> Vec<DVec2> {
@@ -119,23 +81,6 @@ pub fn initial_square_points(density: &dyn DirectionDensity, n: usize, seed: u64
     warped_owen_sobol_directions(density, n, seed)
         .into_iter()
         .map(|d| domain.to_square(d))
-        .collect()
-}
-
-/// The caps of epoch `epoch` for seed `seed`: `count` points of a freshly
-/// scrambled 3D Owen-Sobol set mapped by [`Cap::from_unit_cube`] (independent of
-/// the point count, so every size shares them).
-pub(crate) fn epoch_caps(seed: u64, epoch: usize, count: usize) -> Vec<Cap> {
-    let scramble = derive_seed(seed, 2 * epoch as u64 + 1) as u32;
-    (0..count)
-        .map(|i| {
-            let (idx, dim) = ((i % (1 << 16)) as u32, 3 * (i >> 16) as u32);
-            Cap::from_unit_cube(DVec3::new(
-                sobol_burley::sample(idx, dim, scramble) as f64,
-                sobol_burley::sample(idx, dim + 1, scramble) as f64,
-                sobol_burley::sample(idx, dim + 2, scramble) as f64,
-            ))
-        })
         .collect()
 }
 
@@ -255,28 +200,63 @@ fn run(
     let spacing = (area_of_domain / n as f64).sqrt();
     // Square units per radian: the equal-area map scales areas by 1/area_of_domain.
     let square_per_radian = 1.0 / area_of_domain.sqrt();
-    let exact_measure = match (schedule, config.area) {
+    let exact = match (schedule, config.area) {
         (None, AreaOption::Exact) => Some(ExactCapMeasure::new(density, config.table_points)),
         _ => None,
     };
-    let exact = |c: DVec3, t: f64| exact_measure.as_ref().map_or(0.0, |m| m.measure(c, t));
-    let mut adam = Adam::new(n);
-    let mut grad3 = vec![DVec3::ZERO; n];
-    let mut grad = vec![DVec2::ZERO; n];
-    let (mut local, mut step) = (vec![1.0; n], vec![1.0; n]);
-    for epoch in 0..config.epochs {
-        let (alpha_spacings, lr_ratio) = epoch_schedule(
-            epoch,
-            config.epochs,
-            (config.alpha_start, config.alpha_end),
-            config.final_learning_rate_ratio,
-        );
-        let alpha = alpha_spacings / spacing;
-        let lr = config.learning_rate * spacing * square_per_radian * lr_ratio;
+    let annealing = Schedule {
+        epochs: config.epochs,
+        alpha: (config.alpha_start, config.alpha_end),
+        final_learning_rate_ratio: config.final_learning_rate_ratio,
+    };
+    let mut descent = Descent::new(
+        Adam::new(n),
+        annealing,
+        config.learning_rate * spacing * square_per_radian,
+        spacing,
+    );
+    let mut loss = CapLoss {
+        density,
+        config,
+        schedule,
+        exact,
+        grad3: vec![DVec3::ZERO; n],
+        local: vec![1.0; n],
+        step: vec![1.0; n],
+    };
+    descent.run(&mut params, &mut loss, on_epoch);
+    params
+}
 
+/// The cap loss of one run over equal-area square points: each epoch's caps from
+/// the seed, their measures exact, scheduled or Monte Carlo, the gradient chained
+/// back through the map, and the local units of [`DirectionConfig::local_units`].
+struct CapLoss<'a> {
+    density: &'a dyn DirectionDensity,
+    config: &'a DirectionConfig,
+    schedule: Option<&'a CapSchedule>,
+    exact: Option<ExactCapMeasure<'a>>,
+    grad3: Vec<DVec3>,
+    /// Each point's local factor `f_i` and step scale `1 / f_i`.
+    local: Vec<f64>,
+    step: Vec<f64>,
+}
+
+impl EpochLoss<DVec2> for CapLoss<'_> {
+    fn loss_and_gradient(
+        &mut self,
+        epoch: usize,
+        alpha: f64,
+        params: &[DVec2],
+        grad: &mut [DVec2],
+    ) -> f64 {
+        let (config, density) = (self.config, self.density);
+        let domain = density.domain();
+        let exact_measure = &self.exact;
+        let exact = |c: DVec3, t: f64| exact_measure.as_ref().map_or(0.0, |m| m.measure(c, t));
         let caps = epoch_caps(config.seed, epoch, config.caps);
         let sample_tree;
-        let area = match (schedule, config.area) {
+        let area = match (self.schedule, config.area) {
             (Some(s), _) => CapArea::Precomputed(s.epoch(epoch)),
             (None, AreaOption::Exact) => CapArea::Exact(&exact),
             (None, AreaOption::MonteCarlo { samples }) => {
@@ -290,12 +270,13 @@ fn run(
         };
         let dirs: Vec<DVec3> = params.iter().map(|&p| domain.to_direction(p)).collect();
         if config.local_units {
-            for (f, (s, &x)) in local.iter_mut().zip(step.iter_mut().zip(&dirs)) {
+            let area_of_domain = domain.area();
+            for (f, (s, &x)) in self.local.iter_mut().zip(self.step.iter_mut().zip(&dirs)) {
                 *f = local_factor(area_of_domain, density.pdf(x));
                 *s = 1.0 / *f;
             }
         }
-        let sharpness = config.local_units.then_some(local.as_slice());
+        let sharpness = config.local_units.then_some(self.local.as_slice());
         let loss = cap_loss_and_gradient(
             &dirs,
             &caps,
@@ -303,29 +284,30 @@ fn run(
             alpha,
             sharpness,
             config.path,
-            &mut grad3,
+            &mut self.grad3,
         );
-        for ((g, &g3), &p) in grad.iter_mut().zip(&grad3).zip(&params) {
+        for ((g, &g3), &p) in grad.iter_mut().zip(&self.grad3).zip(params) {
             let (jx, jy) = map_jacobian(domain, p);
             *g = DVec2::new(jx.dot(g3), jy.dot(g3));
         }
-        let steps = config.local_units.then_some(step.as_slice());
-        adam.step_scaled(&mut params, &grad, lr, steps);
-        params.iter_mut().for_each(|p| *p = fold(domain, *p));
-        on_epoch(&EpochReport {
-            epoch,
-            loss,
-            alpha,
-            learning_rate: lr,
-        });
+        loss
     }
-    params
+
+    fn step_scales(&self) -> Option<&[f64]> {
+        self.config.local_units.then_some(self.step.as_slice())
+    }
+
+    fn project(&self, params: &mut [DVec2]) {
+        let domain = self.density.domain();
+        params.iter_mut().for_each(|p| *p = fold(domain, *p));
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::sphere::parse_direction_spec;
+    use nuld_core::blob::Domain;
 
     fn run(threads: usize, domain: Domain, spec: &str, seed: u64) -> (Vec<DVec2>, Vec<f64>) {
         let density = parse_direction_spec(spec, domain).unwrap();

@@ -3,18 +3,17 @@
 //! sigmoid's sharpness ramped linearly, optionally through the inverse-CDF
 //! parameterization `x = T(u)`.
 
-pub mod adam;
 pub mod directions;
 pub mod report;
 pub mod run;
 
 use crate::baselines::seeded_owen_sobol;
 use crate::density::Density2D;
+use crate::descent::{Adam, Descent, EpochLoss, EpochReport, Schedule};
 use crate::discrepancy::{
     loss_and_gradient, quadrant_measures, residuals, AreaModel, GradientPath,
 };
 use crate::seeding::{derive_seed, rng};
-use adam::Adam;
 use glam::DVec2;
 use rand::Rng;
 use serde::Serialize;
@@ -99,20 +98,6 @@ impl Default for OptimizeConfig {
     }
 }
 
-/// What one epoch reports to the progress callback.
-#[derive(Clone, Copy, Debug)]
-pub struct EpochReport {
-    /// 0-based epoch index.
-    pub epoch: usize,
-    /// The estimator's loss this epoch (an unbiased estimate of `(D2asd_mu)^2`
-    /// before the step, with exact areas).
-    pub loss: f64,
-    /// Sigmoid sharpness used.
-    pub alpha: f64,
-    /// Step size used (absolute, in square units).
-    pub learning_rate: f64,
-}
-
 /// The initial point set of a run: the first `n` Owen-scrambled Sobol points of the
 /// run's seed, in the parameter space (`u`).
 pub fn initial_parameters(n: usize, seed: u64) -> Vec<DVec2> {
@@ -126,28 +111,6 @@ pub fn to_points(density: &dyn Density2D, params: &[DVec2], p: Parameterization)
         Parameterization::Direct => params.to_vec(),
         Parameterization::InverseCdf => params.iter().map(|&u| density.inverse_cdf(u)).collect(),
     }
-}
-
-/// The annealing of epoch `epoch` of `epochs`, shared by the 2D and direction
-/// optimizers: with `t = epoch / (epochs - 1)` (1 for a single epoch), the sigmoid
-/// sharpness `alpha_start + (alpha_end - alpha_start) t` (in inverse point
-/// spacings) and the step ratio `final + (1 - final) (1 + cos(pi t)) / 2` (cosine
-/// decay from 1 to `final`).
-pub fn epoch_schedule(
-    epoch: usize,
-    epochs: usize,
-    (alpha_start, alpha_end): (f64, f64),
-    final_learning_rate_ratio: f64,
-) -> (f64, f64) {
-    let t = if epochs > 1 {
-        epoch as f64 / (epochs - 1) as f64
-    } else {
-        1.0
-    };
-    let alpha = alpha_start + (alpha_end - alpha_start) * t;
-    let cosine = 0.5 * (1.0 + (std::f64::consts::PI * t).cos());
-    let lr_ratio = final_learning_rate_ratio + (1.0 - final_learning_rate_ratio) * cosine;
-    (alpha, lr_ratio)
 }
 
 /// Optimizes `n` points for `density`, starting from [`initial_parameters`] (warped
@@ -165,30 +128,55 @@ pub fn optimize(
         Parameterization::Direct => to_points(density, &init, Parameterization::InverseCdf),
     };
     let spacing = 1.0 / (n as f64).sqrt();
-    let mut adam = Adam::new(n);
-    let mut grad = vec![DVec2::ZERO; n];
-    let mut anchors = vec![DVec2::ZERO; config.anchors.max(1)];
-    let mut samples = Vec::new();
-    for epoch in 0..config.epochs {
-        let (alpha_spacings, lr_ratio) = epoch_schedule(
-            epoch,
-            config.epochs,
-            (config.alpha_start, config.alpha_end),
-            config.final_learning_rate_ratio,
-        );
-        let alpha = alpha_spacings / spacing;
-        let lr = config.learning_rate * spacing * lr_ratio;
+    let schedule = Schedule {
+        epochs: config.epochs,
+        alpha: (config.alpha_start, config.alpha_end),
+        final_learning_rate_ratio: config.final_learning_rate_ratio,
+    };
+    let mut descent = Descent::new(
+        Adam::new(n),
+        schedule,
+        config.learning_rate * spacing,
+        spacing,
+    );
+    let mut loss = BoxLoss {
+        density,
+        config,
+        anchors: vec![DVec2::ZERO; config.anchors.max(1)],
+        samples: Vec::new(),
+    };
+    descent.run(&mut params, &mut loss, on_epoch);
+    to_points(density, &params, config.parameterization)
+}
 
+/// The quadrant-box loss of one run: each epoch draws its anchors (and, with
+/// [`AreaOption::MonteCarlo`], its target samples) from the seed.
+struct BoxLoss<'a> {
+    density: &'a dyn Density2D,
+    config: &'a OptimizeConfig,
+    anchors: Vec<DVec2>,
+    samples: Vec<DVec2>,
+}
+
+impl EpochLoss<DVec2> for BoxLoss<'_> {
+    fn loss_and_gradient(
+        &mut self,
+        epoch: usize,
+        alpha: f64,
+        params: &[DVec2],
+        grad: &mut [DVec2],
+    ) -> f64 {
+        let (config, density) = (self.config, self.density);
         match config.anchor_sampling {
             AnchorSampling::Random => {
                 let mut r = rng(config.seed, 2 * epoch as u64 + 1);
-                anchors
+                self.anchors
                     .iter_mut()
                     .for_each(|u| *u = DVec2::new(r.random(), r.random()));
             }
             AnchorSampling::OwenSobol => {
                 let scramble = derive_seed(config.seed, 2 * epoch as u64 + 1) as u32;
-                for (i, u) in anchors.iter_mut().enumerate() {
+                for (i, u) in self.anchors.iter_mut().enumerate() {
                     // Past 2^16 anchors, continue with further dimension pairs.
                     let (idx, dim) = ((i % (1 << 16)) as u32, 2 * (i >> 16) as u32);
                     *u = DVec2::new(
@@ -202,52 +190,37 @@ pub fn optimize(
             AreaOption::Exact => AreaModel::Exact(density),
             AreaOption::MonteCarlo { samples: k } => {
                 let mut r = rng(config.seed, 2 * epoch as u64 + 2);
-                samples.clear();
-                samples.extend(
+                self.samples.clear();
+                self.samples.extend(
                     (0..k).map(|_| density.inverse_cdf(DVec2::new(r.random(), r.random()))),
                 );
-                AreaModel::MonteCarlo(&samples)
+                AreaModel::MonteCarlo(&self.samples)
             }
         };
-        let measures = quadrant_measures(area, &anchors);
-        let points = to_points(density, &params, config.parameterization);
-        let res = residuals(&points, &anchors, &measures);
-        let loss = loss_and_gradient(&points, &anchors, &res, alpha, config.path, &mut grad);
+        let measures = quadrant_measures(area, &self.anchors);
+        let points = to_points(density, params, config.parameterization);
+        let res = residuals(&points, &self.anchors, &measures);
+        let loss = loss_and_gradient(&points, &self.anchors, &res, alpha, config.path, grad);
         if config.parameterization == Parameterization::InverseCdf {
-            for (g, &u) in grad.iter_mut().zip(&params) {
+            for (g, &u) in grad.iter_mut().zip(params) {
                 // Chain rule through x = T(u): dL/du = J^T dL/dx.
                 *g = density.inverse_cdf_jacobian(u).transpose() * *g;
             }
         }
-        adam.step(&mut params, &grad, lr);
+        loss
+    }
+
+    fn project(&self, params: &mut [DVec2]) {
         params
             .iter_mut()
             .for_each(|p| *p = p.clamp(DVec2::ZERO, DVec2::splat(1.0 - 1e-12)));
-        on_epoch(&EpochReport {
-            epoch,
-            loss,
-            alpha,
-            learning_rate: lr,
-        });
     }
-    to_points(density, &params, config.parameterization)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::density::parse_spec;
-
-    #[test]
-    fn epoch_schedule_anneals_from_start_to_end() {
-        let a = (8.0, 128.0);
-        assert_eq!(epoch_schedule(0, 11, a, 0.02), (8.0, 1.0));
-        assert_eq!(epoch_schedule(10, 11, a, 0.02), (128.0, 0.02));
-        assert_eq!(epoch_schedule(0, 1, a, 0.02), (128.0, 0.02));
-        // Halfway: alpha at the midpoint, the step halfway between 1 and the end.
-        let (alpha, lr) = epoch_schedule(5, 11, a, 0.02);
-        assert!((alpha - 68.0).abs() < 1e-12 && (lr - 0.51).abs() < 1e-12);
-    }
 
     fn run_with_threads(threads: usize, cfg: &OptimizeConfig) -> Vec<DVec2> {
         let density = parse_spec("gaussian:0.4,0.6,0.2").unwrap();

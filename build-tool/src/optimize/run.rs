@@ -4,9 +4,10 @@
 
 use super::directions::{initial_square_points, optimize_directions, DirectionConfig};
 use super::report::{RunInfo, RunReport, SetReport};
-use super::{optimize, EpochReport, OptimizeConfig};
+use super::{optimize, OptimizeConfig};
 use crate::baselines::warped_owen_sobol;
 use crate::density::{parse_spec, Density2D};
+use crate::descent::EpochReport;
 use crate::metrics::cap_summary::{CapMetricSummary, CapTarget};
 use crate::metrics::summary::{MetricSummary, Target};
 use crate::metrics::Summary;

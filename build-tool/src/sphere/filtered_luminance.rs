@@ -22,7 +22,7 @@
 //! half pixel's exact mass `∫ L dw`, and its density differs from `L / ∫ L` only
 //! inside half pixels.
 
-use super::envmap::pixel_coords;
+use super::equirect::pixel_coords;
 use super::geometry::unit_or_z;
 use crate::density::image::LuminanceImage;
 use glam::DVec3;

@@ -4,7 +4,9 @@
 //! A cap is `C(w, t) = {x : <w, x> >= t}` with unit centre `w` and `t = cos theta`,
 //! `theta` its angular radius (docs/estimator.md, paper Eq. 7).
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
+use nuld_core::blob::Domain;
+use nuld_core::sphere::wrap_octahedral;
 use rand::{Rng, RngCore};
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -141,6 +143,27 @@ pub fn tangent_frame(w: DVec3) -> (DVec3, DVec3) {
     (
         DVec3::new(1.0 + sign * w.x * w.x * a, sign * b, -sign * w.x),
         DVec3::new(b, sign + w.y * w.y * a, -w.y),
+    )
+}
+
+/// Brings a square point that left `[0,1]^2` back: across the octahedral seam for
+/// the sphere, clamped onto the equator's square boundary for the hemisphere.
+pub(crate) fn fold(domain: Domain, p: DVec2) -> DVec2 {
+    match domain {
+        Domain::Hemisphere => p.clamp(DVec2::ZERO, DVec2::ONE),
+        _ => wrap_octahedral(p),
+    }
+}
+
+/// Jacobian columns `(d dir / d p.x, d dir / d p.y)` of the domain's equal-area
+/// map at `p`, by central differences through [`fold`] (so the seam is crossed
+/// continuously): the chain rule from a direction's gradient to its square point.
+pub(crate) fn map_jacobian(domain: Domain, p: DVec2) -> (DVec3, DVec3) {
+    let h = 1e-7;
+    let f = |q: DVec2| domain.to_direction(fold(domain, q));
+    (
+        (f(p + DVec2::X * h) - f(p - DVec2::X * h)) / (2.0 * h),
+        (f(p + DVec2::Y * h) - f(p - DVec2::Y * h)) / (2.0 * h),
     )
 }
 

@@ -28,6 +28,7 @@ pub mod brdf_target;
 pub mod cap_table;
 pub mod closed_form;
 pub mod envmap;
+pub mod equirect;
 pub mod filtered_luminance;
 pub mod geometry;
 pub mod metrics;

@@ -28,18 +28,16 @@
 
 pub mod checkpoint;
 pub mod pool;
-pub mod speed;
 pub mod target;
 
 pub use checkpoint::Checkpoint;
 pub use pool::{ConditionPool, PoolCondition};
 pub use target::TrainTarget;
 
+use crate::descent::{Adam, Descent, EpochLoss, Schedule};
 use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use crate::discrepancy::GradientPath;
 use crate::network::{backward, output_gradient, Params};
-use crate::optimize::adam::Adam;
-use crate::optimize::epoch_schedule;
 use crate::seeding::rng;
 use glam::{DVec2, DVec3};
 use nuld_core::network::{Activation, Shape};
@@ -251,21 +249,80 @@ impl Trainer {
         self.config.pretrain_steps + self.config.steps
     }
 
-    /// Takes one step.
+    /// Takes one step: a batch of pool conditions (half of them by a tournament
+    /// toward the worst relative to their baselines) and one [`Descent::epoch`]
+    /// on its loss.
     pub fn step(&mut self) -> StepReport {
         let cfg = &self.config;
         let t = self.state.step;
-        let pretraining = t < cfg.pretrain_steps;
-        let (alpha, lr_ratio) = epoch_schedule(
-            t.saturating_sub(cfg.pretrain_steps),
-            cfg.steps,
-            (cfg.alpha_start, cfg.alpha_end),
-            cfg.final_learning_rate_ratio,
+        let schedule = Schedule {
+            epochs: cfg.steps,
+            alpha: (cfg.alpha_start, cfg.alpha_end),
+            final_learning_rate_ratio: cfg.final_learning_rate_ratio,
+        };
+        let adam = Adam::<f64>::from_state(
+            std::mem::take(&mut self.state.adam_m),
+            std::mem::take(&mut self.state.adam_v),
+            self.state.adam_t,
         );
-        let lr = cfg.learning_rate * lr_ratio;
+        // The sharpness is in inverse point spacings already (the loss divides by
+        // the spacing of its sets and their union): spacing 1.
+        let mut descent = Descent::new(adam, schedule, cfg.learning_rate, 1.0);
+        let mut batch = BatchLoss {
+            cfg,
+            pool: &self.pool,
+            shape: self.shape,
+            running: &mut self.state.running,
+            step: t,
+            set_ratio: 0.0,
+        };
+        let report = descent.epoch(
+            t.saturating_sub(cfg.pretrain_steps),
+            &mut self.state.params,
+            &mut batch,
+        );
+        let set_ratio = batch.set_ratio;
+        (self.state.adam_m, self.state.adam_v, self.state.adam_t) = descent.adam.into_state();
+        self.state.losses.push(report.loss);
+        self.state.step += 1;
+        StepReport {
+            step: t,
+            loss: report.loss,
+            set_ratio,
+            alpha: report.alpha,
+            learning_rate: report.learning_rate,
+        }
+    }
+}
+
+/// The loss of step `step`: its batch of conditions drawn from the step's seed,
+/// the warp-fitting loss while pretraining, then the cap loss of the sets and
+/// their union; updates the pool's running losses that the tournament reads.
+struct BatchLoss<'a> {
+    cfg: &'a TrainConfig,
+    pool: &'a ConditionPool,
+    shape: Shape,
+    running: &'a mut Vec<f64>,
+    step: usize,
+    /// Mean set loss over the conditions' baselines, once computed.
+    set_ratio: f64,
+}
+
+impl EpochLoss<f64> for BatchLoss<'_> {
+    fn loss_and_gradient(
+        &mut self,
+        _epoch: usize,
+        alpha: f64,
+        values: &[f64],
+        grad: &mut [f64],
+    ) -> f64 {
+        let cfg = self.cfg;
+        let t = self.step;
+        let pretraining = t < cfg.pretrain_steps;
         let mut r = rng(cfg.seed, 1 + t as u64);
         let p = self.pool.len();
-        let score = |j: usize| self.state.running[j] / self.pool.conditions[j].baseline_loss;
+        let running = &*self.running;
+        let score = |j: usize| running[j] / self.pool.conditions[j].baseline_loss;
         let mut batch = Vec::with_capacity(cfg.conditions_per_step);
         for b in 0..cfg.conditions_per_step {
             let mut pick = r.random_range(0..p);
@@ -281,7 +338,10 @@ impl Trainer {
             let start = r.random_range(0..cfg.pool_caps);
             batch.push((pick, instances, start));
         }
-        let params = self.params();
+        let params = Params {
+            shape: self.shape,
+            values: values.to_vec(),
+        };
         let results: Vec<(f64, f64, Vec<f64>)> = batch
             .par_iter()
             .map(|(pick, instances, start)| {
@@ -298,7 +358,6 @@ impl Trainer {
                 )
             })
             .collect();
-        let mut grad = vec![0.0; params.values.len()];
         let (mut loss, mut ratio) = (0.0, 0.0);
         let inv_b = 1.0 / batch.len() as f64;
         for ((pick, _, _), (set_loss, union_loss, g)) in batch.iter().zip(&results) {
@@ -310,29 +369,15 @@ impl Trainer {
             if pretraining {
                 continue;
             }
-            let run = &mut self.state.running[*pick];
+            let run = &mut self.running[*pick];
             *run = if run.is_finite() {
                 0.8 * *run + 0.2 * set_loss
             } else {
                 *set_loss
             };
         }
-        let mut adam = Adam::<f64>::from_state(
-            std::mem::take(&mut self.state.adam_m),
-            std::mem::take(&mut self.state.adam_v),
-            self.state.adam_t,
-        );
-        adam.step(&mut self.state.params, &grad, lr);
-        (self.state.adam_m, self.state.adam_v, self.state.adam_t) = adam.into_state();
-        self.state.losses.push(loss);
-        self.state.step += 1;
-        StepReport {
-            step: t,
-            loss,
-            set_ratio: ratio,
-            alpha,
-            learning_rate: lr,
-        }
+        self.set_ratio = ratio;
+        loss
     }
 }
 

@@ -17,11 +17,12 @@
 
 use super::target::{LoadedTarget, TrainTarget};
 use crate::baselines::{seeded_owen_sobol, warped_owen_sobol_directions};
+use crate::descent::local_factor;
+use crate::discrepancy::caps::epoch_caps;
 use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use crate::discrepancy::GradientPath;
-use crate::optimize::directions::map_jacobian;
-use crate::optimize::directions::{epoch_caps, local_factor};
 use crate::seeding::derive_seed;
+use crate::sphere::geometry::map_jacobian;
 use crate::sphere::{BrdfTarget, CapMeasureTable, DirectionDensity, EnvmapDensity, TabulatedWarp};
 use anyhow::Result;
 use glam::{DVec2, DVec3};
@@ -257,11 +258,8 @@ fn condition(
     let n = shape.n() as usize;
     let target = BrdfTarget::coarse(cond[0], cond[1], POOL_RULE_POINTS)
         .expect("pool conditions lie in the condition range");
-    let caps = epoch_caps(seed, 0, caps);
-    let measures: Vec<f64> = caps
-        .iter()
-        .map(|c| target.cap_measure(c.center, c.cos_theta))
-        .collect();
+    let exact = TabulatedWarp::new(&target, POOL_BASELINE_TABULATION, 2)?;
+    let baseline = exact.warp_all(&seeded_owen_sobol(n, seed));
     let pc = PoolCondition {
         cond,
         unit: LoadedTarget::GltfBrdf.normalized(cond),
@@ -270,22 +268,45 @@ fn condition(
             albedo: target.albedo(),
         },
         domain: Domain::Hemisphere,
-        caps,
-        measures,
+        caps: Vec::new(),
+        measures: Vec::new(),
         warp_targets: warp_targets(&target, shape),
         baseline_loss: 0.0,
         lobe_probability: target.lobe_probability(),
         warp: PointWarp::of_shape(shape),
     };
-    let exact = TabulatedWarp::new(&target, POOL_BASELINE_TABULATION, 2)?;
-    let pts = exact.warp_all(&seeded_owen_sobol(n, seed));
-    Ok(PoolCondition {
-        baseline_loss: pc.window_loss(&pts, window),
-        ..pc
-    })
+    Ok(pc.measured(
+        caps,
+        seed,
+        |c, t| target.cap_measure(c, t),
+        &baseline,
+        window,
+    ))
 }
 
 impl PoolCondition {
+    /// The condition with its caps (epoch 0 of `seed`, [`epoch_caps`]), their
+    /// target measures by `measure(centre, cos_theta)`, and the loss of the
+    /// `baseline` set on the first `window` of them: what every target's condition
+    /// computes alike once its density is set.
+    fn measured(
+        mut self,
+        caps: usize,
+        seed: u64,
+        measure: impl Fn(DVec3, f64) -> f64,
+        baseline: &[DVec3],
+        window: usize,
+    ) -> Self {
+        self.caps = epoch_caps(seed, 0, caps);
+        self.measures = self
+            .caps
+            .iter()
+            .map(|c| measure(c.center, c.cos_theta))
+            .collect();
+        self.baseline_loss = self.window_loss(baseline, window);
+        self
+    }
+
     /// Cap loss of `pts` on the first window of `window` caps at sharpness 1:
     /// the baseline's score ([`PoolCondition::baseline_loss`]).
     fn window_loss(&self, pts: &[DVec3], window: usize) -> f64 {
@@ -321,11 +342,6 @@ fn envmap_condition(
     // A normal that no light reaches trains on the cosine lobe (its weight is 0).
     let (lit, irradiance) = map.cosine_weighted(normal)?;
     let table = CapMeasureTable::new(&lit.mass_rule(POOL_RULE_POINTS));
-    let caps = epoch_caps(seed, 0, caps);
-    let measures: Vec<f64> = caps
-        .iter()
-        .map(|c| table.measure(c.center, c.cos_theta))
-        .collect();
     let share = irradiance / map.integral();
     let warp_targets = (0..PRETRAIN_INSTANCES)
         .flat_map(|k| {
@@ -338,7 +354,7 @@ fn envmap_condition(
             })
         })
         .collect();
-    let mut pc = PoolCondition {
+    let pc = PoolCondition {
         cond: u,
         unit: u,
         density: ConditionDensity::Envmap {
@@ -347,15 +363,20 @@ fn envmap_condition(
             scale: if share > 0.0 { 1.0 / share } else { 0.0 },
         },
         domain: Domain::Sphere,
-        caps,
-        measures,
+        caps: Vec::new(),
+        measures: Vec::new(),
         warp_targets,
         baseline_loss: 0.0,
         lobe_probability: 0.0,
         warp: PointWarp::EqualArea,
     };
-    pc.baseline_loss = pc.window_loss(&warped_owen_sobol_directions(&lit, n, seed), window);
-    Ok(pc)
+    Ok(pc.measured(
+        caps,
+        seed,
+        |c, t| table.measure(c, t),
+        &warped_owen_sobol_directions(&lit, n, seed),
+        window,
+    ))
 }
 
 #[cfg(test)]
@@ -399,7 +420,7 @@ mod tests {
     #[test]
     fn envmap_conditions_hold_the_lit_map() {
         let dir = std::env::temp_dir().join(format!("nuld-pool-envmap-{}", std::process::id()));
-        let map = crate::render::blobs::tiny_map(&dir);
+        let map = crate::sphere::envmap::tiny_map(&dir);
         let shape = Shape::new(8, &[4], Activation::Relu, 3).unwrap();
         let pool =
             ConditionPool::new(&TrainTarget::envmap(&map).unwrap(), 3, 64, 32, &shape, 5).unwrap();

@@ -135,7 +135,7 @@ mod tests {
         let back = brdf.normalized([0.55, 44.5]);
         assert!(back.iter().all(|x| (x - 0.5).abs() < 1e-12), "{back:?}");
         let dir = std::env::temp_dir().join(format!("nuld-target-range-{}", std::process::id()));
-        let map = TrainTarget::envmap(&crate::render::blobs::tiny_map(&dir))
+        let map = TrainTarget::envmap(&crate::sphere::envmap::tiny_map(&dir))
             .unwrap()
             .load()
             .unwrap();

@@ -14,8 +14,7 @@
 //!   `(0, 1), (1, 2), ..., (K-2, K-1)`. Independent Owen-Sobol sets give about 0.65;
 //!   identical sets give 0.
 
-use crate::sphere::MeasuredCaps;
-use crate::sphere::{root_with_stderr, CapRadius};
+use super::cap_l2::{root_with_stderr, CapRadius, MeasuredCaps};
 use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -105,9 +104,18 @@ pub fn diversity(sets: &[Vec<DVec3>], caps: &MeasuredCaps) -> Diversity {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::baselines::seeded_owen_sobol;
     use crate::sphere::{BrdfTarget, DirectionDensity, TabulatedWarp};
     use nuld_core::blob::Domain;
+
+    /// `n` points of the Owen-scrambled Sobol set of scramble `seed` (sobol_burley).
+    fn owen_sobol(n: u32, seed: u32) -> Vec<glam::DVec2> {
+        (0..n)
+            .map(|i| {
+                let u = |d| sobol_burley::sample(i, d, seed) as f64;
+                glam::DVec2::new(u(0), u(1))
+            })
+            .collect()
+    }
 
     #[test]
     fn angle_is_the_arc_length() {
@@ -126,7 +134,7 @@ mod tests {
         let warp = TabulatedWarp::new(&b, 512, 2).unwrap();
         let caps = MeasuredCaps::draw(4096, 3, CapRadius::ThetaUniform, |w, t| b.cap_measure(w, t));
         let independent: Vec<Vec<DVec3>> = (0..64)
-            .map(|k| warp.warp_all(&seeded_owen_sobol(64, 1000 + k)))
+            .map(|k| warp.warp_all(&owen_sobol(64, 1000 + k)))
             .collect();
         let d = diversity(&independent, &caps);
         eprintln!("independent: {d:?}");

@@ -353,7 +353,7 @@ fn composite<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::summary::CSV_HEADER;
+    use crate::lab::render::summary::CSV_HEADER;
 
     /// `../shared/data/envmaps/courtyard.hdr` when present, else a generated sky
     /// written as PNG into `dir`.

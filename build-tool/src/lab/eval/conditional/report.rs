@@ -3,8 +3,8 @@
 //! `conditional-summary.md`, ratio heat maps and sets drawn over their target).
 
 use super::{ConditionalSettings, Diversity};
-use crate::eval::cache::sanitize;
-use crate::eval::stats;
+use crate::lab::eval::cache::sanitize;
+use crate::lab::eval::stats;
 use crate::plot::{render_direction_set, render_heatmap, Heatmap};
 use crate::sphere::{BrdfTarget, DirectionDensity};
 use anyhow::Result;

@@ -157,25 +157,6 @@ pub(crate) fn tiny_blob(n: u32) -> AlignedBytes {
     bytes
 }
 
-/// A small sky (a bright spot above a gradient, 32 x 16 pixels) written as PNG
-/// into `dir`, for tests that need a map file.
-#[cfg(test)]
-pub(crate) fn tiny_map(dir: &Path) -> PathBuf {
-    std::fs::create_dir_all(dir).unwrap();
-    let path = dir.join("sky.png");
-    image::RgbImage::from_fn(32, 16, |x, y| {
-        let v = if (x, y) == (5, 3) {
-            255
-        } else {
-            (40 + 8 * (16 - y)) as u8
-        };
-        image::Rgb([v, v, v])
-    })
-    .save(&path)
-    .unwrap();
-    path
-}
-
 /// A tiny baked environment sampler of the map at `map` with `N = n` (the
 /// `--quick` bake), baked into a fresh temporary directory: barely trained.
 #[cfg(test)]
@@ -202,6 +183,7 @@ pub(crate) fn tiny_envmap_blob(n: u32, map: &Path) -> AlignedBytes {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sphere::envmap::tiny_map;
 
     #[test]
     fn blobs_of_the_wrong_kind_or_a_repeated_n_are_refused_by_name() {

@@ -68,8 +68,9 @@ pub fn samplers<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::blobs::{tiny_blob, tiny_envmap_blob, tiny_map};
-    use crate::render::sampler::Technique;
+    use crate::lab::render::blobs::{tiny_blob, tiny_envmap_blob};
+    use crate::lab::render::sampler::Technique;
+    use crate::sphere::envmap::tiny_map;
 
     #[test]
     fn the_lineup_is_named_as_the_tables() {

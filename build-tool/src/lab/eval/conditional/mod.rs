@@ -26,11 +26,10 @@
 //! `derive_seed` of the run seed, the condition's index and a fixed stream number,
 //! and every parallel reduction runs in a fixed order.
 
-pub mod diversity;
 pub mod report;
 pub mod sets;
 
-pub use diversity::{diversity, Diversity};
+pub use crate::sphere::metrics::{diversity, Diversity};
 pub use report::{ConditionResult, ConditionalReport, MethodScore, References};
 pub use sets::{blob_sets, ConditionalSets, MixtureOwenSobol, SampleFnSets};
 

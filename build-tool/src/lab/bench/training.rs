@@ -2,7 +2,7 @@
 //! sampler at several `N` (all threads, the default configuration otherwise), and
 //! what it implies for a bake of the default step count.
 
-use super::{TrainConfig, Trainer};
+use crate::train::{TrainConfig, Trainer};
 use std::time::Instant;
 
 /// One `N`'s timing.

@@ -63,6 +63,16 @@ impl<P: AdamParam> Adam<P> {
         }
     }
 
+    /// How many parameters the state is for.
+    pub fn len(&self) -> usize {
+        self.m.len()
+    }
+
+    /// Whether the state is for no parameters.
+    pub fn is_empty(&self) -> bool {
+        self.m.is_empty()
+    }
+
     /// One step of size `lr` against `grad`: `x -= lr * m_hat / (sqrt(v_hat) + eps)`.
     pub fn step(&mut self, params: &mut [P], grad: &[P], lr: f64) {
         self.step_scaled(params, grad, lr, None);

@@ -165,12 +165,12 @@ impl Setup<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::blobs::tiny_blob;
-    use crate::render::brdf_warp::{LobeTable, MixtureSampler};
-    use crate::render::lineup;
-    use crate::render::nuld_sampler::{NuldMode, NuldSampler};
-    use crate::render::primary::{Generator, PrimaryPoints};
-    use crate::render::scene::Sphere;
+    use crate::lab::render::blobs::tiny_blob;
+    use crate::lab::render::brdf_warp::{LobeTable, MixtureSampler};
+    use crate::lab::render::lineup;
+    use crate::lab::render::nuld_sampler::{NuldMode, NuldSampler};
+    use crate::lab::render::primary::{Generator, PrimaryPoints};
+    use crate::lab::render::scene::Sphere;
     use crate::sphere::brdf_albedo::directional_albedo;
     use nuld_core::brdf::BrdfModel;
 

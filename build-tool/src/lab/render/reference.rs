@@ -161,9 +161,9 @@ fn pixel(setup: &Setup<'_>, lobes: &LobeTable, m: u32, seed: u64, x: u32, y: u32
 mod tests {
     use super::*;
     use crate::density::image::LuminanceImage;
-    use crate::render::camera::Camera;
-    use crate::render::environment::Environment;
-    use crate::render::scene::{Scene, Sphere};
+    use crate::lab::render::camera::Camera;
+    use crate::lab::render::environment::Environment;
+    use crate::lab::render::scene::{Scene, Sphere};
     use crate::sphere::brdf_albedo::directional_albedo;
     use nuld_core::brdf::BrdfModel;
 

@@ -237,8 +237,8 @@ fn envmap_sample(at: &ShadingPoint, env: &Environment, s: nuld_runtime::Sample) 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::blobs::tiny_blob;
-    use crate::render::frame::Frame;
+    use crate::lab::render::blobs::tiny_blob;
+    use crate::lab::render::frame::Frame;
     use glam::{DVec3, Vec3};
 
     /// Ours is the runtime and nothing else: on the same blob bytes, the samples
@@ -307,8 +307,9 @@ mod tests {
     /// `L max(0, n.l) / E`.
     #[test]
     fn envmap_samples_are_the_runtimes_and_contribute_e_times_f() {
-        use crate::render::blobs::{tiny_envmap_blob, tiny_map};
-        use crate::render::environment::Environment;
+        use crate::lab::render::blobs::tiny_envmap_blob;
+        use crate::lab::render::environment::Environment;
+        use crate::sphere::envmap::tiny_map;
         let dir = std::env::temp_dir().join(format!("nuld-envsampler-{}", std::process::id()));
         let map = tiny_map(&dir);
         let env = Environment::from_file(&map).unwrap();
@@ -360,7 +361,7 @@ mod tests {
     /// tool's training, network or conditional-sampler code.
     #[test]
     fn the_renderer_does_not_import_the_tools_sampler_internals() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/render");
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/lab/render");
         let mut checked = 0;
         for entry in std::fs::read_dir(&dir).unwrap() {
             let path = entry.unwrap().path();

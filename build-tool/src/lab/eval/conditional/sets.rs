@@ -135,8 +135,8 @@ mod tests {
         let sets = blob_sets(&brdf.0).unwrap();
         assert_eq!(sets.len(), 2);
         let dir = std::env::temp_dir().join(format!("nuld-blob-sets-{}", std::process::id()));
-        let map = crate::render::blobs::tiny_map(&dir);
-        let env = crate::render::blobs::tiny_envmap_blob(4, &map);
+        let map = crate::sphere::envmap::tiny_map(&dir);
+        let env = crate::lab::render::blobs::tiny_envmap_blob(4, &map);
         let e = blob_sets(env.as_slice()).err().unwrap().to_string();
         assert!(e.contains("bake --envmap"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
