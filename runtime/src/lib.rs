@@ -74,6 +74,7 @@ mod brdf;
 mod conditional;
 mod envmap;
 mod points;
+mod section;
 pub mod shader;
 
 /// The `glam` this crate returns its vectors in; use it instead of a `glam`
@@ -93,6 +94,7 @@ pub use nuld_core::conditional::{ConditionalInfo, ConditionalTarget};
 pub use points::{DirectionSet, PointSet2D};
 
 use nuld_core::blob::{Layout, PointSetInfo, SectionTag};
+use section::{record, typed_section};
 
 /// A validated blob, borrowing its bytes.
 ///
@@ -211,16 +213,10 @@ impl<'a> Blob<'a> {
 
     /// The info section and the coordinate array, validated against each other.
     fn points_view(&self) -> Result<(PointSetInfo, &'a [[u16; 2]]), BlobError> {
-        let (_, info_bytes) = self.layout.section(SectionTag::PointSetInfo)?;
-        let info_len = core::mem::size_of::<PointSetInfo>();
-        if info_bytes.len() != info_len {
-            return Err(PointSetError::InfoSize {
-                got: info_bytes.len() as u64,
-                expected: info_len as u64,
-            }
-            .into());
-        }
-        let info: PointSetInfo = bytemuck::pod_read_unaligned(info_bytes);
+        let info: PointSetInfo =
+            record(&self.layout, SectionTag::PointSetInfo, |got, expected| {
+                PointSetError::InfoSize { got, expected }
+            })?;
         if info.len == 0 {
             return Err(PointSetError::NoPoints.into());
         }
@@ -241,23 +237,18 @@ impl<'a> Blob<'a> {
             }
             .into());
         }
-        let (entry, bytes) = self.layout.section(SectionTag::Points)?;
-        if entry.elem_size != 4 {
-            return Err(PointSetError::ElementSize(entry.elem_size).into());
-        }
-        let expected = (info.len as u64) * (info.set_count as u64) * 4;
-        if bytes.len() as u64 != expected {
-            return Err(PointSetError::Length {
-                expected,
-                got: bytes.len() as u64,
-            }
-            .into());
-        }
-        // The length is a whole number of 4-byte elements (checked above) and the
-        // section starts 16-byte aligned in an aligned blob (`Layout::read`), so the
-        // cast cannot fail; were the bytes misaligned, that would be the cause.
-        let coords: &[[u16; 2]] =
-            bytemuck::try_cast_slice(bytes).map_err(|_| LayoutError::Misaligned)?;
+        // Lengths in bytes in the error, as the format states them (saturating:
+        // two counts near 2^32 make a byte length past 2^64, which no section has).
+        let coords: &[[u16; 2]] = typed_section(
+            &self.layout,
+            SectionTag::Points,
+            PointSetError::ElementSize,
+            || Ok((info.len as u64) * (info.set_count as u64)),
+            |expected, got| PointSetError::Length {
+                expected: expected.saturating_mul(4),
+                got: got.saturating_mul(4),
+            },
+        )?;
         Ok((info, coords))
     }
 }
@@ -352,4 +343,60 @@ fn doc_example_sampler(
     let mut out = Aligned([0u8; 400]);
     let _ = write(&mut out.0, BlobKind::Conditional, &meta, &sections);
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nuld_core::blob::{write, SectionSpec};
+
+    /// A point-set blob whose info claims `len` points in `sets` sets over one
+    /// stored point.
+    fn claiming(len: u32, sets: u32) -> Aligned<[u8; 160]> {
+        let info = PointSetInfo {
+            len,
+            set_count: sets,
+            domain: Domain::Square as u32,
+            reserved: 0,
+        };
+        let pts: [[u16; 2]; 4] = [[1, 2], [3, 4], [5, 6], [7, 8]];
+        let meta = [
+            3, b'd', b'o', b'c', 7, b'u', b'n', b'i', b'f', b'o', b'r', b'm', 0,
+        ];
+        let sections = [
+            SectionSpec {
+                tag: SectionTag::PointSetInfo,
+                elem_size: 16,
+                bytes: bytemuck::bytes_of(&info),
+            },
+            SectionSpec {
+                tag: SectionTag::Points,
+                elem_size: 4,
+                bytes: bytemuck::cast_slice(&pts),
+            },
+        ];
+        let mut out = Aligned([0u8; 160]);
+        write(&mut out.0, BlobKind::PointSet2D, &meta, &sections).unwrap();
+        out
+    }
+
+    #[test]
+    fn point_counts_whose_byte_length_passes_2_pow_64_are_refused_without_overflow() {
+        assert!(Blob::parse(&claiming(4, 1).0).is_ok());
+        // 4 (2^32 - 1)^2 bytes: past u64, so the byte length saturates.
+        assert_eq!(
+            Blob::parse(&claiming(u32::MAX, u32::MAX).0).unwrap_err(),
+            BlobError::PointSet(PointSetError::Length {
+                expected: u64::MAX,
+                got: 16
+            })
+        );
+        assert_eq!(
+            Blob::parse(&claiming(3, 2).0).unwrap_err(),
+            BlobError::PointSet(PointSetError::Length {
+                expected: 24,
+                got: 16
+            })
+        );
+    }
 }

@@ -73,6 +73,7 @@ fn kernel() -> Option<&'static Kernel> {
     static KERNEL: OnceLock<Option<Kernel>> = OnceLock::new();
     let kernel = KERNEL
         .get_or_init(|| {
+            quiet_wayland();
             let gpu = Gpu::new()?;
             // Both streams: the CI log shows it with or without --nocapture.
             println!("shader tests: adapter {}", gpu.adapter);
@@ -92,6 +93,29 @@ fn kernel() -> Option<&'static Kernel> {
         );
     }
     kernel
+}
+
+/// Mesa's Vulkan drivers look for a Wayland display when the instance starts, and
+/// libwayland prints `error: XDG_RUNTIME_DIR is invalid or not set` to stderr
+/// where the variable is unset (CI, containers), which reads like a failure. A
+/// private empty directory silences it (no display is found there, as before).
+fn quiet_wayland() {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_some() {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("nuld-xdg-runtime-{}", std::process::id()));
+    let made = std::fs::create_dir_all(&dir).and_then(|()| {
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700))?;
+        }
+        Ok(())
+    });
+    if made.is_ok() {
+        // Once, before any thread of this test binary starts a Vulkan instance.
+        std::env::set_var("XDG_RUNTIME_DIR", &dir);
+    }
 }
 
 /// `(condition, instance, index)` of sample `e` of `p`, as the kernel computes them.

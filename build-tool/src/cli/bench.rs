@@ -1,16 +1,13 @@
-//! `build-tool bench`: the optimizer's speed, fast banded gradient against the dense
-//! reference, and the wall time of full default runs.
+//! `build-tool bench`: parses the arguments, takes the measurements of
+//! [`crate::lab::bench`] and prints them as tables.
 
 use crate::baselines::Baseline;
-use crate::density::parse_spec;
 use crate::discrepancy::GradientPath;
-use crate::optimize::directions::{optimize_directions, DirectionConfig};
-use crate::optimize::{optimize, AreaOption, OptimizeConfig};
-use crate::sphere::parse_direction_spec;
-use anyhow::{Context, Result};
+use crate::lab::bench::{baselines, optimizer, runtime, training};
+use crate::optimize::directions::DirectionConfig;
+use crate::optimize::{AreaOption, OptimizeConfig};
+use anyhow::Result;
 use clap::Args;
-use nuld_core::blob::Domain;
-use std::time::Instant;
 
 /// Arguments of `build-tool bench`.
 #[derive(Args, Debug)]
@@ -62,24 +59,6 @@ pub enum BenchPart {
     Training,
 }
 
-fn direction_seconds_per_epoch(
-    spec: &str,
-    n: usize,
-    epochs: usize,
-    path: GradientPath,
-) -> Result<f64> {
-    let density = parse_direction_spec(spec, Domain::Sphere)
-        .with_context(|| format!("--direction-density {spec}"))?;
-    let cfg = DirectionConfig {
-        epochs,
-        path,
-        ..DirectionConfig::default()
-    };
-    let t = Instant::now();
-    let _ = optimize_directions(density.as_ref(), n, &cfg, &mut |_| {});
-    Ok(t.elapsed().as_secs_f64() / epochs as f64)
-}
-
 fn run_directions(a: &BenchArgs) -> Result<()> {
     let d = DirectionConfig::default();
     println!(
@@ -91,13 +70,13 @@ fn run_directions(a: &BenchArgs) -> Result<()> {
         "N", "fast ms/epoch", "dense ms/epoch", "ratio"
     );
     for &n in &a.sizes {
-        let fast = direction_seconds_per_epoch(
+        let fast = optimizer::direction_seconds_per_epoch(
             &a.direction_density,
             n,
             5 * a.fast_epochs,
             GradientPath::Fast,
         )?;
-        let dense = direction_seconds_per_epoch(
+        let dense = optimizer::direction_seconds_per_epoch(
             &a.direction_density,
             n,
             a.dense_epochs,
@@ -111,40 +90,13 @@ fn run_directions(a: &BenchArgs) -> Result<()> {
         );
     }
     if a.full_n > 0 {
-        let density = parse_direction_spec(&a.direction_density, Domain::Sphere)?;
-        let t = Instant::now();
-        let _ = optimize_directions(density.as_ref(), a.full_n, &d, &mut |_| {});
+        let s = optimizer::direction_full_run(&a.direction_density, a.full_n)?;
         println!(
-            "full default run ({} epochs), N = {}: {:.1} s   (paper, RTX 5090 laptop: 75 s)",
-            d.epochs,
-            a.full_n,
-            t.elapsed().as_secs_f64()
+            "full default run ({} epochs), N = {}: {s:.1} s   (paper, RTX 5090 laptop: 75 s)",
+            d.epochs, a.full_n
         );
     }
     Ok(())
-}
-
-fn seconds_per_epoch(spec: &str, n: usize, epochs: usize, path: GradientPath) -> Result<f64> {
-    let density = parse_spec(spec).with_context(|| format!("--density {spec}"))?;
-    let cfg = OptimizeConfig {
-        epochs,
-        path,
-        ..OptimizeConfig::default()
-    };
-    let t = Instant::now();
-    let _ = optimize(density.as_ref(), n, &cfg, &mut |_| {});
-    Ok(t.elapsed().as_secs_f64() / epochs as f64)
-}
-
-fn full_run(spec: &str, n: usize, area: AreaOption) -> Result<f64> {
-    let density = parse_spec(spec).with_context(|| format!("--image-density {spec}"))?;
-    let cfg = OptimizeConfig {
-        area,
-        ..OptimizeConfig::default()
-    };
-    let t = Instant::now();
-    let _ = optimize(density.as_ref(), n, &cfg, &mut |_| {});
-    Ok(t.elapsed().as_secs_f64())
 }
 
 /// Runs `build-tool bench`.
@@ -186,7 +138,7 @@ fn run_training() -> Result<()> {
         "ms/step",
         format!("{bake_steps} steps at that rate, min")
     );
-    for t in crate::lab::bench::training::measure(&TRAINING_SIZES) {
+    for t in training::measure(&TRAINING_SIZES) {
         println!(
             "{:>6} {:>10.1} {:>8} {:>12.1} {:>30.1}",
             t.n,
@@ -205,7 +157,7 @@ const RUNTIME_SAMPLES: u32 = 2_000_000;
 /// Nanoseconds per sample of the conditional sampler's modes and of the incumbent,
 /// one thread, with each method's ratio to the incumbent (direction only).
 fn run_runtime() -> Result<()> {
-    let t = crate::lab::bench::runtime::measure(RUNTIME_SAMPLES)?;
+    let t = runtime::measure(RUNTIME_SAMPLES)?;
     println!("runtime ns per sample, one thread, n = 64 (best of 3)");
     println!("{:<44} {:>10} {:>12}", "method", "ns/sample", "/ incumbent");
     let base = t.rows.first().map_or(f64::NAN, |r| r.1);
@@ -235,13 +187,7 @@ fn run_baselines(a: &BenchArgs) -> Result<()> {
     for b in Baseline::ALL {
         print!("{:<14}", b.name());
         for &n in &a.sizes {
-            let mut best = f64::INFINITY;
-            for seed in 1..=BASELINE_REPEATS {
-                let t = Instant::now();
-                let pts = b.generate(n, seed);
-                best = best.min(t.elapsed().as_secs_f64() * 1e3);
-                anyhow::ensure!(pts.len() == n, "{b} made {} points, not {n}", pts.len());
-            }
+            let best = baselines::best_ms_per_set(b, n, BASELINE_REPEATS)?;
             print!(" {best:>10.2}");
         }
         println!();
@@ -264,8 +210,14 @@ fn run_square(a: &BenchArgs) -> Result<()> {
         "N", "fast ms/epoch", "dense ms/epoch", "ratio"
     );
     for &n in &a.sizes {
-        let fast = seconds_per_epoch(&a.density, n, a.fast_epochs, GradientPath::Fast)?;
-        let dense = seconds_per_epoch(&a.density, n, a.dense_epochs, GradientPath::Dense)?;
+        let fast =
+            optimizer::square_seconds_per_epoch(&a.density, n, a.fast_epochs, GradientPath::Fast)?;
+        let dense = optimizer::square_seconds_per_epoch(
+            &a.density,
+            n,
+            a.dense_epochs,
+            GradientPath::Dense,
+        )?;
         println!(
             "{n:>6} {:>14.2} {:>14.2} {:>7.1}x",
             fast * 1e3,
@@ -275,7 +227,7 @@ fn run_square(a: &BenchArgs) -> Result<()> {
     }
     if a.full_n > 0 {
         println!("full default runs ({} epochs), N = {}:", d.epochs, a.full_n);
-        let s = full_run(&a.density, a.full_n, AreaOption::Exact)?;
+        let s = optimizer::square_full_run(&a.density, a.full_n, AreaOption::Exact)?;
         println!("  {:<50} {s:>7.1} s   (paper, RTX A5000: 150 s)", a.density);
         let mc = AreaOption::MonteCarlo { samples: 65536 };
         for (area, label) in [
@@ -283,7 +235,7 @@ fn run_square(a: &BenchArgs) -> Result<()> {
             (mc, "MC areas, K = 65536"),
         ] {
             let name = format!("{} ({label})", a.image_density);
-            match full_run(&a.image_density, a.full_n, area) {
+            match optimizer::square_full_run(&a.image_density, a.full_n, area) {
                 Ok(s) => println!("  {name:<50} {s:>7.1} s   (paper, RTX A5000: 630 s, MC areas)"),
                 Err(e) => println!("  {name:<50} skipped: {e:#}"),
             }

@@ -12,6 +12,7 @@ pub mod gaussian;
 pub mod image;
 pub(crate) mod numeric;
 pub mod quarter_disc;
+pub mod spec_syntax;
 pub mod special;
 pub mod uniform;
 
@@ -22,46 +23,18 @@ pub use bilinear::Bilinear;
 pub use gaussian::{StepGaussian, TruncatedGaussian};
 pub use image::TabulatedDensity;
 pub use quarter_disc::QuarterDisc;
+pub use spec_syntax::{SpecFamily, SpecSyntaxError};
 pub use uniform::Uniform;
+
+pub(crate) use spec_syntax::split_params;
 
 /// Why a density could not be built (from a SPEC string, parameters, a file or a
 /// grid). `Display` is a single line naming the problem.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum DensityError {
-    /// The SPEC string is empty (or only whitespace).
-    #[error("empty density spec (expected e.g. `uniform` or `gaussian:0.5,0.5,0.15`)")]
-    EmptySpec,
-    /// The part of the SPEC before `:` names no known density.
-    #[error(
-        "unknown density spec kind `{kind}` (expected uniform, gaussian:MX,MY,SIGMA, \
-         bilinear:V00,V10,V01,V11, quarter-disc, step-gaussian or image:PATH)"
-    )]
-    UnknownKind {
-        /// The kind as written.
-        kind: String,
-    },
-    /// Wrong number of comma-separated parameters.
-    #[error("density `{kind}` takes {expected} parameter(s) ({usage}), got {got}")]
-    ParamCount {
-        /// Density kind.
-        kind: &'static str,
-        /// Usage string, e.g. `gaussian:MX,MY,SIGMA`.
-        usage: &'static str,
-        /// Number of parameters the kind takes.
-        expected: usize,
-        /// Number of parameters given.
-        got: usize,
-    },
-    /// A parameter does not parse as a number.
-    #[error("density `{kind}`: parameter {param} = `{text}` is not a number")]
-    NotANumber {
-        /// Density kind.
-        kind: &'static str,
-        /// Parameter name.
-        param: &'static str,
-        /// The text as written.
-        text: String,
-    },
+    /// The SPEC does not follow the grammar.
+    #[error(transparent)]
+    Syntax(#[from] SpecSyntaxError),
     /// A parameter is NaN or infinite.
     #[error("density `{kind}`: parameter {param} = {value} is not finite")]
     NonFinite {
@@ -173,42 +146,6 @@ pub(crate) fn one_line(s: impl std::fmt::Display) -> String {
         .join(" ")
 }
 
-/// Why a SPEC's comma-separated parameter list was refused ([`split_params`]).
-pub(crate) enum ParamError<'a> {
-    /// `got` parameters where the kind takes `expected`.
-    Count { expected: usize, got: usize },
-    /// Parameter `param` is not a number.
-    NotANumber { param: &'static str, text: &'a str },
-}
-
-/// The numbers of a SPEC's parameter list `text` (after the `:`), one per name in
-/// `names`; no list, or an empty one, is zero parameters. Shared by the 2D and the
-/// direction SPEC parsers, which map [`ParamError`] into their own error types and
-/// do their own range checks.
-pub(crate) fn split_params<'a>(
-    names: &[&'static str],
-    text: Option<&'a str>,
-) -> Result<Vec<f64>, ParamError<'a>> {
-    let parts: Vec<&str> = match text.map(str::trim) {
-        None | Some("") => Vec::new(),
-        Some(t) => t.split(',').map(str::trim).collect(),
-    };
-    if parts.len() != names.len() {
-        return Err(ParamError::Count {
-            expected: names.len(),
-            got: parts.len(),
-        });
-    }
-    parts
-        .iter()
-        .zip(names)
-        .map(|(&text, &param)| {
-            text.parse::<f64>()
-                .map_err(|_| ParamError::NotANumber { param, text })
-        })
-        .collect()
-}
-
 /// Parses the comma-separated numeric parameters of `kind` (all must be finite).
 fn parse_params(
     kind: &'static str,
@@ -216,19 +153,7 @@ fn parse_params(
     names: &[&'static str],
     text: Option<&str>,
 ) -> Result<Vec<f64>, DensityError> {
-    let values = split_params(names, text).map_err(|e| match e {
-        ParamError::Count { expected, got } => DensityError::ParamCount {
-            kind,
-            usage,
-            expected,
-            got,
-        },
-        ParamError::NotANumber { param, text } => DensityError::NotANumber {
-            kind,
-            param,
-            text: text.to_string(),
-        },
-    })?;
+    let values = split_params(SpecFamily::Square, kind, usage, names, text)?;
     for (&value, &param) in values.iter().zip(names) {
         if !value.is_finite() {
             return Err(DensityError::NonFinite { kind, param, value });
@@ -254,7 +179,10 @@ fn parse_params(
 pub fn parse_spec(spec: &str) -> Result<Box<dyn Density2D>, DensityError> {
     let spec = spec.trim();
     if spec.is_empty() {
-        return Err(DensityError::EmptySpec);
+        return Err(SpecSyntaxError::Empty {
+            family: SpecFamily::Square,
+        }
+        .into());
     }
     let (kind, rest) = match spec.split_once(':') {
         Some((k, r)) => (k.trim(), Some(r)),
@@ -298,9 +226,11 @@ pub fn parse_spec(spec: &str) -> Result<Box<dyn Density2D>, DensityError> {
             }
             Ok(Box::new(TabulatedDensity::from_file(path)?))
         }
-        other => Err(DensityError::UnknownKind {
+        other => Err(SpecSyntaxError::UnknownKind {
+            family: SpecFamily::Square,
             kind: other.to_string(),
-        }),
+        }
+        .into()),
     }
 }
 

@@ -3,7 +3,7 @@
 //! * [`eval`]: the paper's §5 figures and the held-out quality report of a
 //!   conditional sampler (`build-tool eval`);
 //! * [`render`]: the renderer study of paper Fig. 8 (`build-tool render`);
-//! * [`bench`]: speed of the optimizer, the trainer and the runtime
+//! * [`mod@bench`]: speed of the optimizer, the trainer and the runtime
 //!   (`build-tool bench`).
 
 pub mod bench;

@@ -5,7 +5,7 @@ use super::brdf_target::BrdfTarget;
 use super::closed_form::{CosineDirections, UniformDirections};
 use super::envmap::EnvmapDensity;
 use super::target::{DirectionDensity, DirectionSpecError};
-use crate::density::{split_params, ParamError};
+use crate::density::{split_params, SpecFamily, SpecSyntaxError};
 use nuld_core::blob::Domain;
 use nuld_core::brdf::BrdfModel;
 
@@ -31,7 +31,10 @@ pub fn parse_direction_spec(
 ) -> Result<Box<dyn DirectionDensity>, DirectionSpecError> {
     let spec = spec.trim();
     if spec.is_empty() {
-        return Err(DirectionSpecError::EmptySpec);
+        return Err(SpecSyntaxError::Empty {
+            family: SpecFamily::Direction,
+        }
+        .into());
     }
     if domain == Domain::Square {
         return Err(DirectionSpecError::SquareDomain {
@@ -82,9 +85,11 @@ pub fn parse_direction_spec(
             }
             Ok(Box::new(EnvmapDensity::from_file(path, domain)?))
         }
-        other => Err(DirectionSpecError::UnknownKind {
+        other => Err(SpecSyntaxError::UnknownKind {
+            family: SpecFamily::Direction,
             kind: other.to_string(),
-        }),
+        }
+        .into()),
     }
 }
 
@@ -95,19 +100,13 @@ fn params(
     names: &[&'static str],
     text: Option<&str>,
 ) -> Result<Vec<f64>, DirectionSpecError> {
-    split_params(names, text).map_err(|e| match e {
-        ParamError::Count { expected, got } => DirectionSpecError::ParamCount {
-            kind,
-            usage,
-            expected,
-            got,
-        },
-        ParamError::NotANumber { param, text } => DirectionSpecError::NotANumber {
-            kind,
-            param,
-            text: text.to_string(),
-        },
-    })
+    Ok(split_params(
+        SpecFamily::Direction,
+        kind,
+        usage,
+        names,
+        text,
+    )?)
 }
 
 #[cfg(test)]

@@ -19,7 +19,7 @@
 //!
 //! The SPEC parser that builds them is [`super::spec`].
 
-use crate::density::{fmt_num, DensityError};
+use crate::density::{fmt_num, DensityError, SpecSyntaxError};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
 use rand::{Rng, RngCore};
@@ -125,43 +125,9 @@ pub(crate) fn normalize_rule(rule: &mut [(DVec3, f64)]) {
 /// problem.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum DirectionSpecError {
-    /// The SPEC is empty or whitespace.
-    #[error(
-        "empty direction density spec (expected uniform, cosine, \
-         brdf:ROUGHNESS,THETA_O_DEG, brdf-burley:ROUGHNESS,THETA_O_DEG or envmap:PATH)"
-    )]
-    EmptySpec,
-    /// The kind before `:` is not a direction density.
-    #[error(
-        "unknown direction density spec kind `{kind}` (expected uniform, cosine, \
-         brdf:ROUGHNESS,THETA_O_DEG, brdf-burley:ROUGHNESS,THETA_O_DEG or envmap:PATH)"
-    )]
-    UnknownKind {
-        /// The kind as written.
-        kind: String,
-    },
-    /// Wrong number of comma-separated parameters.
-    #[error("direction density `{kind}` takes {expected} parameter(s) ({usage}), got {got}")]
-    ParamCount {
-        /// Density kind.
-        kind: &'static str,
-        /// Usage, e.g. `brdf:ROUGHNESS,THETA_O_DEG`.
-        usage: &'static str,
-        /// Parameters the kind takes.
-        expected: usize,
-        /// Parameters given.
-        got: usize,
-    },
-    /// A parameter does not parse as a number.
-    #[error("direction density `{kind}`: parameter {param} = `{text}` is not a number")]
-    NotANumber {
-        /// Density kind.
-        kind: &'static str,
-        /// Parameter name.
-        param: &'static str,
-        /// The text as written.
-        text: String,
-    },
+    /// The SPEC does not follow the grammar.
+    #[error(transparent)]
+    Syntax(#[from] SpecSyntaxError),
     /// A parameter is outside its valid range (NaN and infinities included).
     #[error("direction density `{kind}`: parameter {param} = {value} is outside {range}")]
     OutOfRange {

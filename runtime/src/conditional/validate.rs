@@ -2,8 +2,9 @@
 //! [`crate::Blob::parse`]: each failed check is its own [`ConditionalError`].
 
 use super::{ConditionalSampler, NetworkParams};
-use nuld_core::blob::{BlobError, ConditionalError, Domain, Layout, LayoutError, SectionTag};
-use nuld_core::conditional::{ConditionalInfo, ConditionalTarget, PointWarp, CONDITIONAL_INFO_LEN};
+use crate::section::{record, typed_section};
+use nuld_core::blob::{BlobError, ConditionalError, Domain, Layout, SectionTag};
+use nuld_core::conditional::{ConditionalInfo, ConditionalTarget, PointWarp};
 use nuld_core::network::Activation;
 use nuld_core::quantize::f16_is_finite;
 
@@ -25,14 +26,10 @@ impl<'a> ConditionalSampler<'a> {
     /// The sampler over a layout whose values [`Self::validate`] has checked once:
     /// re-checks the counts and section sizes (`O(1)`), not every value.
     pub(crate) fn view(layout: &Layout<'a>) -> Result<Self, BlobError> {
-        let (_, info_bytes) = layout.section(SectionTag::ConditionalInfo)?;
-        if info_bytes.len() != CONDITIONAL_INFO_LEN {
-            return fail(ConditionalError::InfoSize {
-                got: info_bytes.len() as u64,
-                expected: CONDITIONAL_INFO_LEN as u64,
-            });
-        }
-        let info: ConditionalInfo = bytemuck::pod_read_unaligned(info_bytes);
+        let info: ConditionalInfo =
+            record(layout, SectionTag::ConditionalInfo, |got, expected| {
+                ConditionalError::InfoSize { got, expected }
+            })?;
         if info.n == 0 {
             return fail(ConditionalError::NoPoints);
         }
@@ -162,30 +159,6 @@ impl<'a> ConditionalSampler<'a> {
         }
         Ok(())
     }
-}
-
-/// Section `tag` of `layout` as a slice of `T`, checked in this order: the section
-/// exists; its `elem_size` is `size_of::<T>()` (else `bad_size(elem_size)`); it holds
-/// exactly `expected()?` elements (else `bad_length(expected, got)`); it is aligned
-/// for `T` (else [`LayoutError::Misaligned`]).
-fn typed_section<'a, T: bytemuck::Pod>(
-    layout: &Layout<'a>,
-    tag: SectionTag,
-    bad_size: fn(u32) -> ConditionalError,
-    expected: impl FnOnce() -> Result<u64, ConditionalError>,
-    bad_length: fn(u64, u64) -> ConditionalError,
-) -> Result<&'a [T], BlobError> {
-    let (entry, bytes) = layout.section(tag)?;
-    let size = core::mem::size_of::<T>();
-    if entry.elem_size as usize != size {
-        return fail(bad_size(entry.elem_size));
-    }
-    let expected = expected()?;
-    let got = (bytes.len() / size) as u64;
-    if got != expected {
-        return fail(bad_length(expected, got));
-    }
-    bytemuck::try_cast_slice(bytes).map_err(|_| LayoutError::Misaligned.into())
 }
 
 /// `Err(e)` as a [`BlobError`].

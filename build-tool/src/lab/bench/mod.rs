@@ -1,6 +1,9 @@
-//! Speed measurements printed by `build-tool bench`: [`training`], the trainer's
-//! time per step; [`runtime`], the runtime's cost per sample against the
-//! incumbent a renderer would otherwise use.
+//! Speed measurements printed by `build-tool bench`: [`optimizer`], the 2D and
+//! direction optimizers per epoch and per full run; [`baselines`], the baseline
+//! generators per set; [`training`], the trainer's time per step; [`runtime`], the
+//! runtime's cost per sample against the incumbent a renderer would otherwise use.
 
+pub mod baselines;
+pub mod optimizer;
 pub mod runtime;
 pub mod training;

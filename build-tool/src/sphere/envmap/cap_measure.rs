@@ -77,7 +77,7 @@ impl EnvmapDensity {
     }
 
     /// The cap measure with at least `min_pieces` integration pieces per row (1 in
-    /// [`DirectionDensity::cap_measure`]; more only to study convergence).
+    /// [`DirectionDensity::cap_measure`](crate::sphere::DirectionDensity::cap_measure); more only to study convergence).
     pub fn cap_measure_with(&self, center: DVec3, cos_theta: f64, min_pieces: usize) -> f64 {
         if cos_theta > 1.0 {
             return 0.0;

@@ -144,7 +144,7 @@ pub fn cap_star_estimate_with(
 /// [`cap_star_estimate_with`] whose random caps (phase 1) are `screened`: drawn
 /// once with [`CapRadius::ThetaUniform`] (`options.random_caps` is ignored) and
 /// measured beforehand, possibly by something cheaper than the exact
-/// `cap_measure` (e.g. a [`super::CapMeasureTable`] of a target whose exact
+/// `cap_measure` (e.g. a [`CapMeasureTable`](crate::sphere::CapMeasureTable) of a target whose exact
 /// measure costs `O(H)`), so that many sets share the cost. The `refine` best of
 /// them are scored again with the exact `density.cap_measure`, as are the refined
 /// caps: the reported value rests on exact measures only.

@@ -18,7 +18,7 @@
 //!
 //! Parallel sums use fixed chunks combined in a fixed order, so every result is
 //! bit-identical whatever the number of threads.//!
-//! [`cap_l2`] holds the L2 forms, [`cap_star`] the star search, [`diversity`] the
+//! [`cap_l2`] holds the L2 forms, [`cap_star`] the star search, [`mod@diversity`] the
 //! diversity of many instances of a conditional sampler (their union and their
 //! nearest neighbours).
 
