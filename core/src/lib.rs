@@ -11,6 +11,8 @@
 //! * [`warp`]: the warps baselines sample with (concentric disk, cosine hemisphere,
 //!   GGX visible normals), each beside its density and its inverse;
 //! * [`domain`]: where a set's points live and the map from square to direction;
+//! * [`marginal2d`]: tabulated conditional 2D warps, blended between the nodes of a
+//!   parameter grid and sampled exactly, with their pdf and inverse;
 //! * [`conditional`]: the conditional sampler's info record, condition grid and
 //!   bilinear interpolation (blob kind 3);
 //! * [`network`]: the conditional sampler's network (features, forward pass), one
@@ -36,6 +38,7 @@ pub mod blob;
 pub mod brdf;
 pub mod conditional;
 pub mod domain;
+pub mod marginal2d;
 pub mod network;
 pub mod quantize;
 pub mod real;

@@ -1,0 +1,545 @@
+//! Tabulated conditional 2D warps: a density on the unit square given by a table
+//! per node of a parameter grid, sampled *exactly* at any parameter between the
+//! nodes (the idea of Mitsuba 3's `Marginal2D<Dim>` and pbrt-v4's
+//! `PiecewiseLinear2D<Dim>`).
+//!
+//! **Tables.** Each node's table holds the density's values at the `nx x ny`
+//! vertices `(i / (nx - 1), j / (ny - 1))` of a grid on `[0,1]^2`; between vertices
+//! the density is the bilinear interpolant. [`tabulate`] normalizes each table to
+//! integrate to 1 and stores beside it two cumulative tables, exact for the
+//! bilinear interpolant: per vertex row `j`, `C_j(x_i) = ∫_0^{x_i} f(x, y_j) dx`
+//! (the trapezoid rule is exact on linear pieces), and the marginal
+//! `M(y_j) = ∫_0^{y_j} ∫_0^1 f(x, y) dx dy` (the row integral is linear in `y`
+//! between vertex rows).
+//!
+//! **Blends.** A query's parameters select a [`Blend`]: at most `2^3` node tables
+//! with convex weights (multilinear between the nodes of a regular grid,
+//! [`Blend::multilinear`], or any weights the caller computes, e.g. wrapping
+//! around a sphere). Values and both cumulative tables are linear in the data, so
+//! the blend's cumulative tables are the blends of the nodes' ones and cost
+//! `O(2^d)` per lookup.
+//!
+//! **The warp** ([`Marginal2D::sample`]) inverts the blend's marginal CDF in `y`,
+//! then its conditional CDF in `x` at that `y`, each a quadratic within one cell
+//! (the density is linear along each axis there), found by binary search: work
+//! `O(2^d (log nx + log ny))` per sample, no allocation, no panic.
+//! [`Marginal2D::pdf`] is the blend's bilinear value over its total mass: *exactly*
+//! the density of the points `sample` returns (up to rounding), not an
+//! approximation of it. [`Marginal2D::invert`] is `sample`'s inverse.
+
+use crate::real::Real;
+
+/// Most parameter dimensions of a warp (a blend has at most `2^3` nodes).
+pub const MAX_PARAMS: usize = 3;
+
+/// Most nodes in one blend: `2^MAX_PARAMS`.
+pub const MAX_BLEND: usize = 1 << MAX_PARAMS;
+
+/// The sizes of a warp: vertices per table axis and the number of node tables.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Marginal2DShape {
+    /// Vertices per axis of each table, `[nx, ny]`, each at least 2.
+    pub size: [u32; 2],
+    /// Node tables, at least 1.
+    pub nodes: u32,
+}
+
+impl Marginal2DShape {
+    /// Values per table, `nx ny` (`None` on overflow).
+    pub fn table_len(&self) -> Option<usize> {
+        (self.size[0] as usize).checked_mul(self.size[1] as usize)
+    }
+
+    /// Length of the data and of the conditional CDFs: `nodes nx ny`.
+    pub fn data_len(&self) -> Option<usize> {
+        self.table_len()?.checked_mul(self.nodes as usize)
+    }
+
+    /// Length of the marginal CDFs: `nodes ny`.
+    pub fn marginal_len(&self) -> Option<usize> {
+        (self.size[1] as usize).checked_mul(self.nodes as usize)
+    }
+}
+
+/// Why tables were refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Marginal2DError {
+    /// A table axis has fewer than 2 vertices, or there is no node.
+    Shape,
+    /// A slice's length is not the shape's (`data`, `marginal`, `conditional`).
+    Length {
+        /// Which slice: 0 data, 1 marginal, 2 conditional.
+        slice: u8,
+        /// Length the shape asks for (`u64::MAX` if it overflows).
+        expected: u64,
+        /// Length given.
+        got: u64,
+    },
+    /// A value is negative, NaN or infinite (index into its slice).
+    BadValue {
+        /// Which slice: 0 data, 1 marginal, 2 conditional.
+        slice: u8,
+        /// Index of the value.
+        index: u64,
+    },
+    /// A cumulative table decreases (index into its slice).
+    Decreasing {
+        /// Which slice: 1 marginal, 2 conditional.
+        slice: u8,
+        /// Index of the value below its predecessor.
+        index: u64,
+    },
+    /// A node's table has no mass (or its mass is not finite).
+    NoMass {
+        /// The node.
+        node: u32,
+    },
+}
+
+impl core::fmt::Display for Marginal2DError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        const SLICES: [&str; 3] = ["data", "marginal CDF", "conditional CDF"];
+        let name = |s: u8| SLICES.get(s as usize).copied().unwrap_or("table");
+        match *self {
+            Self::Shape => write!(f, "a warp table needs at least 2 x 2 vertices and 1 node"),
+            Self::Length {
+                slice,
+                expected,
+                got,
+            } => write!(f, "warp {}: {got} values, expected {expected}", name(slice)),
+            Self::BadValue { slice, index } => {
+                write!(
+                    f,
+                    "warp {} value {index} is negative or not finite",
+                    name(slice)
+                )
+            }
+            Self::Decreasing { slice, index } => {
+                write!(f, "warp {} decreases at {index}", name(slice))
+            }
+            Self::NoMass { node } => write!(f, "warp node {node} has no mass"),
+        }
+    }
+}
+
+/// Node tables with convex weights: what a query's parameters select.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Blend<T> {
+    nodes: [u32; MAX_BLEND],
+    weights: [T; MAX_BLEND],
+    len: usize,
+}
+
+impl<T: Real> Blend<T> {
+    /// Node `node` alone (weight 1).
+    pub fn single(node: u32) -> Self {
+        let mut b = Self::empty();
+        b.push(node, T::ONE);
+        b
+    }
+
+    /// The multilinear blend on a regular grid of `counts[k]` nodes over `[0, 1]`
+    /// per parameter `k` (node `(i_0, i_1, i_2)` is table `i_0 + counts[0] (i_1 +
+    /// counts[1] i_2)`): each parameter clamped into `[0, 1]` (NaN is 0) and
+    /// weighted between its two neighbouring nodes. At most [`MAX_PARAMS`]
+    /// parameters are read (`params` and `counts` pair up, the shorter decides); a
+    /// count of 0 or 1 pins its parameter to node 0. Exactly a node's table at
+    /// the node.
+    pub fn multilinear(params: &[T], counts: &[u32]) -> Self {
+        let d = params.len().min(counts.len()).min(MAX_PARAMS);
+        let mut lower = [0u32; MAX_PARAMS];
+        let mut frac = [T::ZERO; MAX_PARAMS];
+        let mut stride = [0u32; MAX_PARAMS];
+        let mut s = 1u32;
+        for k in 0..d {
+            stride[k] = s;
+            let c = counts[k].max(1);
+            s = s.saturating_mul(c);
+            if c < 2 {
+                continue;
+            }
+            let p = params[k];
+            let p = if p >= T::ZERO { p.min(T::ONE) } else { T::ZERO };
+            let pos = p * T::of((c - 1) as f64);
+            let i = (pos.floor().to_f64() as u32).min(c - 2);
+            lower[k] = i;
+            frac[k] = pos - T::of(i as f64);
+        }
+        let mut b = Self::empty();
+        for corner in 0..(1usize << d) {
+            let mut node = 0u32;
+            let mut w = T::ONE;
+            for k in 0..d {
+                let up = (corner >> k) & 1 == 1;
+                let i = lower[k] + u32::from(up);
+                node = node.saturating_add(i.saturating_mul(stride[k]));
+                w = w * if up { frac[k] } else { T::ONE - frac[k] };
+            }
+            if w > T::ZERO {
+                b.push(node, w);
+            }
+        }
+        if b.len == 0 {
+            b.push(0, T::ONE);
+        }
+        b
+    }
+
+    /// The blend of `(node, weight)` pairs (at most [`MAX_BLEND`]; the rest are
+    /// ignored), negative or NaN weights read as 0; the caller makes them sum to
+    /// 1 (the warp divides by the blend's mass, so any positive sum samples the
+    /// same density).
+    pub fn from_pairs(pairs: &[(u32, T)]) -> Self {
+        let mut b = Self::empty();
+        for &(node, w) in pairs.iter().take(MAX_BLEND) {
+            b.push(node, if w > T::ZERO { w } else { T::ZERO });
+        }
+        b
+    }
+
+    /// The `(node, weight)` pairs.
+    pub fn pairs(&self) -> impl Iterator<Item = (u32, T)> + '_ {
+        self.nodes[..self.len]
+            .iter()
+            .copied()
+            .zip(self.weights[..self.len].iter().copied())
+    }
+
+    fn empty() -> Self {
+        Self {
+            nodes: [0; MAX_BLEND],
+            weights: [T::ZERO; MAX_BLEND],
+            len: 0,
+        }
+    }
+
+    fn push(&mut self, node: u32, w: T) {
+        if self.len < MAX_BLEND {
+            self.nodes[self.len] = node;
+            self.weights[self.len] = w;
+            self.len += 1;
+        }
+    }
+}
+
+/// Normalizes each node's table of `data` in place (its bilinear interpolant
+/// integrates to 1 over `[0,1]^2`) and fills `marginal` and `conditional` with its
+/// cumulative tables (module docs), all in `T`'s arithmetic. The layout: node
+/// `k`'s vertex `(i, j)` is `data[(k ny + j) nx + i]` and `conditional[...]` at the
+/// same index; its marginal at row `j` is `marginal[k ny + j]`.
+pub fn tabulate<T: Real>(
+    shape: Marginal2DShape,
+    data: &mut [T],
+    marginal: &mut [T],
+    conditional: &mut [T],
+) -> Result<(), Marginal2DError> {
+    check_lengths(shape, data.len(), marginal.len(), conditional.len())?;
+    if let Some(index) = data.iter().position(|&v| !(v >= T::ZERO && v.is_finite())) {
+        return Err(Marginal2DError::BadValue {
+            slice: 0,
+            index: index as u64,
+        });
+    }
+    let (nx, ny) = (shape.size[0] as usize, shape.size[1] as usize);
+    let half_dx = T::of(0.5) / T::of((nx - 1) as f64);
+    let half_dy = T::of(0.5) / T::of((ny - 1) as f64);
+    for k in 0..shape.nodes as usize {
+        let table = k * nx * ny;
+        for j in 0..ny {
+            let row = table + j * nx;
+            conditional[row] = T::ZERO;
+            for i in 1..nx {
+                conditional[row + i] =
+                    conditional[row + i - 1] + half_dx * (data[row + i - 1] + data[row + i]);
+            }
+        }
+        let m = k * ny;
+        marginal[m] = T::ZERO;
+        for j in 1..ny {
+            let r0 = conditional[table + j * nx - 1];
+            let r1 = conditional[table + (j + 1) * nx - 1];
+            marginal[m + j] = marginal[m + j - 1] + half_dy * (r0 + r1);
+        }
+        let total = marginal[m + ny - 1];
+        if !(total > T::ZERO && total.is_finite()) {
+            return Err(Marginal2DError::NoMass { node: k as u32 });
+        }
+        let inv = T::ONE / total;
+        for v in &mut data[table..table + nx * ny] {
+            *v = *v * inv;
+        }
+        for v in &mut conditional[table..table + nx * ny] {
+            *v = *v * inv;
+        }
+        for v in &mut marginal[m..m + ny] {
+            *v = *v * inv;
+        }
+    }
+    Ok(())
+}
+
+fn check_lengths(
+    shape: Marginal2DShape,
+    data: usize,
+    marginal: usize,
+    conditional: usize,
+) -> Result<(), Marginal2DError> {
+    if shape.size[0] < 2 || shape.size[1] < 2 || shape.nodes == 0 {
+        return Err(Marginal2DError::Shape);
+    }
+    let want = |n: Option<usize>| n.map_or(u64::MAX, |n| n as u64);
+    for (slice, expected, got) in [
+        (0u8, want(shape.data_len()), data),
+        (1, want(shape.marginal_len()), marginal),
+        (2, want(shape.data_len()), conditional),
+    ] {
+        if expected != got as u64 {
+            return Err(Marginal2DError::Length {
+                slice,
+                expected,
+                got: got as u64,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// A tabulated conditional 2D warp over borrowed tables (see the module docs).
+#[derive(Clone, Copy, Debug)]
+pub struct Marginal2D<'a, T> {
+    nx: usize,
+    ny: usize,
+    nodes: usize,
+    data: &'a [T],
+    marginal: &'a [T],
+    conditional: &'a [T],
+}
+
+impl<'a, T: Real> Marginal2D<'a, T> {
+    /// The warp over tables laid out as [`tabulate`] writes them. Checks, in order:
+    /// the shape; the three lengths; every value finite and non-negative; each
+    /// cumulative row and each marginal non-decreasing; each node's mass positive.
+    /// `O(nodes nx ny)`, once. Tables that pass but were not written by
+    /// [`tabulate`] still never make the warp panic; its pdf is then only as exact
+    /// as they are consistent.
+    pub fn new(
+        shape: Marginal2DShape,
+        data: &'a [T],
+        marginal: &'a [T],
+        conditional: &'a [T],
+    ) -> Result<Self, Marginal2DError> {
+        check_lengths(shape, data.len(), marginal.len(), conditional.len())?;
+        for (slice, values) in [(0u8, data), (1, marginal), (2, conditional)] {
+            if let Some(index) = values
+                .iter()
+                .position(|&v| !(v >= T::ZERO && v.is_finite()))
+            {
+                return Err(Marginal2DError::BadValue {
+                    slice,
+                    index: index as u64,
+                });
+            }
+        }
+        let (nx, ny) = (shape.size[0] as usize, shape.size[1] as usize);
+        for (slice, values, run) in [(1u8, marginal, ny), (2, conditional, nx)] {
+            for (r, chunk) in values.chunks(run).enumerate() {
+                if let Some(i) = chunk.windows(2).position(|w| w[1] < w[0]) {
+                    return Err(Marginal2DError::Decreasing {
+                        slice,
+                        index: (r * run + i + 1) as u64,
+                    });
+                }
+            }
+        }
+        for (node, m) in marginal.chunks(ny).enumerate() {
+            if !positive(m[ny - 1]) {
+                return Err(Marginal2DError::NoMass { node: node as u32 });
+            }
+        }
+        Ok(Self {
+            nx,
+            ny,
+            nodes: shape.nodes as usize,
+            data,
+            marginal,
+            conditional,
+        })
+    }
+
+    /// The blend's value of `values` at offset `at` of each node's block of
+    /// `block` values (nodes past the tables count as 0).
+    #[inline]
+    fn blended(&self, values: &[T], block: usize, at: usize, blend: &Blend<T>) -> T {
+        let mut s = T::ZERO;
+        for (node, w) in blend.pairs() {
+            if (node as usize) < self.nodes {
+                if let Some(&v) = values.get(node as usize * block + at) {
+                    s = s + w * v;
+                }
+            }
+        }
+        s
+    }
+
+    fn m(&self, j: usize, b: &Blend<T>) -> T {
+        self.blended(self.marginal, self.ny, j, b)
+    }
+
+    fn c(&self, j: usize, i: usize, b: &Blend<T>) -> T {
+        self.blended(self.conditional, self.nx * self.ny, j * self.nx + i, b)
+    }
+
+    fn f(&self, j: usize, i: usize, b: &Blend<T>) -> T {
+        self.blended(self.data, self.nx * self.ny, j * self.nx + i, b)
+    }
+
+    /// The blended conditional CDF at vertex `i` of the row at `y = (j + t) dy`.
+    fn c_at(&self, j: usize, t: T, i: usize, b: &Blend<T>) -> T {
+        (T::ONE - t) * self.c(j, i, b) + t * self.c(j + 1, i, b)
+    }
+
+    /// The blended density at vertex `i` of the row at `y = (j + t) dy`.
+    fn f_at(&self, j: usize, t: T, i: usize, b: &Blend<T>) -> T {
+        (T::ONE - t) * self.f(j, i, b) + t * self.f(j + 1, i, b)
+    }
+
+    /// Draws the point at primary sample `u` in `[0,1]^2` from the blend's
+    /// density and returns it with its density ([`Self::pdf`]). `u` outside the
+    /// square is clamped into it (NaN as 0).
+    pub fn sample(&self, u: [T; 2], blend: &Blend<T>) -> ([T; 2], T) {
+        let (nx, ny) = (self.nx, self.ny);
+        let total = self.m(ny - 1, blend);
+        // y: the marginal, then the quadratic within the row interval.
+        let target = unit(u[1]) * total;
+        let j = search(ny, target, |j| self.m(j, blend));
+        let dy = T::ONE / T::of((ny - 1) as f64);
+        let (r0, r1) = (self.c(j, nx - 1, blend), self.c(j + 1, nx - 1, blend));
+        let t = solve_linear(r0 * dy, r1 * dy, target - self.m(j, blend));
+        let y = (T::of(j as f64) + t) * dy;
+        // x: the conditional CDF of the row at y, then the quadratic in the cell.
+        let row_total = self.c_at(j, t, nx - 1, blend);
+        let x = if row_total > T::ZERO {
+            let target = unit(u[0]) * row_total;
+            let i = search(nx, target, |i| self.c_at(j, t, i, blend));
+            let dx = T::ONE / T::of((nx - 1) as f64);
+            let (g0, g1) = (self.f_at(j, t, i, blend), self.f_at(j, t, i + 1, blend));
+            let s = solve_linear(g0 * dx, g1 * dx, target - self.c_at(j, t, i, blend));
+            (T::of(i as f64) + s) * dx
+        } else {
+            // A row without mass (only at a row interval's end): any x, density 0.
+            unit(u[0])
+        };
+        let p = [x.min(T::ONE), y.min(T::ONE)];
+        (p, self.pdf(p, blend))
+    }
+
+    /// The density at `p` in `[0,1]^2` (clamped into it) of the points
+    /// [`Self::sample`] draws: the blend's bilinear value over the blend's mass
+    /// (per unit area of the square).
+    pub fn pdf(&self, p: [T; 2], blend: &Blend<T>) -> T {
+        let total = self.m(self.ny - 1, blend);
+        if !positive(total) {
+            return T::ZERO;
+        }
+        let (i, s) = cell(p[0], self.nx);
+        let (j, t) = cell(p[1], self.ny);
+        let lo = (T::ONE - s) * self.f(j, i, blend) + s * self.f(j, i + 1, blend);
+        let hi = (T::ONE - s) * self.f(j + 1, i, blend) + s * self.f(j + 1, i + 1, blend);
+        ((T::ONE - t) * lo + t * hi) / total
+    }
+
+    /// The primary sample that [`Self::sample`] maps to `p` (clamped into the
+    /// square): the blend's marginal CDF at `p.y` and its conditional CDF at `p.x`.
+    pub fn invert(&self, p: [T; 2], blend: &Blend<T>) -> [T; 2] {
+        let (nx, ny) = (self.nx, self.ny);
+        let total = self.m(ny - 1, blend);
+        if !positive(total) {
+            return [unit(p[0]), unit(p[1])];
+        }
+        let (j, t) = cell(p[1], ny);
+        let dy = T::ONE / T::of((ny - 1) as f64);
+        let (r0, r1) = (self.c(j, nx - 1, blend), self.c(j + 1, nx - 1, blend));
+        let uy = (self.m(j, blend) + linear_integral(r0 * dy, r1 * dy, t)) / total;
+        let row_total = self.c_at(j, t, nx - 1, blend);
+        let ux = if row_total > T::ZERO {
+            let (i, s) = cell(p[0], nx);
+            let dx = T::ONE / T::of((nx - 1) as f64);
+            let (g0, g1) = (self.f_at(j, t, i, blend), self.f_at(j, t, i + 1, blend));
+            (self.c_at(j, t, i, blend) + linear_integral(g0 * dx, g1 * dx, s)) / row_total
+        } else {
+            unit(p[0])
+        };
+        [unit(ux), unit(uy)]
+    }
+}
+
+/// Whether `x > 0` (false for NaN).
+fn positive<T: Real>(x: T) -> bool {
+    x > T::ZERO
+}
+
+/// `x` clamped into `[0, 1]`, NaN as 0.
+fn unit<T: Real>(x: T) -> T {
+    if x >= T::ZERO {
+        x.min(T::ONE)
+    } else {
+        T::ZERO
+    }
+}
+
+/// The cell of `x` (clamped into `[0, 1]`) on `n` vertices and the position in it,
+/// `(k, s)` with `x = (k + s) / (n - 1)`, `k <= n - 2`.
+fn cell<T: Real>(x: T, n: usize) -> (usize, T) {
+    let pos = unit(x) * T::of((n - 1) as f64);
+    let k = (pos.floor().to_f64() as usize).min(n - 2);
+    (k, unit(pos - T::of(k as f64)))
+}
+
+/// The interval `k` in `0..n-1` with `cdf(k) <= target < cdf(k + 1)` of a
+/// non-decreasing `cdf` on `n` vertices, skipping intervals without mass (the
+/// last such interval at or below `target`; interval 0 if none has mass there).
+fn search<T: Real>(n: usize, target: T, cdf: impl Fn(usize) -> T) -> usize {
+    // The largest k in 0..=n-2 with cdf(k) <= target (0 if none).
+    let (mut lo, mut hi) = (0usize, n - 1);
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if cdf(mid) <= target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let mut k = lo;
+    // Move off an interval without mass: down while the interval is empty (a
+    // target at the top of the CDF), up while it is empty (a target at 0).
+    while k > 0 && cdf(k + 1) <= cdf(k) {
+        k -= 1;
+    }
+    while k + 2 < n && cdf(k + 1) <= cdf(k) {
+        k += 1;
+    }
+    k
+}
+
+/// `∫_0^s (a + (b - a) r) dr = a s + (b - a) s^2 / 2`: the mass below `s` of a
+/// linear density with ends `a` and `b` on `[0, 1]`.
+fn linear_integral<T: Real>(a: T, b: T, s: T) -> T {
+    a * s + T::of(0.5) * (b - a) * s * s
+}
+
+/// The `s` in `[0, 1]` with [`linear_integral`]`(a, b, s) = v`, for `a, b >= 0`:
+/// `s = 2 v / (a + sqrt(a^2 + 2 (b - a) v))`, the root without cancellation
+/// (pbrt's `SampleLinear` in its stable form); 0 where the interval has no mass.
+fn solve_linear<T: Real>(a: T, b: T, v: T) -> T {
+    let v = v.max(T::ZERO);
+    let disc = (a * a + T::of(2.0) * (b - a) * v).max(T::ZERO);
+    let den = a + disc.sqrt();
+    if den > T::ZERO {
+        unit(T::of(2.0) * v / den)
+    } else {
+        T::ZERO
+    }
+}
+
+#[cfg(test)]
+mod tests;
