@@ -122,6 +122,8 @@ impl core::fmt::Display for Marginal2DError {
     }
 }
 
+impl core::error::Error for Marginal2DError {}
+
 /// Node tables with convex weights: what a query's parameters select.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Blend<T> {

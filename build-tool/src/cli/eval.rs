@@ -29,6 +29,11 @@ pub enum FigArg {
     /// vs Owen-Sobol + exact inverse CDF, + VNDF/cosine mixture, and per-condition
     /// optimization; instance diversity. Writes conditional.json, .csv, PNGs.
     Conditional,
+    /// An environment map's product warp as a prior (`--envmap MAP`): cap L2 at
+    /// held-out normals of Owen-Sobol and of a shifted lattice through it, over
+    /// Owen-Sobol through each normal's exact inverse CDF, by --grids and --sizes;
+    /// the tables' size. Writes envmap-prior.json and envmap-prior.md.
+    EnvmapPrior,
 }
 
 /// Arguments of `build-tool eval`.
@@ -86,9 +91,19 @@ pub struct EvalArgs {
     /// [default: 64, --quick: 16].
     #[arg(long, value_parser = super::count)]
     pub n_instances: Option<usize>,
-    /// conditional: points per set of the --calibrate sampler.
+    /// conditional: points per set of the --calibrate sampler; envmap-prior:
+    /// points per set.
     #[arg(long, default_value_t = 64, value_parser = super::count)]
     pub n: usize,
+    /// envmap-prior: the environment map (PNG, JPEG, HDR or EXR; equirectangular).
+    #[arg(long)]
+    pub envmap: Option<PathBuf>,
+    /// envmap-prior: normal grids, nodes per axis (each >= 2).
+    #[arg(long, value_delimiter = ',', default_value = "9,13,17")]
+    pub grids: Vec<u32>,
+    /// envmap-prior: table sizes, vertices per axis (each >= 2).
+    #[arg(long, value_delimiter = ',', default_value = "32,64,128")]
+    pub sizes: Vec<u32>,
 }
 
 impl EvalArgs {
@@ -132,6 +147,7 @@ pub fn run(a: EvalArgs) -> Result<()> {
         FigArg::Fig7 => vec![Figure::Fig7],
         FigArg::All => Figure::ALL.to_vec(),
         FigArg::Conditional => return run_conditional(&a),
+        FigArg::EnvmapPrior => return run_envmap_prior(&a),
     };
     let s = a.settings();
     s.validate()?;
@@ -197,6 +213,53 @@ fn run_conditional(a: &EvalArgs) -> Result<()> {
         "conditional: {} conditions, {} file(s) in {:.1} s -> {}",
         rep.conditions.len(),
         files.len(),
+        started.elapsed().as_secs_f64(),
+        a.out.display()
+    );
+    Ok(())
+}
+
+/// `build-tool eval envmap-prior`: reads the map, measures, writes, prints.
+fn run_envmap_prior(a: &EvalArgs) -> Result<()> {
+    use crate::lab::eval::envmap_prior::{evaluate, markdown, PriorSettings};
+    let path = a
+        .envmap
+        .as_ref()
+        .ok_or_else(|| anyhow::anyhow!("eval envmap-prior needs --envmap MAP"))?;
+    anyhow::ensure!(
+        a.grids.iter().chain(&a.sizes).all(|&v| v >= 2),
+        "--grids and --sizes need values of at least 2"
+    );
+    let s = PriorSettings {
+        grids: a.grids.clone(),
+        sizes: a.sizes.clone(),
+        n: u32::try_from(a.n).map_err(|_| anyhow::anyhow!("--n {} is too large", a.n))?,
+        ..PriorSettings::default()
+    };
+    let map =
+        crate::sphere::EnvmapDensity::from_file_filtered(path, nuld_core::blob::Domain::Sphere)
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
+    crate::output::ensure_dir(&a.out)?;
+    let started = Instant::now();
+    let total = (s.normals + s.grids.len() * s.sizes.len()) as u64;
+    let progress = crate::progress::Progress::stderr("envmap-prior", total, "step");
+    let rows = evaluate(&map, &s, &|what| {
+        progress.set_message(what.to_string());
+        progress.inc(1);
+    })?;
+    progress.finish();
+    let table = markdown(&rows);
+    let json = serde_json::to_string_pretty(&serde_json::json!({
+        "map": path.display().to_string(),
+        "settings": s,
+        "rows": rows,
+    }))?;
+    crate::output::write_atomic(&a.out.join("envmap-prior.json"), json.as_bytes())?;
+    crate::output::write_atomic(&a.out.join("envmap-prior.md"), table.as_bytes())?;
+    print!("{table}");
+    eprintln!(
+        "envmap-prior: {} configurations in {:.1} s -> {}",
+        rows.len(),
         started.elapsed().as_secs_f64(),
         a.out.display()
     );

@@ -7,6 +7,8 @@
 //!   `brdf:ROUGHNESS,THETA_O_DEG` (`brdf-burley:...`), `envmap:PATH`;
 //! * [`closed_form`]: the `uniform` and `cosine` targets;
 //! * [`brdf_target`], [`envmap`]: the two tabulated targets;
+//! * [`envmap_prior`]: [`EnvmapPrior`], a map's `L cos` tabulated for a grid of
+//!   normals and sampled exactly between them (the environment sampler's prior);
 //! * [`filtered_luminance`]: a map's bilinearly filtered luminance (the light of
 //!   `bake --envmap` and `render`) and its exact tabulation on half pixels;
 //! * [`brdf_albedo`]: the BRDF's directional albedo (the `brdf` normalizer and the
@@ -28,6 +30,7 @@ pub mod brdf_target;
 pub mod cap_table;
 pub mod closed_form;
 pub mod envmap;
+pub mod envmap_prior;
 pub mod equirect;
 pub mod filtered_luminance;
 pub mod geometry;
@@ -40,6 +43,7 @@ pub use brdf_target::BrdfTarget;
 pub use cap_table::CapMeasureTable;
 pub use closed_form::{CosineDirections, UniformDirections};
 pub use envmap::EnvmapDensity;
+pub use envmap_prior::EnvmapPrior;
 pub use filtered_luminance::FilteredLuminance;
 pub use geometry::{
     cosine_cap_measure, random_direction, uniform_hemisphere_cap_measure,

@@ -16,11 +16,15 @@
 //! `figN-summary.md` ([`summary`]: ours against the best other method).
 //! Everything is deterministic given the seeds ([`methods::realization_seed`]).
 //!
+//! [`envmap_prior`] measures an environment map's product warp as a prior, by
+//! normal grid and table size (`build-tool eval envmap-prior`).
+//!
 //! [`conditional`] is the quality report of a conditional BRDF sampler (paper §4)
 //! on held-out conditions (`build-tool eval conditional`).
 
 pub mod cache;
 pub mod conditional;
+pub mod envmap_prior;
 pub mod figures;
 pub mod integrands;
 pub mod methods;
