@@ -15,6 +15,8 @@
 //!   parameter grid and sampled exactly, with their pdf and inverse;
 //! * [`conditional`]: the conditional sampler's info record, condition grid and
 //!   bilinear interpolation (blob kind 3);
+//! * [`quadtree`]: hierarchical product warping over a mip pyramid of masses times
+//!   a factor known at the query, with its pdf and inverse;
 //! * [`network`]: the conditional sampler's network (features, forward pass), one
 //!   formula for the trainer and the runtime;
 //! * [`quantize`]: the u16 unorm and f16 codecs blobs store values with;
@@ -40,6 +42,7 @@ pub mod conditional;
 pub mod domain;
 pub mod marginal2d;
 pub mod network;
+pub mod quadtree;
 pub mod quantize;
 pub mod real;
 pub mod sphere;

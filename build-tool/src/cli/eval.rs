@@ -29,10 +29,11 @@ pub enum FigArg {
     /// vs Owen-Sobol + exact inverse CDF, + VNDF/cosine mixture, and per-condition
     /// optimization; instance diversity. Writes conditional.json, .csv, PNGs.
     Conditional,
-    /// An environment map's product warp as a prior (`--envmap MAP`): cap L2 at
-    /// held-out normals of Owen-Sobol and of a shifted lattice through it, over
-    /// Owen-Sobol through each normal's exact inverse CDF, by --grids and --sizes;
-    /// the tables' size. Writes envmap-prior.json and envmap-prior.md.
+    /// An environment map's product warps as priors (`--envmap MAP`): cap L2 at
+    /// held-out normals of Owen-Sobol and of a shifted lattice through them, over
+    /// Owen-Sobol through each normal's exact inverse CDF: tables by --grids and
+    /// --sizes, the hierarchical warp by --levels; their state. Writes
+    /// envmap-prior.json and envmap-prior.md.
     EnvmapPrior,
 }
 
@@ -104,6 +105,10 @@ pub struct EvalArgs {
     /// envmap-prior: table sizes, vertices per axis (each >= 2).
     #[arg(long, value_delimiter = ',', default_value = "32,64,128")]
     pub sizes: Vec<u32>,
+    /// envmap-prior: depths of the hierarchical product warp (`2^L` leaves per
+    /// axis; each 1 to 12).
+    #[arg(long, value_delimiter = ',', default_value = "8,9,10")]
+    pub levels: Vec<u32>,
 }
 
 impl EvalArgs {
@@ -230,9 +235,14 @@ fn run_envmap_prior(a: &EvalArgs) -> Result<()> {
         a.grids.iter().chain(&a.sizes).all(|&v| v >= 2),
         "--grids and --sizes need values of at least 2"
     );
+    anyhow::ensure!(
+        a.levels.iter().all(|&l| (1..=12).contains(&l)),
+        "--levels needs values from 1 to 12"
+    );
     let s = PriorSettings {
         grids: a.grids.clone(),
         sizes: a.sizes.clone(),
+        levels: a.levels.clone(),
         n: u32::try_from(a.n).map_err(|_| anyhow::anyhow!("--n {} is too large", a.n))?,
         ..PriorSettings::default()
     };
@@ -241,7 +251,7 @@ fn run_envmap_prior(a: &EvalArgs) -> Result<()> {
             .map_err(|e| anyhow::anyhow!("{e}"))?;
     crate::output::ensure_dir(&a.out)?;
     let started = Instant::now();
-    let total = (s.normals + s.grids.len() * s.sizes.len()) as u64;
+    let total = (s.normals + s.grids.len() * s.sizes.len() + s.levels.len()) as u64;
     let progress = crate::progress::Progress::stderr("envmap-prior", total, "step");
     let rows = evaluate(&map, &s, &|what| {
         progress.set_message(what.to_string());

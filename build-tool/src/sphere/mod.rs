@@ -9,6 +9,9 @@
 //! * [`brdf_target`], [`envmap`]: the two tabulated targets;
 //! * [`envmap_prior`]: [`EnvmapPrior`], a map's `L cos` tabulated for a grid of
 //!   normals and sampled exactly between them (the environment sampler's prior);
+//! * [`envmap_tree`]: [`EnvmapTree`], a map's mip pyramid (masses and first
+//!   moments) on that square, sampled exactly times the cosine about the query's
+//!   normal;
 //! * [`filtered_luminance`]: a map's bilinearly filtered luminance (the light of
 //!   `bake --envmap` and `render`) and its exact tabulation on half pixels;
 //! * [`brdf_albedo`]: the BRDF's directional albedo (the `brdf` normalizer and the
@@ -31,6 +34,7 @@ pub mod cap_table;
 pub mod closed_form;
 pub mod envmap;
 pub mod envmap_prior;
+pub mod envmap_tree;
 pub mod equirect;
 pub mod filtered_luminance;
 pub mod geometry;
@@ -44,6 +48,7 @@ pub use cap_table::CapMeasureTable;
 pub use closed_form::{CosineDirections, UniformDirections};
 pub use envmap::EnvmapDensity;
 pub use envmap_prior::EnvmapPrior;
+pub use envmap_tree::EnvmapTree;
 pub use filtered_luminance::FilteredLuminance;
 pub use geometry::{
     cosine_cap_measure, random_direction, uniform_hemisphere_cap_measure,

@@ -6,6 +6,8 @@
 //! exact inverse CDF of the normal's own `L cos` (the baseline of the environment
 //! sampler's quality check); and the bytes the tables take.
 //!
+//! The same for the map's hierarchical product warp ([`EnvmapTree`]), by depth.
+//!
 //! Points through the prior sample a blend of the grid's tables, not the normal's
 //! own target, so a ratio above 1 for Owen-Sobol is the price of the blend and of
 //! the tables' resolution; the lattice shows what structure in primary space
@@ -14,7 +16,7 @@
 use crate::baselines::{seeded_owen_sobol, warped_owen_sobol_directions};
 use crate::seeding::{derive_seed, rng};
 use crate::sphere::metrics::{CapRadius, MeasuredCaps};
-use crate::sphere::{DirectionDensity, EnvmapDensity, EnvmapPrior};
+use crate::sphere::{DirectionDensity, EnvmapDensity, EnvmapPrior, EnvmapTree};
 use crate::train::lattice_generator;
 use anyhow::Result;
 use glam::{DVec2, DVec3};
@@ -32,6 +34,8 @@ pub struct PriorSettings {
     pub grids: Vec<u32>,
     /// Table sizes `S` (vertices per axis).
     pub sizes: Vec<u32>,
+    /// Depths `L` of the hierarchical warp (`2^L x 2^L` leaves).
+    pub levels: Vec<u32>,
     /// Points per set.
     pub n: u32,
     /// Held-out normals drawn (uniform on the sphere; unlit ones are left out).
@@ -49,6 +53,7 @@ impl Default for PriorSettings {
         Self {
             grids: vec![9, 13, 17],
             sizes: vec![32, 64, 128],
+            levels: vec![8, 9, 10],
             n: 64,
             normals: 16,
             instances: 8,
@@ -58,12 +63,14 @@ impl Default for PriorSettings {
     }
 }
 
-/// One `(grid, size)`'s figures over the held-out normals.
+/// One prior's figures over the held-out normals.
 #[derive(Clone, Debug, Serialize)]
 pub struct PriorRow {
-    /// Normal nodes per axis.
+    /// `table` ([`EnvmapPrior`]) or `tree` ([`EnvmapTree`]).
+    pub kind: &'static str,
+    /// Normal nodes per axis (0 for a tree: it has none).
     pub grid: u32,
-    /// Table vertices per axis.
+    /// Table vertices per axis, or a tree's leaves per axis.
     pub size: u32,
     /// Bytes of the tables as `f32`.
     pub state_bytes: usize,
@@ -125,7 +132,6 @@ pub fn evaluate(
         progress(&format!("normal {index} judged"));
     }
     anyhow::ensure!(!judges.is_empty(), "no held-out normal receives light");
-    let g = lattice_generator(s.n);
     let mut rows = Vec::new();
     for &grid in &s.grids {
         for &size in &s.sizes {
@@ -133,49 +139,78 @@ pub fn evaluate(
             let prior = EnvmapPrior::new(map, grid, size)?;
             let build_s = t.elapsed().as_secs_f64();
             let warp = prior.warp();
-            let through = |normal: DVec3, primary: &[DVec2]| -> Vec<DVec3> {
-                primary
-                    .iter()
-                    .map(|&u| prior.sample(&warp, normal, u).0)
-                    .collect()
-            };
-            let (mut os, mut lat) = (Vec::new(), Vec::new());
-            for (j, judge) in judges.iter().enumerate() {
-                let owen: Vec<f64> = (0..s.instances as u64)
-                    .into_par_iter()
-                    .map(|k| {
-                        judge.d(&through(
-                            judge.normal,
-                            &seeded_owen_sobol(n, s.seed ^ (k + 1)),
-                        ))
-                    })
-                    .collect();
-                let lattice: Vec<f64> = (0..s.instances as u64)
-                    .into_par_iter()
-                    .map(|k| {
-                        let mut z = rng(s.seed, (j as u64) << 32 | k);
-                        let shift = [z.random::<f64>(), z.random::<f64>()];
-                        let pts: Vec<DVec2> = (0..s.n)
-                            .map(|i| DVec2::from(shifted_lattice_point(i, s.n, g, shift)))
-                            .collect();
-                        judge.d(&through(judge.normal, &pts))
-                    })
-                    .collect();
-                os.push(mean(owen) / judge.baseline);
-                lat.push(mean(lattice) / judge.baseline);
-            }
+            let (owen_sobol, lattice) = score(&judges, s, &|n, u| prior.sample(&warp, n, u).0);
             rows.push(PriorRow {
+                kind: "table",
                 grid,
                 size,
                 state_bytes: prior.state_bytes(),
                 build_s,
-                owen_sobol: (mean(os.clone()), os.iter().copied().fold(0.0, f64::max)),
-                lattice: (mean(lat.clone()), lat.iter().copied().fold(0.0, f64::max)),
+                owen_sobol,
+                lattice,
             });
             progress(&format!("grid {grid}, size {size} done"));
         }
     }
+    for &levels in &s.levels {
+        let t = Instant::now();
+        let tree = EnvmapTree::new(map, levels)?;
+        let build_s = t.elapsed().as_secs_f64();
+        let warp = tree.warp();
+        let (owen_sobol, lattice) = score(&judges, s, &|n, u| tree.sample(&warp, n, u).0);
+        rows.push(PriorRow {
+            kind: "tree",
+            grid: 0,
+            size: 1 << levels,
+            state_bytes: tree.state_bytes(),
+            build_s,
+            owen_sobol,
+            lattice,
+        });
+        progress(&format!("tree of {levels} levels done"));
+    }
     Ok(rows)
+}
+
+/// `(mean, worst)` over the judges of Owen-Sobol and of shifted-lattice sets
+/// mapped by `warp(normal, primary point)`, each over the judge's baseline.
+fn score(
+    judges: &[Judge],
+    s: &PriorSettings,
+    warp: &(dyn Fn(DVec3, DVec2) -> DVec3 + Sync),
+) -> ((f64, f64), (f64, f64)) {
+    let n = s.n as usize;
+    let g = lattice_generator(s.n);
+    let through = |normal: DVec3, primary: &[DVec2]| -> Vec<DVec3> {
+        primary.iter().map(|&u| warp(normal, u)).collect()
+    };
+    let (mut os, mut lat) = (Vec::new(), Vec::new());
+    for (j, judge) in judges.iter().enumerate() {
+        let owen: Vec<f64> = (0..s.instances as u64)
+            .into_par_iter()
+            .map(|k| {
+                judge.d(&through(
+                    judge.normal,
+                    &seeded_owen_sobol(n, s.seed ^ (k + 1)),
+                ))
+            })
+            .collect();
+        let lattice: Vec<f64> = (0..s.instances as u64)
+            .into_par_iter()
+            .map(|k| {
+                let mut z = rng(s.seed, (j as u64) << 32 | k);
+                let shift = [z.random::<f64>(), z.random::<f64>()];
+                let pts: Vec<DVec2> = (0..s.n)
+                    .map(|i| DVec2::from(shifted_lattice_point(i, s.n, g, shift)))
+                    .collect();
+                judge.d(&through(judge.normal, &pts))
+            })
+            .collect();
+        os.push(mean(owen) / judge.baseline);
+        lat.push(mean(lattice) / judge.baseline);
+    }
+    let summary = |v: &[f64]| (mean(v.to_vec()), v.iter().copied().fold(0.0, f64::max));
+    (summary(&os), summary(&lat))
 }
 
 fn mean(v: Vec<f64>) -> f64 {
@@ -185,11 +220,12 @@ fn mean(v: Vec<f64>) -> f64 {
 /// The rows as a Markdown table.
 pub fn markdown(rows: &[PriorRow]) -> String {
     let mut out = String::from(
-        "| grid G | table S | state (f32) | build s | Owen-Sobol through the prior / baseline (mean, worst) | shifted lattice through the prior / baseline (mean, worst) |\n|---:|---:|---:|---:|---:|---:|\n",
+        "| prior | normals G | table S / leaves | state (f32) | build s | Owen-Sobol through the prior / baseline (mean, worst) | shifted lattice through the prior / baseline (mean, worst) |\n|---|---:|---:|---:|---:|---:|---:|\n",
     );
     for r in rows {
         out += &format!(
-            "| {} | {} | {:.1} MB | {:.1} | {:.3}, {:.3} | {:.3}, {:.3} |\n",
+            "| {} | {} | {} | {:.1} MB | {:.1} | {:.3}, {:.3} | {:.3}, {:.3} |\n",
+            r.kind,
             r.grid,
             r.size,
             r.state_bytes as f64 / 1e6,
@@ -218,6 +254,7 @@ mod tests {
         let s = PriorSettings {
             grids: vec![2, 9],
             sizes: vec![16],
+            levels: vec![4],
             n: 16,
             normals: 4,
             instances: 4,
@@ -225,8 +262,10 @@ mod tests {
             seed: 1,
         };
         let rows = evaluate(&map, &s, &|_| {}).unwrap();
-        assert_eq!(rows.len(), 2);
-        for r in &rows {
+        assert_eq!(rows.len(), 3);
+        assert_eq!((rows[2].kind, rows[2].size), ("tree", 16));
+        assert_eq!(rows[2].state_bytes, 16 * (4usize.pow(5) - 1) / 3);
+        for r in &rows[..2] {
             let nodes = (r.grid * r.grid) as usize;
             assert_eq!(r.state_bytes, 4 * nodes * (2 * 16 * 16 + 16));
             assert!(
@@ -235,7 +274,8 @@ mod tests {
             );
             assert!(r.owen_sobol.1 >= r.owen_sobol.0 && r.lattice.1 >= r.lattice.0);
         }
-        assert_eq!(markdown(&rows).lines().count(), 4);
+        assert!(rows[2].owen_sobol.0.is_finite() && rows[2].lattice.0.is_finite());
+        assert_eq!(markdown(&rows).lines().count(), 5);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

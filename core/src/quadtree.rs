@@ -1,0 +1,321 @@
+//! Hierarchical product warping (Clarberg, Jarosz, Akenine-Möller and Jensen 2005;
+//! Clarberg and Akenine-Möller 2008): a density on the unit square given by a
+//! quadtree of masses (a mip pyramid of sums), reweighted at the query (e.g. by a
+//! cosine about a normal), sampled exactly.
+//!
+//! **The density.** At each node the four children weigh `weight(c)`, which the
+//! query computes from the child's level, position and mass; a
+//! sample descends from the root, choosing a column by the two columns' weights
+//! and then a child in it, and remaps its primary sample into the chosen part (so
+//! nearby primary samples stay nearby); at a leaf it is uniform. The density at a
+//! point is the product of the chosen children's shares along its path times
+//! `4^L` (the leaf's inverse area): [`QuadtreeWarp::pdf`] computes it by the same
+//! descent, so it is *exactly* the density of [`QuadtreeWarp::sample`]'s points.
+//! A child without mass weighs 0; negative and NaN weights count as 0. Where all
+//! four children of a node weigh 0 (the query's weights vanish on a node the path
+//! reached), the masses alone decide, and where those are 0 too, the four children
+//! share equally: the rule `sample` and `pdf` both follow.
+//!
+//! **Unbiasedness** of `g / pdf` needs `pdf > 0` wherever `g` is: weights that are
+//! positive on every node where the query's function is (for a product
+//! `mass x f`, e.g. the mass times an upper bound of `f` over the node) give it.
+//!
+//! Work per sample `O(L)` (four weights per level), no allocation, no panic.
+
+use crate::real::Real;
+
+/// Most levels below the root (`4^24` leaves is far beyond any table).
+pub const MAX_LEVELS: u32 = 24;
+
+/// Why a pyramid was refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum QuadtreeError {
+    /// More than [`MAX_LEVELS`] levels.
+    Levels(u32),
+    /// The pyramid's length is not `(4^(L+1) - 1) / 3`.
+    Length {
+        /// Length the levels ask for.
+        expected: u64,
+        /// Length given.
+        got: u64,
+    },
+    /// A mass is negative, NaN or infinite (index into the pyramid).
+    BadMass(u64),
+    /// The root's mass is 0.
+    NoMass,
+}
+
+impl core::fmt::Display for QuadtreeError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            Self::Levels(l) => write!(f, "{l} quadtree levels (at most {MAX_LEVELS})"),
+            Self::Length { expected, got } => {
+                write!(f, "quadtree pyramid of {got} masses, expected {expected}")
+            }
+            Self::BadMass(i) => write!(f, "quadtree mass {i} is negative or not finite"),
+            Self::NoMass => write!(f, "quadtree without mass"),
+        }
+    }
+}
+
+impl core::error::Error for QuadtreeError {}
+
+/// Offset of level `l`'s first node in a pyramid: `(4^l - 1) / 3`. Level `l`
+/// holds `2^l x 2^l` nodes, row-major.
+pub fn level_offset(l: u32) -> usize {
+    ((1usize << (2 * l)) - 1) / 3
+}
+
+/// Length of a pyramid with `levels` levels below the root.
+pub fn pyramid_len(levels: u32) -> usize {
+    level_offset(levels + 1)
+}
+
+/// Fills `pyramid` from the `2^L x 2^L` leaf masses `leaves` (row-major): level
+/// `L` is the leaves, every node above the sum of its four children.
+pub fn build_pyramid<T: Real>(
+    levels: u32,
+    leaves: &[T],
+    pyramid: &mut [T],
+) -> Result<(), QuadtreeError> {
+    if levels > MAX_LEVELS {
+        return Err(QuadtreeError::Levels(levels));
+    }
+    let side = 1usize << levels;
+    if leaves.len() != side * side || pyramid.len() != pyramid_len(levels) {
+        return Err(QuadtreeError::Length {
+            expected: pyramid_len(levels) as u64,
+            got: pyramid.len() as u64,
+        });
+    }
+    let leaf = level_offset(levels);
+    pyramid[leaf..leaf + side * side].copy_from_slice(leaves);
+    for l in (0..levels).rev() {
+        let (s, o, c) = (1usize << l, level_offset(l), level_offset(l + 1));
+        for y in 0..s {
+            for x in 0..s {
+                let child = |i: usize, j: usize| pyramid[c + (2 * y + j) * 2 * s + 2 * x + i];
+                pyramid[o + y * s + x] = child(0, 0) + child(1, 0) + child(0, 1) + child(1, 1);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A hierarchical warp over a borrowed pyramid (see the module docs).
+#[derive(Clone, Copy, Debug)]
+pub struct QuadtreeWarp<'a, T> {
+    levels: u32,
+    pyramid: &'a [T],
+}
+
+/// One level's choice on a path: the column share, the column, the child's share
+/// within its column and the row.
+#[derive(Clone, Copy)]
+struct Step<T> {
+    px: T,
+    i: usize,
+    py: T,
+    j: usize,
+}
+
+impl<'a, T: Real> QuadtreeWarp<'a, T> {
+    /// The warp over `pyramid` (as [`build_pyramid`] writes it) with `levels`
+    /// levels below the root; checks the length, every mass finite and
+    /// non-negative, and the root's mass positive. A pyramid whose nodes are not
+    /// the sums of their children still never makes the warp panic; its pdf is
+    /// then the density of the warp it describes all the same (the shares use the
+    /// children only).
+    pub fn new(levels: u32, pyramid: &'a [T]) -> Result<Self, QuadtreeError> {
+        if levels > MAX_LEVELS {
+            return Err(QuadtreeError::Levels(levels));
+        }
+        if pyramid.len() != pyramid_len(levels) {
+            return Err(QuadtreeError::Length {
+                expected: pyramid_len(levels) as u64,
+                got: pyramid.len() as u64,
+            });
+        }
+        if let Some(i) = pyramid
+            .iter()
+            .position(|&m| !(m >= T::ZERO && m.is_finite()))
+        {
+            return Err(QuadtreeError::BadMass(i as u64));
+        }
+        if pyramid[0] <= T::ZERO {
+            return Err(QuadtreeError::NoMass);
+        }
+        Ok(Self { levels, pyramid })
+    }
+
+    /// Levels below the root (`2^L x 2^L` leaves).
+    pub fn levels(&self) -> u32 {
+        self.levels
+    }
+
+    /// The four children's weights of node `(x, y)` of level `l` (`[i + 2 j]` for
+    /// child `(2x + i, 2y + j)`), by the module docs' rule.
+    fn weights(
+        &self,
+        l: u32,
+        x: usize,
+        y: usize,
+        weight: &impl Fn(u32, u32, u32, T) -> T,
+    ) -> [T; 4] {
+        let s = 1usize << (l + 1);
+        let o = level_offset(l + 1);
+        let mass = |i: usize, j: usize| self.pyramid[o + (2 * y + j) * s + 2 * x + i];
+        let m = [mass(0, 0), mass(1, 0), mass(0, 1), mass(1, 1)];
+        let mut w = [T::ZERO; 4];
+        for k in 0..4 {
+            let (cx, cy) = ((2 * x + (k & 1)) as u32, (2 * y + (k >> 1)) as u32);
+            if m[k] > T::ZERO {
+                let v = weight(l + 1, cx, cy, m[k]);
+                w[k] = if v > T::ZERO && v.is_finite() {
+                    v
+                } else {
+                    T::ZERO
+                };
+            }
+        }
+        if sum4(w) > T::ZERO {
+            w
+        } else if sum4(m) > T::ZERO {
+            m
+        } else {
+            [T::ONE; 4]
+        }
+    }
+
+    /// Draws the point at primary sample `u` in `[0,1]^2` (clamped into it, NaN as
+    /// 0), children weighed by `weight(level, x, y, mass)`, and returns it with its
+    /// density per unit area of the square ([`Self::pdf`]).
+    pub fn sample(&self, u: [T; 2], weight: impl Fn(u32, u32, u32, T) -> T) -> ([T; 2], T) {
+        let (mut ux, mut uy) = (unit(u[0]), unit(u[1]));
+        let (mut x, mut y) = (0usize, 0usize);
+        let mut p = T::ONE;
+        for l in 0..self.levels {
+            let w = self.weights(l, x, y, &weight);
+            let step = choose(w, &mut ux, &mut uy);
+            p = p * share(w, step);
+            x = 2 * x + step.i;
+            y = 2 * y + step.j;
+        }
+        let side = T::of((1u64 << self.levels) as f64);
+        let point = [
+            ((T::of(x as f64) + ux) / side).min(T::ONE),
+            ((T::of(y as f64) + uy) / side).min(T::ONE),
+        ];
+        (point, p * side * side)
+    }
+
+    /// The density at `p` (clamped into the square) of [`Self::sample`]'s points.
+    pub fn pdf(&self, p: [T; 2], weight: impl Fn(u32, u32, u32, T) -> T) -> T {
+        let (lx, ly) = (self.leaf(p[0]), self.leaf(p[1]));
+        let mut prob = T::ONE;
+        for l in 0..self.levels {
+            let shift = self.levels - l - 1;
+            let (x, y) = (lx >> (shift + 1), ly >> (shift + 1));
+            let w = self.weights(l, x, y, &weight);
+            let (i, j) = ((lx >> shift) & 1, (ly >> shift) & 1);
+            let k = i + 2 * j;
+            let total = sum4(w);
+            prob = prob * w[k] / total;
+        }
+        let side = T::of((1u64 << self.levels) as f64);
+        prob * side * side
+    }
+
+    /// The primary sample that [`Self::sample`] maps to `p` (clamped into the
+    /// square).
+    pub fn invert(&self, p: [T; 2], weight: impl Fn(u32, u32, u32, T) -> T) -> [T; 2] {
+        let (lx, ly) = (self.leaf(p[0]), self.leaf(p[1]));
+        let side = T::of((1u64 << self.levels) as f64);
+        let mut ux = unit(unit(p[0]) * side - T::of(lx as f64));
+        let mut uy = unit(unit(p[1]) * side - T::of(ly as f64));
+        let mut steps = [Step {
+            px: T::ZERO,
+            i: 0,
+            py: T::ZERO,
+            j: 0,
+        }; MAX_LEVELS as usize];
+        for (l, step) in steps.iter_mut().enumerate().take(self.levels as usize) {
+            let shift = self.levels - l as u32 - 1;
+            let (x, y) = (lx >> (shift + 1), ly >> (shift + 1));
+            let w = self.weights(l as u32, x, y, &weight);
+            let (i, j) = ((lx >> shift) & 1, (ly >> shift) & 1);
+            let (left, right) = (w[0] + w[2], w[1] + w[3]);
+            let col = [w[i], w[i + 2]];
+            *step = Step {
+                px: left / (left + right),
+                i,
+                py: col[0] / (col[0] + col[1]),
+                j,
+            };
+        }
+        for step in steps[..self.levels as usize].iter().rev() {
+            uy = if step.j == 0 {
+                uy * step.py
+            } else {
+                step.py + uy * (T::ONE - step.py)
+            };
+            ux = if step.i == 0 {
+                ux * step.px
+            } else {
+                step.px + ux * (T::ONE - step.px)
+            };
+        }
+        [unit(ux), unit(uy)]
+    }
+
+    /// The leaf column (or row) of coordinate `c`, clamped into the square.
+    fn leaf(&self, c: T) -> usize {
+        let side = 1usize << self.levels;
+        ((unit(c) * T::of(side as f64)).floor().to_f64() as usize).min(side - 1)
+    }
+}
+
+/// Picks a child by `u` (column by `u.x`, then the row within it by `u.y`) and
+/// rescales `u` into the chosen part; an empty part is never picked.
+fn choose<T: Real>(w: [T; 4], ux: &mut T, uy: &mut T) -> Step<T> {
+    let (left, right) = (w[0] + w[2], w[1] + w[3]);
+    let px = left / (left + right);
+    let i = if (*ux < px && left > T::ZERO) || right <= T::ZERO {
+        *ux = unit(*ux / px);
+        0
+    } else {
+        *ux = unit((*ux - px) / (T::ONE - px));
+        1
+    };
+    let (bottom, top) = (w[i], w[i + 2]);
+    let py = bottom / (bottom + top);
+    let j = if (*uy < py && bottom > T::ZERO) || top <= T::ZERO {
+        *uy = unit(*uy / py);
+        0
+    } else {
+        *uy = unit((*uy - py) / (T::ONE - py));
+        1
+    };
+    Step { px, i, py, j }
+}
+
+/// The share of the chosen child among the four.
+fn share<T: Real>(w: [T; 4], s: Step<T>) -> T {
+    w[s.i + 2 * s.j] / sum4(w)
+}
+
+fn sum4<T: Real>(w: [T; 4]) -> T {
+    (w[0] + w[1]) + (w[2] + w[3])
+}
+
+/// `x` clamped into `[0, 1]`, NaN as 0.
+fn unit<T: Real>(x: T) -> T {
+    if x >= T::ZERO {
+        x.min(T::ONE)
+    } else {
+        T::ZERO
+    }
+}
+
+#[cfg(test)]
+mod tests;
