@@ -46,4 +46,6 @@ pub mod quadtree;
 pub mod quantize;
 pub mod real;
 pub mod sphere;
+#[cfg(test)]
+mod test_rng;
 pub mod warp;

@@ -63,13 +63,7 @@ impl<'a> TryFrom<ConditionalSampler<'a>> for BrdfSampler<'a> {
     /// The typed view of a target-agnostic sampler: [`BlobError::WrongTarget`]
     /// unless it samples [`ConditionalTarget::GltfBrdf`]. `O(1)`.
     fn try_from(sampler: ConditionalSampler<'a>) -> Result<Self, BlobError> {
-        match sampler.target() {
-            ConditionalTarget::GltfBrdf => Ok(Self(sampler)),
-            found => Err(BlobError::WrongTarget {
-                expected: ConditionalTarget::GltfBrdf,
-                found,
-            }),
-        }
+        sampler.expect_target(ConditionalTarget::GltfBrdf).map(Self)
     }
 }
 

@@ -31,13 +31,9 @@ impl<'a> TryFrom<ConditionalSampler<'a>> for EnvmapSampler<'a> {
     /// The typed view of a target-agnostic sampler: [`BlobError::WrongTarget`]
     /// unless it samples [`ConditionalTarget::EnvmapNormal`]. `O(1)`.
     fn try_from(sampler: ConditionalSampler<'a>) -> Result<Self, BlobError> {
-        match sampler.target() {
-            ConditionalTarget::EnvmapNormal => Ok(Self(sampler)),
-            found => Err(BlobError::WrongTarget {
-                expected: ConditionalTarget::EnvmapNormal,
-                found,
-            }),
-        }
+        sampler
+            .expect_target(ConditionalTarget::EnvmapNormal)
+            .map(Self)
     }
 }
 

@@ -256,10 +256,17 @@ impl<'a> Blob<'a> {
 /// A small valid blob for the crate's documentation examples: 4 points, 1 set.
 #[doc(hidden)]
 pub fn doc_example_blob() -> Aligned<[u8; 160]> {
+    point_set_blob(4, 1)
+}
+
+/// The 4 points of [`doc_example_blob`] in a blob whose info claims `len` points
+/// in `set_count` sets (so counts that disagree with the points make a corrupt
+/// blob for the tests).
+fn point_set_blob(len: u32, set_count: u32) -> Aligned<[u8; 160]> {
     use nuld_core::blob::{write, SectionSpec};
     let info = PointSetInfo {
-        len: 4,
-        set_count: 1,
+        len,
+        set_count,
         domain: Domain::Square as u32,
         reserved: 0,
     };
@@ -348,51 +355,19 @@ fn doc_example_sampler(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nuld_core::blob::{write, SectionSpec};
-
-    /// A point-set blob whose info claims `len` points in `sets` sets over one
-    /// stored point.
-    fn claiming(len: u32, sets: u32) -> Aligned<[u8; 160]> {
-        let info = PointSetInfo {
-            len,
-            set_count: sets,
-            domain: Domain::Square as u32,
-            reserved: 0,
-        };
-        let pts: [[u16; 2]; 4] = [[1, 2], [3, 4], [5, 6], [7, 8]];
-        let meta = [
-            3, b'd', b'o', b'c', 7, b'u', b'n', b'i', b'f', b'o', b'r', b'm', 0,
-        ];
-        let sections = [
-            SectionSpec {
-                tag: SectionTag::PointSetInfo,
-                elem_size: 16,
-                bytes: bytemuck::bytes_of(&info),
-            },
-            SectionSpec {
-                tag: SectionTag::Points,
-                elem_size: 4,
-                bytes: bytemuck::cast_slice(&pts),
-            },
-        ];
-        let mut out = Aligned([0u8; 160]);
-        write(&mut out.0, BlobKind::PointSet2D, &meta, &sections).unwrap();
-        out
-    }
-
     #[test]
     fn point_counts_whose_byte_length_passes_2_pow_64_are_refused_without_overflow() {
-        assert!(Blob::parse(&claiming(4, 1).0).is_ok());
+        assert!(Blob::parse(&point_set_blob(4, 1).0).is_ok());
         // 4 (2^32 - 1)^2 bytes: past u64, so the byte length saturates.
         assert_eq!(
-            Blob::parse(&claiming(u32::MAX, u32::MAX).0).unwrap_err(),
+            Blob::parse(&point_set_blob(u32::MAX, u32::MAX).0).unwrap_err(),
             BlobError::PointSet(PointSetError::Length {
                 expected: u64::MAX,
                 got: 16
             })
         );
         assert_eq!(
-            Blob::parse(&claiming(3, 2).0).unwrap_err(),
+            Blob::parse(&point_set_blob(3, 2).0).unwrap_err(),
             BlobError::PointSet(PointSetError::Length {
                 expected: 24,
                 got: 16

@@ -216,24 +216,14 @@ fn horizon(n: DVec3, l: u32, x: u32, y: u32) -> Horizon {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sphere::envmap::test_support::assert_unbiased_irradiance;
     use crate::sphere::envmap::tiny_map;
     use nuld_core::blob::Domain;
 
-    fn halton(i: u32, base: u32) -> f64 {
-        let (mut f, mut r, mut i) = (1.0, 0.0, i);
-        while i > 0 {
-            f /= base as f64;
-            r += f * (i % base) as f64;
-            i /= base;
-        }
-        r
-    }
-
     /// The estimate `(1/M) sum L cos / pdf` over the tree's samples is the
-    /// irradiance of an independent quadrature (midpoint rule on 1024^2 points of
-    /// the square), and `pdf` returns the samples' pdf (but for the rare sample on
-    /// a leaf's edge, which the round trip through the direction in `f32` may move
-    /// into the neighbouring leaf: the pdf is constant per leaf).
+    /// irradiance of an independent quadrature, and `pdf` returns the samples'
+    /// pdf (but for the rare sample on a leaf's edge: the pdf is constant per
+    /// leaf).
     #[test]
     fn the_estimate_with_the_trees_pdf_is_the_irradiance() {
         let dir = std::env::temp_dir().join(format!("nuld-tree-{}", std::process::id()));
@@ -241,48 +231,13 @@ mod tests {
         let tree = EnvmapTree::new(&map, 6).unwrap();
         assert_eq!(tree.state_bytes(), 16 * (4usize.pow(7) - 1) / 3);
         let warp = tree.warp();
-        for n in [
-            DVec3::Z,
-            DVec3::new(0.3, -0.5, 0.2).normalize(),
-            DVec3::new(-0.8, 0.1, -0.3).normalize(),
-        ] {
-            let q = 1024;
-            let e: f64 = (0..q * q)
-                .into_par_iter()
-                .map(|k| {
-                    let p = DVec2::new(
-                        ((k % q) as f64 + 0.5) / q as f64,
-                        ((k / q) as f64 + 0.5) / q as f64,
-                    );
-                    let d = square_to_sphere(p);
-                    map.pdf(d) * map.integral() * n.dot(d).max(0.0)
-                })
-                .sum::<f64>()
-                * 4.0
-                * PI
-                / (q * q) as f64;
-            let m = 1 << 12;
-            let (mut sum, mut sq, mut moved) = (0.0, 0.0, 0);
-            for i in 0..m {
-                let u = DVec2::new((i as f64 + 0.5) / m as f64, halton(i, 3));
-                let (d, pdf) = tree.sample(&warp, n, u);
-                let again = tree.pdf(&warp, n, d);
-                if (again - pdf).abs() > 1e-3 * pdf {
-                    moved += 1;
-                }
-                let v = map.pdf(d) * map.integral() * n.dot(d).max(0.0) / pdf;
-                sum += v;
-                sq += v * v;
-            }
-            assert!(moved < m / 500, "{moved} of {m} samples disagree with pdf");
-            let estimate = sum / m as f64;
-            // The error of independent samples (stratified ones do better).
-            let se = ((sq / m as f64 - estimate * estimate) / m as f64).sqrt();
-            assert!(
-                (estimate - e).abs() < 4.0 * se,
-                "n {n}: {estimate} vs {e} (se {se})"
-            );
-        }
+        assert_unbiased_irradiance(
+            &map,
+            1 << 12,
+            0.002,
+            |n, u| tree.sample(&warp, n, u),
+            |n, d| tree.pdf(&warp, n, d),
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -1,21 +1,9 @@
 extern crate std;
 
 use super::*;
+use crate::test_rng::Rng;
 use std::vec;
 use std::vec::Vec;
-
-/// SplitMix64: a deterministic stream of uniform numbers for the tests.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 /// Tabulated tables of `nodes` nodes on `nx x ny` vertices: node `k`'s value at
 /// vertex `(x, y)` is `value(k, x, y)`.

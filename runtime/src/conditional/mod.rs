@@ -7,7 +7,7 @@
 //! order of operations `core/FORMAT.md` documents, so that a shader reproduces it.
 
 use glam::{Vec2, Vec3};
-use nuld_core::blob::Domain;
+use nuld_core::blob::{BlobError, Domain};
 use nuld_core::conditional::{
     unpack_point, ConditionalInfo, ConditionalTarget, GridCell, PointWarp,
 };
@@ -112,6 +112,15 @@ impl<'a> ConditionalSampler<'a> {
     /// What the condition means ([`ConditionalTarget`]).
     pub fn target(&self) -> ConditionalTarget {
         self.target
+    }
+
+    /// The sampler, if it samples `expected`; else [`BlobError::WrongTarget`]
+    /// (the check of every typed view). `O(1)`.
+    pub(crate) fn expect_target(self, expected: ConditionalTarget) -> Result<Self, BlobError> {
+        match self.target() {
+            found if found == expected => Ok(self),
+            found => Err(BlobError::WrongTarget { expected, found }),
+        }
     }
 
     /// The estimator weight at condition `cond` (blob units): the weight table

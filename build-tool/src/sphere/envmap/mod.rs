@@ -41,6 +41,8 @@ mod cap_measure;
 mod irradiance;
 mod mass_rule;
 #[cfg(test)]
+pub(crate) mod test_support;
+#[cfg(test)]
 mod tests;
 
 use super::cap_table::profile_of_rule;
