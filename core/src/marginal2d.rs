@@ -27,7 +27,7 @@
 //! the density of the points `sample` returns (up to rounding), not an
 //! approximation of it. [`Marginal2D::invert`] is `sample`'s inverse.
 
-use crate::real::Real;
+use crate::real::{clamp_unit, Real};
 
 /// Most parameter dimensions of a warp (a blend has at most `2^3` nodes).
 pub const MAX_PARAMS: usize = 3;
@@ -160,9 +160,7 @@ impl<T: Real> Blend<T> {
             if c < 2 {
                 continue;
             }
-            let p = params[k];
-            let p = if p >= T::ZERO { p.min(T::ONE) } else { T::ZERO };
-            let pos = p * T::of((c - 1) as f64);
+            let pos = clamp_unit(params[k]) * T::of((c - 1) as f64);
             let i = (pos.floor().to_f64() as u32).min(c - 2);
             lower[k] = i;
             frac[k] = pos - T::of(i as f64);
@@ -412,7 +410,7 @@ impl<'a, T: Real> Marginal2D<'a, T> {
         let (nx, ny) = (self.nx, self.ny);
         let total = self.m(ny - 1, blend);
         // y: the marginal, then the quadratic within the row interval.
-        let target = unit(u[1]) * total;
+        let target = clamp_unit(u[1]) * total;
         let j = search(ny, target, |j| self.m(j, blend));
         let dy = T::ONE / T::of((ny - 1) as f64);
         let (r0, r1) = (self.c(j, nx - 1, blend), self.c(j + 1, nx - 1, blend));
@@ -421,7 +419,7 @@ impl<'a, T: Real> Marginal2D<'a, T> {
         // x: the conditional CDF of the row at y, then the quadratic in the cell.
         let row_total = self.c_at(j, t, nx - 1, blend);
         let x = if row_total > T::ZERO {
-            let target = unit(u[0]) * row_total;
+            let target = clamp_unit(u[0]) * row_total;
             let i = search(nx, target, |i| self.c_at(j, t, i, blend));
             let dx = T::ONE / T::of((nx - 1) as f64);
             let (g0, g1) = (self.f_at(j, t, i, blend), self.f_at(j, t, i + 1, blend));
@@ -429,7 +427,7 @@ impl<'a, T: Real> Marginal2D<'a, T> {
             (T::of(i as f64) + s) * dx
         } else {
             // A row without mass (only at a row interval's end): any x, density 0.
-            unit(u[0])
+            clamp_unit(u[0])
         };
         let p = [x.min(T::ONE), y.min(T::ONE)];
         (p, self.pdf(p, blend))
@@ -456,7 +454,7 @@ impl<'a, T: Real> Marginal2D<'a, T> {
         let (nx, ny) = (self.nx, self.ny);
         let total = self.m(ny - 1, blend);
         if !positive(total) {
-            return [unit(p[0]), unit(p[1])];
+            return [clamp_unit(p[0]), clamp_unit(p[1])];
         }
         let (j, t) = cell(p[1], ny);
         let dy = T::ONE / T::of((ny - 1) as f64);
@@ -469,9 +467,9 @@ impl<'a, T: Real> Marginal2D<'a, T> {
             let (g0, g1) = (self.f_at(j, t, i, blend), self.f_at(j, t, i + 1, blend));
             (self.c_at(j, t, i, blend) + linear_integral(g0 * dx, g1 * dx, s)) / row_total
         } else {
-            unit(p[0])
+            clamp_unit(p[0])
         };
-        [unit(ux), unit(uy)]
+        [clamp_unit(ux), clamp_unit(uy)]
     }
 }
 
@@ -480,21 +478,12 @@ fn positive<T: Real>(x: T) -> bool {
     x > T::ZERO
 }
 
-/// `x` clamped into `[0, 1]`, NaN as 0.
-fn unit<T: Real>(x: T) -> T {
-    if x >= T::ZERO {
-        x.min(T::ONE)
-    } else {
-        T::ZERO
-    }
-}
-
 /// The cell of `x` (clamped into `[0, 1]`) on `n` vertices and the position in it,
 /// `(k, s)` with `x = (k + s) / (n - 1)`, `k <= n - 2`.
 fn cell<T: Real>(x: T, n: usize) -> (usize, T) {
-    let pos = unit(x) * T::of((n - 1) as f64);
+    let pos = clamp_unit(x) * T::of((n - 1) as f64);
     let k = (pos.floor().to_f64() as usize).min(n - 2);
-    (k, unit(pos - T::of(k as f64)))
+    (k, clamp_unit(pos - T::of(k as f64)))
 }
 
 /// The interval `k` in `0..n-1` with `cdf(k) <= target < cdf(k + 1)` of a
@@ -537,7 +526,7 @@ fn solve_linear<T: Real>(a: T, b: T, v: T) -> T {
     let disc = (a * a + T::of(2.0) * (b - a) * v).max(T::ZERO);
     let den = a + disc.sqrt();
     if den > T::ZERO {
-        unit(T::of(2.0) * v / den)
+        clamp_unit(T::of(2.0) * v / den)
     } else {
         T::ZERO
     }

@@ -22,7 +22,7 @@
 //!
 //! Work per sample `O(L)` (four weights per level), no allocation, no panic.
 
-use crate::real::Real;
+use crate::real::{clamp_unit, Real};
 
 /// Most levels below the root (`4^24` leaves is far beyond any table).
 pub const MAX_LEVELS: u32 = 24;
@@ -32,7 +32,7 @@ pub const MAX_LEVELS: u32 = 24;
 pub enum QuadtreeError {
     /// More than [`MAX_LEVELS`] levels.
     Levels(u32),
-    /// The pyramid's length is not `(4^(L+1) - 1) / 3`.
+    /// The leaves are not `4^L` masses, or the pyramid is not `(4^(L+1) - 1) / 3`.
     Length {
         /// Length the levels ask for.
         expected: u64,
@@ -50,7 +50,7 @@ impl core::fmt::Display for QuadtreeError {
         match *self {
             Self::Levels(l) => write!(f, "{l} quadtree levels (at most {MAX_LEVELS})"),
             Self::Length { expected, got } => {
-                write!(f, "quadtree pyramid of {got} masses, expected {expected}")
+                write!(f, "quadtree of {got} masses, expected {expected}")
             }
             Self::BadMass(i) => write!(f, "quadtree mass {i} is negative or not finite"),
             Self::NoMass => write!(f, "quadtree without mass"),
@@ -82,11 +82,16 @@ pub fn build_pyramid<T: Real>(
         return Err(QuadtreeError::Levels(levels));
     }
     let side = 1usize << levels;
-    if leaves.len() != side * side || pyramid.len() != pyramid_len(levels) {
-        return Err(QuadtreeError::Length {
-            expected: pyramid_len(levels) as u64,
-            got: pyramid.len() as u64,
-        });
+    for (expected, got) in [
+        (side * side, leaves.len()),
+        (pyramid_len(levels), pyramid.len()),
+    ] {
+        if expected != got {
+            return Err(QuadtreeError::Length {
+                expected: expected as u64,
+                got: got as u64,
+            });
+        }
     }
     let leaf = level_offset(levels);
     pyramid[leaf..leaf + side * side].copy_from_slice(leaves);
@@ -191,7 +196,7 @@ impl<'a, T: Real> QuadtreeWarp<'a, T> {
     /// 0), children weighed by `weight(level, x, y, mass)`, and returns it with its
     /// density per unit area of the square ([`Self::pdf`]).
     pub fn sample(&self, u: [T; 2], weight: impl Fn(u32, u32, u32, T) -> T) -> ([T; 2], T) {
-        let (mut ux, mut uy) = (unit(u[0]), unit(u[1]));
+        let (mut ux, mut uy) = (clamp_unit(u[0]), clamp_unit(u[1]));
         let (mut x, mut y) = (0usize, 0usize);
         let mut p = T::ONE;
         for l in 0..self.levels {
@@ -231,8 +236,8 @@ impl<'a, T: Real> QuadtreeWarp<'a, T> {
     pub fn invert(&self, p: [T; 2], weight: impl Fn(u32, u32, u32, T) -> T) -> [T; 2] {
         let (lx, ly) = (self.leaf(p[0]), self.leaf(p[1]));
         let side = T::of((1u64 << self.levels) as f64);
-        let mut ux = unit(unit(p[0]) * side - T::of(lx as f64));
-        let mut uy = unit(unit(p[1]) * side - T::of(ly as f64));
+        let mut ux = clamp_unit(clamp_unit(p[0]) * side - T::of(lx as f64));
+        let mut uy = clamp_unit(clamp_unit(p[1]) * side - T::of(ly as f64));
         let mut steps = [Step {
             px: T::ZERO,
             i: 0,
@@ -265,13 +270,13 @@ impl<'a, T: Real> QuadtreeWarp<'a, T> {
                 step.px + ux * (T::ONE - step.px)
             };
         }
-        [unit(ux), unit(uy)]
+        [clamp_unit(ux), clamp_unit(uy)]
     }
 
     /// The leaf column (or row) of coordinate `c`, clamped into the square.
     fn leaf(&self, c: T) -> usize {
         let side = 1usize << self.levels;
-        ((unit(c) * T::of(side as f64)).floor().to_f64() as usize).min(side - 1)
+        ((clamp_unit(c) * T::of(side as f64)).floor().to_f64() as usize).min(side - 1)
     }
 }
 
@@ -281,19 +286,19 @@ fn choose<T: Real>(w: [T; 4], ux: &mut T, uy: &mut T) -> Step<T> {
     let (left, right) = (w[0] + w[2], w[1] + w[3]);
     let px = left / (left + right);
     let i = if (*ux < px && left > T::ZERO) || right <= T::ZERO {
-        *ux = unit(*ux / px);
+        *ux = clamp_unit(*ux / px);
         0
     } else {
-        *ux = unit((*ux - px) / (T::ONE - px));
+        *ux = clamp_unit((*ux - px) / (T::ONE - px));
         1
     };
     let (bottom, top) = (w[i], w[i + 2]);
     let py = bottom / (bottom + top);
     let j = if (*uy < py && bottom > T::ZERO) || top <= T::ZERO {
-        *uy = unit(*uy / py);
+        *uy = clamp_unit(*uy / py);
         0
     } else {
-        *uy = unit((*uy - py) / (T::ONE - py));
+        *uy = clamp_unit((*uy - py) / (T::ONE - py));
         1
     };
     Step { px, i, py, j }
@@ -306,15 +311,6 @@ fn share<T: Real>(w: [T; 4], s: Step<T>) -> T {
 
 fn sum4<T: Real>(w: [T; 4]) -> T {
     (w[0] + w[1]) + (w[2] + w[3])
-}
-
-/// `x` clamped into `[0, 1]`, NaN as 0.
-fn unit<T: Real>(x: T) -> T {
-    if x >= T::ZERO {
-        x.min(T::ONE)
-    } else {
-        T::ZERO
-    }
 }
 
 #[cfg(test)]

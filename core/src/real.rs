@@ -193,6 +193,17 @@ impl Real for f32 {
     }
 }
 
+/// `x` clamped into `[0, 1]`, NaN as 0: a primary sample or a cell position made
+/// safe to index with (the warps of [`crate::marginal2d`] and [`crate::quadtree`]).
+#[inline]
+pub fn clamp_unit<T: Real>(x: T) -> T {
+    if x >= T::ZERO {
+        x.min(T::ONE)
+    } else {
+        T::ZERO
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -247,8 +247,7 @@ fn run_envmap_prior(a: &EvalArgs) -> Result<()> {
         ..PriorSettings::default()
     };
     let map =
-        crate::sphere::EnvmapDensity::from_file_filtered(path, nuld_core::blob::Domain::Sphere)
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        crate::sphere::EnvmapDensity::from_file_filtered(path, nuld_core::blob::Domain::Sphere)?;
     crate::output::ensure_dir(&a.out)?;
     let started = Instant::now();
     let total = (s.normals + s.grids.len() * s.sizes.len() + s.levels.len()) as u64;

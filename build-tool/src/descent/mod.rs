@@ -168,9 +168,15 @@ mod tests {
         assert_eq!(loss.alphas[399], 256.0);
         assert_eq!(reports[0].learning_rate, 0.05);
         assert!((reports[399].learning_rate - 0.005).abs() < 1e-15);
-        // Projected after the first step (3 - 0.05 would stay above 1).
         assert!(reports[0].loss > reports[399].loss);
         assert!(x.iter().all(|v| (v - 0.25).abs() < 1e-2), "{x:?}");
+        // The loss's projection follows each step: Adam's first step is 0.05 per
+        // coordinate, so 3 would stay at 2.95 without it.
+        let mut d = Descent::new(Adam::<f64>::new(2), schedule, 0.05, 0.5);
+        let mut x = vec![3.0, -2.0];
+        d.epoch(0, &mut x, &mut loss);
+        assert_eq!(x[0], 1.0);
+        assert!((x[1] - -1.95).abs() < 1e-12, "{x:?}");
     }
 
     #[test]

@@ -42,6 +42,9 @@ pub struct EnvmapTree {
     /// as the masses: a node's `∑ mass max(0, n.l)` is `n . moment` when the node
     /// lies above the horizon of `n`.
     pub moments: [Vec<f32>; 3],
+    /// Node cones ([`node_cone`]), laid out as the masses: computed once, since a
+    /// sample reads many nodes' geometry at every level.
+    cones: Vec<(DVec3, f64)>,
 }
 
 impl EnvmapTree {
@@ -89,6 +92,15 @@ impl EnvmapTree {
                 pyramid_of(&|v| v.1.y)?,
                 pyramid_of(&|v| v.1.z)?,
             ],
+            cones: (0..=levels)
+                .flat_map(|l| {
+                    let side = 1u32 << l;
+                    (0..side * side).map(move |k| (l, k % side, k / side))
+                })
+                .collect::<Vec<_>>()
+                .into_par_iter()
+                .map(|(l, x, y)| node_cone(l, x, y))
+                .collect(),
         })
     }
 
@@ -144,7 +156,7 @@ impl EnvmapTree {
             self.moments[2][i] as f64,
         );
         let dot = n.dot(moment);
-        match horizon(n, l, x, y) {
+        match horizon(n, l, self.cones[i]) {
             Horizon::Above => dot.max(0.0),
             Horizon::Below => 0.0,
             Horizon::Across(bound) if depth == 0 || l == self.levels => dot.max(0.05 * bound * m),
@@ -176,15 +188,27 @@ enum Horizon {
     Across(f64),
 }
 
-/// Where node `(x, y)` of level `l` lies against the horizon of `n`: from the
-/// angle between `n` and the node's centre and the node's angular radius (the
-/// largest angle from the centre to its corners and edge midpoints, with a
-/// quarter's margin for the curved edges of the octahedral cells); the top levels,
-/// whose nodes span a hemisphere, are always across.
-fn horizon(n: DVec3, l: u32, x: u32, y: u32) -> Horizon {
+/// Where a node of level `l` with cone `(centre, radius)` ([`node_cone`]) lies
+/// against the horizon of `n`, from the angle between `n` and the centre; the top
+/// levels, whose nodes span a hemisphere, are always across.
+fn horizon(n: DVec3, l: u32, (c, radius): (DVec3, f64)) -> Horizon {
     if l <= UNBOUNDED_LEVELS {
         return Horizon::Across(1.0);
     }
+    let angle = acos_clamped(n.dot(c));
+    if angle + radius < FRAC_PI_2 {
+        Horizon::Above
+    } else if angle - radius >= FRAC_PI_2 {
+        Horizon::Below
+    } else {
+        Horizon::Across((angle - radius).max(0.0).cos())
+    }
+}
+
+/// Node `(x, y)` of level `l` as a cone: its centre's direction and its angular
+/// radius (the largest angle from the centre to its corners and edge midpoints,
+/// with a quarter's margin for the curved edges of the octahedral cells).
+fn node_cone(l: u32, x: u32, y: u32) -> (DVec3, f64) {
     let side = (1u64 << l) as f64;
     let at =
         |a: f64, b: f64| square_to_sphere(DVec2::new((x as f64 + a) / side, (y as f64 + b) / side));
@@ -203,14 +227,7 @@ fn horizon(n: DVec3, l: u32, x: u32, y: u32) -> Horizon {
     .map(|&(a, b)| acos_clamped(c.dot(at(a, b))))
     .fold(0.0, f64::max)
         * 1.25;
-    let angle = acos_clamped(n.dot(c));
-    if angle + radius < FRAC_PI_2 {
-        Horizon::Above
-    } else if angle - radius >= FRAC_PI_2 {
-        Horizon::Below
-    } else {
-        Horizon::Across((angle - radius).max(0.0).cos())
-    }
+    (c, radius)
 }
 
 #[cfg(test)]
@@ -257,7 +274,7 @@ mod tests {
             for node in (0..side * side).step_by(7) {
                 let (x, y) = (node % side, node / side);
                 for n in normals {
-                    let h = horizon(n, l, x, y);
+                    let h = horizon(n, l, node_cone(l, x, y));
                     for k in 0..64 {
                         let p = DVec2::new(
                             (x as f64 + ((k % 8) as f64 + 0.5) / 8.0) / side as f64,
