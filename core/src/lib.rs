@@ -15,6 +15,9 @@
 //!   parameter grid and sampled exactly, with their pdf and inverse;
 //! * [`conditional`]: the conditional sampler's info record, condition grid and
 //!   bilinear interpolation (blob kind 3);
+//! * [`envmap_tree`]: an environment map's light times the cosine about a normal,
+//!   sampled exactly by hierarchical warping with bounded work per node (the
+//!   environment sampler's prior), with its pdf and inverse;
 //! * [`quadtree`]: hierarchical product warping over a mip pyramid of masses times
 //!   a factor known at the query, with its pdf and inverse;
 //! * [`network`]: the conditional sampler's network (features, forward pass), one
@@ -40,6 +43,7 @@ pub mod blob;
 pub mod brdf;
 pub mod conditional;
 pub mod domain;
+pub mod envmap_tree;
 pub mod marginal2d;
 pub mod network;
 pub mod quadtree;

@@ -20,6 +20,9 @@
 //! positive on every node where the query's function is (for a product
 //! `mass x f`, e.g. the mass times an upper bound of `f` over the node) give it.
 //!
+//! The descent itself ([`sample`], [`pdf`], [`invert`]) is written once over
+//! [`ChildWeights`], whatever computes the weights.
+//!
 //! Work per sample `O(L)` (four weights per level), no allocation, no panic.
 
 use crate::real::{clamp_unit, Real};
@@ -175,20 +178,13 @@ impl<'a, T: Real> QuadtreeWarp<'a, T> {
         for k in 0..4 {
             let (cx, cy) = ((2 * x + (k & 1)) as u32, (2 * y + (k >> 1)) as u32);
             if m[k] > T::ZERO {
-                let v = weight(l + 1, cx, cy, m[k]);
-                w[k] = if v > T::ZERO && v.is_finite() {
-                    v
-                } else {
-                    T::ZERO
-                };
+                w[k] = positive(weight(l + 1, cx, cy, m[k]));
             }
         }
         if sum4(w) > T::ZERO {
             w
-        } else if sum4(m) > T::ZERO {
-            m
         } else {
-            [T::ONE; 4]
+            m
         }
     }
 
@@ -196,88 +192,173 @@ impl<'a, T: Real> QuadtreeWarp<'a, T> {
     /// 0), children weighed by `weight(level, x, y, mass)`, and returns it with its
     /// density per unit area of the square ([`Self::pdf`]).
     pub fn sample(&self, u: [T; 2], weight: impl Fn(u32, u32, u32, T) -> T) -> ([T; 2], T) {
-        let (mut ux, mut uy) = (clamp_unit(u[0]), clamp_unit(u[1]));
-        let (mut x, mut y) = (0usize, 0usize);
-        let mut p = T::ONE;
-        for l in 0..self.levels {
-            let w = self.weights(l, x, y, &weight);
-            let step = choose(w, &mut ux, &mut uy);
-            p = p * share(w, step);
-            x = 2 * x + step.i;
-            y = 2 * y + step.j;
-        }
-        let side = T::of((1u64 << self.levels) as f64);
-        let point = [
-            ((T::of(x as f64) + ux) / side).min(T::ONE),
-            ((T::of(y as f64) + uy) / side).min(T::ONE),
-        ];
-        (point, p * side * side)
+        sample(&self.query(weight), u)
     }
 
     /// The density at `p` (clamped into the square) of [`Self::sample`]'s points.
     pub fn pdf(&self, p: [T; 2], weight: impl Fn(u32, u32, u32, T) -> T) -> T {
-        let (lx, ly) = (self.leaf(p[0]), self.leaf(p[1]));
-        let mut prob = T::ONE;
-        for l in 0..self.levels {
-            let shift = self.levels - l - 1;
-            let (x, y) = (lx >> (shift + 1), ly >> (shift + 1));
-            let w = self.weights(l, x, y, &weight);
-            let (i, j) = ((lx >> shift) & 1, (ly >> shift) & 1);
-            let k = i + 2 * j;
-            let total = sum4(w);
-            prob = prob * w[k] / total;
-        }
-        let side = T::of((1u64 << self.levels) as f64);
-        prob * side * side
+        pdf(&self.query(weight), p)
     }
 
     /// The primary sample that [`Self::sample`] maps to `p` (clamped into the
     /// square).
     pub fn invert(&self, p: [T; 2], weight: impl Fn(u32, u32, u32, T) -> T) -> [T; 2] {
-        let (lx, ly) = (self.leaf(p[0]), self.leaf(p[1]));
-        let side = T::of((1u64 << self.levels) as f64);
-        let mut ux = clamp_unit(clamp_unit(p[0]) * side - T::of(lx as f64));
-        let mut uy = clamp_unit(clamp_unit(p[1]) * side - T::of(ly as f64));
-        let mut steps = [Step {
-            px: T::ZERO,
-            i: 0,
-            py: T::ZERO,
-            j: 0,
-        }; MAX_LEVELS as usize];
-        for (l, step) in steps.iter_mut().enumerate().take(self.levels as usize) {
-            let shift = self.levels - l as u32 - 1;
-            let (x, y) = (lx >> (shift + 1), ly >> (shift + 1));
-            let w = self.weights(l as u32, x, y, &weight);
-            let (i, j) = ((lx >> shift) & 1, (ly >> shift) & 1);
-            let (left, right) = (w[0] + w[2], w[1] + w[3]);
-            let col = [w[i], w[i + 2]];
-            *step = Step {
-                px: left / (left + right),
-                i,
-                py: col[0] / (col[0] + col[1]),
-                j,
-            };
-        }
-        for step in steps[..self.levels as usize].iter().rev() {
-            uy = if step.j == 0 {
-                uy * step.py
-            } else {
-                step.py + uy * (T::ONE - step.py)
-            };
-            ux = if step.i == 0 {
-                ux * step.px
-            } else {
-                step.px + ux * (T::ONE - step.px)
-            };
-        }
-        [clamp_unit(ux), clamp_unit(uy)]
+        invert(&self.query(weight), p)
     }
 
-    /// The leaf column (or row) of coordinate `c`, clamped into the square.
-    fn leaf(&self, c: T) -> usize {
-        let side = 1usize << self.levels;
-        ((clamp_unit(c) * T::of(side as f64)).floor().to_f64() as usize).min(side - 1)
+    fn query<F: Fn(u32, u32, u32, T) -> T>(&self, weight: F) -> Query<'_, 'a, T, F> {
+        Query { warp: self, weight }
     }
+}
+
+/// A [`QuadtreeWarp`] with the weight function of one query.
+struct Query<'w, 'a, T, F> {
+    warp: &'w QuadtreeWarp<'a, T>,
+    weight: F,
+}
+
+impl<T: Real, F: Fn(u32, u32, u32, T) -> T> ChildWeights<T> for Query<'_, '_, T, F> {
+    fn levels(&self) -> u32 {
+        self.warp.levels
+    }
+
+    fn children(&self, level: u32, x: u32, y: u32) -> [T; 4] {
+        self.warp
+            .weights(level, x as usize, y as usize, &self.weight)
+    }
+}
+
+/// A quadtree as one query sees it: the weights of every node's four children.
+/// [`sample`], [`pdf`] and [`invert`] descend it; any type that can weigh a node's
+/// children (a mass pyramid reweighed by a function, [`QuadtreeWarp`]; a
+/// pyramid of moments lit by a cosine, [`crate::envmap_tree`]) is sampled by the
+/// same arithmetic.
+pub trait ChildWeights<T> {
+    /// Levels below the root (`2^L x 2^L` leaves), at most [`MAX_LEVELS`].
+    fn levels(&self) -> u32;
+
+    /// The weights of the four children of node `(x, y)` of level `level <
+    /// levels()` (`[i + 2 j]` for child `(2x + i, 2y + j)` of level `level + 1`),
+    /// proportional to the share of samples each receives. Negative and NaN
+    /// weights count as 0; where all four are 0 (or one is infinite) the four
+    /// children share equally.
+    fn children(&self, level: u32, x: u32, y: u32) -> [T; 4];
+}
+
+/// The children's weights of a node, made usable: negative, NaN and infinite
+/// weights read as 0, and four zeros as four ones.
+#[inline]
+fn usable<T: Real>(w: [T; 4]) -> [T; 4] {
+    let w = w.map(positive);
+    if sum4(w) > T::ZERO && sum4(w).is_finite() {
+        w
+    } else {
+        [T::ONE; 4]
+    }
+}
+
+/// `v` if positive and finite, else 0.
+#[inline]
+fn positive<T: Real>(v: T) -> T {
+    if v > T::ZERO && v.is_finite() {
+        v
+    } else {
+        T::ZERO
+    }
+}
+
+/// Draws the point of `tree` at primary sample `u` in `[0,1]^2` (clamped into it,
+/// NaN as 0) and returns it with its density per unit area of the square
+/// ([`pdf`]). The descent picks a column by `u.x` and a child in it by `u.y` at
+/// every level and rescales `u` into the chosen part, so the warp is continuous
+/// within each level's split; at a leaf it is uniform. `O(levels)`; never panics.
+#[inline]
+pub fn sample<T: Real>(tree: &impl ChildWeights<T>, u: [T; 2]) -> ([T; 2], T) {
+    let levels = tree.levels().min(MAX_LEVELS);
+    let (mut ux, mut uy) = (clamp_unit(u[0]), clamp_unit(u[1]));
+    let (mut x, mut y) = (0u32, 0u32);
+    let mut p = T::ONE;
+    for l in 0..levels {
+        let w = usable(tree.children(l, x, y));
+        let step = choose(w, &mut ux, &mut uy);
+        p = p * share(w, step);
+        x = 2 * x + step.i as u32;
+        y = 2 * y + step.j as u32;
+    }
+    let side = T::of((1u64 << levels) as f64);
+    let point = [
+        ((T::of(x as f64) + ux) / side).min(T::ONE),
+        ((T::of(y as f64) + uy) / side).min(T::ONE),
+    ];
+    (point, p * side * side)
+}
+
+/// The density at `p` (clamped into the square) of [`sample`]'s points: the
+/// product of the chosen children's shares along the path to `p`'s leaf times the
+/// leaves' count. `O(levels)`; never panics.
+#[inline]
+pub fn pdf<T: Real>(tree: &impl ChildWeights<T>, p: [T; 2]) -> T {
+    let levels = tree.levels().min(MAX_LEVELS);
+    let (lx, ly) = (leaf(levels, p[0]), leaf(levels, p[1]));
+    let mut prob = T::ONE;
+    for l in 0..levels {
+        let shift = levels - l - 1;
+        let w = usable(tree.children(l, lx >> (shift + 1), ly >> (shift + 1)));
+        let k = ((lx >> shift) & 1) + 2 * ((ly >> shift) & 1);
+        prob = prob * w[k as usize] / sum4(w);
+    }
+    let side = T::of((1u64 << levels) as f64);
+    prob * side * side
+}
+
+/// The primary sample that [`sample`] maps to `p` (clamped into the square).
+/// `O(levels)`; never panics.
+pub fn invert<T: Real>(tree: &impl ChildWeights<T>, p: [T; 2]) -> [T; 2] {
+    let levels = tree.levels().min(MAX_LEVELS);
+    let (lx, ly) = (leaf(levels, p[0]), leaf(levels, p[1]));
+    let side = T::of((1u64 << levels) as f64);
+    let mut ux = clamp_unit(clamp_unit(p[0]) * side - T::of(lx as f64));
+    let mut uy = clamp_unit(clamp_unit(p[1]) * side - T::of(ly as f64));
+    let mut steps = [Step {
+        px: T::ZERO,
+        i: 0,
+        py: T::ZERO,
+        j: 0,
+    }; MAX_LEVELS as usize];
+    for (l, step) in steps.iter_mut().enumerate().take(levels as usize) {
+        let shift = levels - l as u32 - 1;
+        let w = usable(tree.children(l as u32, lx >> (shift + 1), ly >> (shift + 1)));
+        let (i, j) = (((lx >> shift) & 1) as usize, ((ly >> shift) & 1) as usize);
+        let (left, right) = (w[0] + w[2], w[1] + w[3]);
+        let col = [w[i], w[i + 2]];
+        *step = Step {
+            px: left / (left + right),
+            i,
+            py: col[0] / (col[0] + col[1]),
+            j,
+        };
+    }
+    for step in steps[..levels as usize].iter().rev() {
+        uy = if step.j == 0 {
+            uy * step.py
+        } else {
+            step.py + uy * (T::ONE - step.py)
+        };
+        ux = if step.i == 0 {
+            ux * step.px
+        } else {
+            step.px + ux * (T::ONE - step.px)
+        };
+    }
+    [clamp_unit(ux), clamp_unit(uy)]
+}
+
+/// The leaf column (or row) of coordinate `c` among `2^levels`, clamped into the
+/// square.
+#[inline]
+fn leaf<T: Real>(levels: u32, c: T) -> u32 {
+    let side = 1u32 << levels;
+    ((clamp_unit(c) * T::of(side as f64)).floor().to_f64() as u32).min(side - 1)
 }
 
 /// Picks a child by `u` (column by `u.x`, then the row within it by `u.y`) and

@@ -3,7 +3,7 @@
 
 use crate::baselines::Baseline;
 use crate::discrepancy::GradientPath;
-use crate::lab::bench::{baselines, optimizer, runtime, training};
+use crate::lab::bench::{baselines, envmap_prior, optimizer, runtime, training};
 use crate::optimize::directions::DirectionConfig;
 use crate::optimize::{AreaOption, OptimizeConfig};
 use anyhow::Result;
@@ -34,6 +34,9 @@ pub struct BenchArgs {
     /// Direction target (sphere domain) for the direction timings.
     #[arg(long, default_value = "uniform")]
     pub direction_density: String,
+    /// Environment map of the `envmap-prior` timings.
+    #[arg(long, default_value = "../shared/data/envmaps/courtyard.hdr")]
+    pub envmap: std::path::PathBuf,
     /// Which parts to run.
     #[arg(long, value_enum, default_value = "all")]
     pub only: BenchPart,
@@ -53,6 +56,11 @@ pub enum BenchPart {
     /// Only the runtime's conditional sampler against the incumbent warp
     /// (nanoseconds per sample, one thread; not part of `all`).
     Runtime,
+    /// Only the environment sampler's prior, the exact product warp of a map's
+    /// light and a normal's cosine, against Owen-Sobol through the map's
+    /// luminance inverse CDF (nanoseconds per sample, one thread; not part of
+    /// `all`).
+    EnvmapPrior,
     /// Only the conditional sampler's training: milliseconds per step at N = 64,
     /// 256 and 2048, all threads, and the default bake's training time that
     /// implies (not part of `all`).
@@ -111,6 +119,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
         BenchPart::Baselines => run_baselines(&a),
         BenchPart::Runtime => run_runtime(),
         BenchPart::Training => run_training(),
+        BenchPart::EnvmapPrior => run_envmap_prior(&a),
     }
 }
 
@@ -163,6 +172,26 @@ fn run_runtime() -> Result<()> {
     let base = t.rows.first().map_or(f64::NAN, |r| r.1);
     for (name, ns) in &t.rows {
         println!("{name:<44} {ns:>10.1} {:>11.2}x", ns / base);
+    }
+    Ok(())
+}
+
+/// Nanoseconds per sample of the environment sampler's prior against the
+/// incumbent, one thread.
+fn run_envmap_prior(a: &BenchArgs) -> Result<()> {
+    let map = crate::sphere::EnvmapDensity::from_file_filtered(
+        &a.envmap,
+        nuld_core::blob::Domain::Sphere,
+    )?;
+    let rows = envmap_prior::measure(&map, RUNTIME_SAMPLES)?;
+    println!(
+        "environment prior ns per sample, one thread, {}, n = 64 (best of 3)",
+        a.envmap.display()
+    );
+    println!("{:<52} {:>10} {:>12}", "method", "ns/sample", "/ incumbent");
+    let base = rows.first().map_or(f64::NAN, |r| r.1);
+    for (name, ns) in &rows {
+        println!("{name:<52} {ns:>10.1} {:>11.2}x", ns / base);
     }
     Ok(())
 }

@@ -99,14 +99,15 @@ pub struct EvalArgs {
     /// envmap-prior: the environment map (PNG, JPEG, HDR or EXR; equirectangular).
     #[arg(long)]
     pub envmap: Option<PathBuf>,
-    /// envmap-prior: normal grids, nodes per axis (each >= 2).
+    /// envmap-prior: normal grids, nodes per axis (each >= 2): the tables'
+    /// normals, and the normals of the tree's exact top-level weights.
     #[arg(long, value_delimiter = ',', default_value = "9,13,17")]
     pub grids: Vec<u32>,
     /// envmap-prior: table sizes, vertices per axis (each >= 2).
     #[arg(long, value_delimiter = ',', default_value = "32,64,128")]
     pub sizes: Vec<u32>,
     /// envmap-prior: depths of the hierarchical product warp (`2^L` leaves per
-    /// axis; each 1 to 12).
+    /// axis; each 3 to 12).
     #[arg(long, value_delimiter = ',', default_value = "8,9,10")]
     pub levels: Vec<u32>,
 }
@@ -236,8 +237,8 @@ fn run_envmap_prior(a: &EvalArgs) -> Result<()> {
         "--grids and --sizes need values of at least 2"
     );
     anyhow::ensure!(
-        a.levels.iter().all(|&l| (1..=12).contains(&l)),
-        "--levels needs values from 1 to 12"
+        a.levels.iter().all(|&l| (3..=12).contains(&l)),
+        "--levels needs values from 3 to 12"
     );
     let s = PriorSettings {
         grids: a.grids.clone(),
@@ -250,7 +251,7 @@ fn run_envmap_prior(a: &EvalArgs) -> Result<()> {
         crate::sphere::EnvmapDensity::from_file_filtered(path, nuld_core::blob::Domain::Sphere)?;
     crate::output::ensure_dir(&a.out)?;
     let started = Instant::now();
-    let total = (s.normals + s.grids.len() * s.sizes.len() + s.levels.len()) as u64;
+    let total = (s.normals + s.grids.len() * (s.sizes.len() + s.levels.len())) as u64;
     let progress = crate::progress::Progress::stderr("envmap-prior", total, "step");
     let rows = evaluate(&map, &s, &|what| {
         progress.set_message(what.to_string());

@@ -9,8 +9,9 @@
 //! * [`brdf_target`], [`envmap`]: the two tabulated targets;
 //! * [`envmap_prior`]: [`EnvmapPrior`], a map's `L cos` tabulated for a grid of
 //!   normals and sampled exactly between them (the environment sampler's prior);
-//! * [`envmap_tree`]: [`EnvmapTree`], a map's mip pyramid (masses and first
-//!   moments) on that square, sampled exactly times the cosine about the query's
+//! * [`envmap_tree`]: [`EnvmapTree`], a map measured into the records of
+//!   [`nuld_core::envmap_tree`] (mass, first moment and spread per node of a
+//!   pyramid on that square), sampled exactly times the cosine about the query's
 //!   normal;
 //! * [`filtered_luminance`]: a map's bilinearly filtered luminance (the light of
 //!   `bake --envmap` and `render`) and its exact tabulation on half pixels;

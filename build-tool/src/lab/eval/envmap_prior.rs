@@ -152,22 +152,27 @@ pub fn evaluate(
             progress(&format!("grid {grid}, size {size} done"));
         }
     }
-    for &levels in &s.levels {
-        let t = Instant::now();
-        let tree = EnvmapTree::new(map, levels)?;
-        let build_s = t.elapsed().as_secs_f64();
-        let warp = tree.warp();
-        let (owen_sobol, lattice) = score(&judges, s, &|n, u| tree.sample(&warp, n, u).0);
-        rows.push(PriorRow {
-            kind: "tree",
-            grid: 0,
-            size: 1 << levels,
-            state_bytes: tree.state_bytes(),
-            build_s,
-            owen_sobol,
-            lattice,
-        });
-        progress(&format!("tree of {levels} levels done"));
+    for &grid in &s.grids {
+        for &levels in &s.levels {
+            let t = Instant::now();
+            let tree = EnvmapTree::new(map, levels, grid)?;
+            let build_s = t.elapsed().as_secs_f64();
+            let core = tree.tree();
+            let warp = |n, u| EnvmapTree::sample(&core, n, u).0;
+            let (owen_sobol, lattice) = score(&judges, s, &warp);
+            rows.push(PriorRow {
+                kind: "tree",
+                grid,
+                size: 1 << levels,
+                state_bytes: tree.state_bytes(),
+                build_s,
+                owen_sobol,
+                lattice,
+            });
+            progress(&format!(
+                "tree of {levels} levels, {grid} x {grid} top normals done"
+            ));
+        }
     }
     Ok(rows)
 }
@@ -262,9 +267,12 @@ mod tests {
             seed: 1,
         };
         let rows = evaluate(&map, &s, &|_| {}).unwrap();
-        assert_eq!(rows.len(), 3);
-        assert_eq!((rows[2].kind, rows[2].size), ("tree", 16));
-        assert_eq!(rows[2].state_bytes, 16 * (4usize.pow(5) - 1) / 3);
+        assert_eq!(rows.len(), 4);
+        assert_eq!((rows[2].kind, rows[2].size, rows[2].grid), ("tree", 16, 2));
+        assert_eq!(
+            rows[3].state_bytes,
+            16 * ((4usize.pow(5) - 1) / 3 - 1) + 4 * 81 * 84
+        );
         for r in &rows[..2] {
             let nodes = (r.grid * r.grid) as usize;
             assert_eq!(r.state_bytes, 4 * nodes * (2 * 16 * 16 + 16));
@@ -274,8 +282,10 @@ mod tests {
             );
             assert!(r.owen_sobol.1 >= r.owen_sobol.0 && r.lattice.1 >= r.lattice.0);
         }
-        assert!(rows[2].owen_sobol.0.is_finite() && rows[2].lattice.0.is_finite());
-        assert_eq!(markdown(&rows).lines().count(), 5);
+        for r in &rows[2..] {
+            assert!(r.owen_sobol.0.is_finite() && r.lattice.0.is_finite());
+        }
+        assert_eq!(markdown(&rows).lines().count(), 6);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

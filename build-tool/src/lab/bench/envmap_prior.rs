@@ -1,0 +1,99 @@
+//! The environment sampler's prior per sample (`build-tool bench --only
+//! envmap-prior`): [`nuld_core::envmap_tree`]'s exact product warp of a map's
+//! light and a normal's cosine, in `f32` as the runtime calls it, against the
+//! incumbent a renderer ships, Owen-scrambled Sobol (`sobol_burley`) through the
+//! map's luminance inverse CDF ([`EnvmapDensity`]'s warp, which ignores the
+//! cosine).
+
+use crate::sphere::{DirectionDensity, EnvmapDensity, EnvmapTree};
+use anyhow::Result;
+use glam::{DVec2, DVec3};
+use nuld_core::network::hash_u32;
+use rand::{Rng, SeedableRng};
+use std::hint::black_box;
+use std::time::Instant;
+
+/// Normals cycled through: a renderer's shading points each have their own.
+const NORMALS: usize = 64;
+
+/// Points per set: a set of 64 shares its normal and scramble.
+const N: u32 = 64;
+
+/// Times of each method are the best of this many repeats.
+const REPEATS: usize = 3;
+
+/// Depth and top-weight grid timed: the environment sampler's defaults.
+pub const LEVELS: u32 = 8;
+/// Normals per axis of the top-weight table timed.
+pub const GRID: u32 = 49;
+
+/// Best-of-[`REPEATS`] nanoseconds per call of `f(sample number)`.
+fn ns_per_sample(count: u32, mut f: impl FnMut(u32)) -> f64 {
+    let mut best = f64::INFINITY;
+    for _ in 0..REPEATS {
+        let t = Instant::now();
+        for s in 0..count {
+            f(black_box(s));
+        }
+        best = best.min(t.elapsed().as_secs_f64() * 1e9 / count as f64);
+    }
+    best
+}
+
+/// `(method, ns per sample)` rows, the incumbent first, over `samples` samples
+/// each, one thread: sample `s` has normal `s / N mod 64`, and index `s mod N` of
+/// the set scrambled by `s / N`.
+pub fn measure(map: &EnvmapDensity, samples: u32) -> Result<Vec<(String, f64)>> {
+    let tree = EnvmapTree::new(map, LEVELS, GRID)?;
+    let core = tree.tree();
+    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(2);
+    let normals: Vec<DVec3> = (0..NORMALS)
+        .map(|_| {
+            DVec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            )
+            .normalize()
+        })
+        .collect();
+    let normals32: Vec<[f32; 3]> = normals.iter().map(|n| n.as_vec3().to_array()).collect();
+    let at = |s: u32| (s / N) as usize % NORMALS;
+    let u = |s: u32| {
+        let seed = hash_u32(s / N);
+        [
+            sobol_burley::sample(s % N, 0, seed),
+            sobol_burley::sample(s % N, 1, seed),
+        ]
+    };
+    let mut rows = Vec::new();
+    rows.push((
+        "incumbent: owen-sobol + luminance inverse CDF (f64)".to_string(),
+        ns_per_sample(samples, |s| {
+            let [x, y] = u(s);
+            black_box(map.sample(DVec2::new(x as f64, y as f64)));
+        }),
+    ));
+    rows.push((
+        format!("tree L {LEVELS}, top {GRID}: sample + pdf (f32)"),
+        ns_per_sample(samples, |s| {
+            black_box(core.sample(normals32[at(s)], u(s)));
+        }),
+    ));
+    rows.push((
+        format!("tree L {LEVELS}, top {GRID}: pdf of a direction (f32)"),
+        ns_per_sample(samples, |s| {
+            let [x, y] = u(s);
+            let d = nuld_core::sphere::square_to_sphere_real([x, y]);
+            black_box(core.pdf(normals32[at(s)], d));
+        }),
+    ));
+    rows.push((
+        format!("tree L {LEVELS}, top {GRID}: sample + pdf (f64)"),
+        ns_per_sample(samples / 4, |s| {
+            let [x, y] = u(s);
+            black_box(core.sample(normals[at(s)].to_array(), [x as f64, y as f64]));
+        }),
+    ));
+    Ok(rows)
+}

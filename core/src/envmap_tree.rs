@@ -1,0 +1,402 @@
+//! An environment map's light times the clamped cosine about a normal, sampled
+//! exactly by hierarchical product warping ([`crate::quadtree`]; Clarberg and
+//! Akenine-Möller 2008) with bounded work per node: the environment sampler's prior.
+//!
+//! **The state** is one pyramid of the map over the sphere's equal-area octahedral
+//! square ([`crate::sphere`]), whatever the normals: every node of levels `1..=L`
+//! holds a [`NodeRecord`], its mass `m0 = Σ mass` (the map's luminance over the
+//! node), first moment `m1 = Σ mass l` and *spread* `s = sqrt(m0² - |m1|²)`
+//! (`|l| = 1`, so `s² / m0` is the mass times the spread of `l` about its mean:
+//! 0 for a point, `m0²` for light balanced about the origin).
+//!
+//! **The weight of a node for a normal `n`** stands in for `Σ mass max(0, n.l)`:
+//!
+//! ```text
+//! w(n) = ( n.m1 + sqrt((n.m1)² + s²) ) / 2
+//! ```
+//!
+//! the largest `Σ mass max(0, x)` over all distributions of `x = n.l` with the
+//! node's mean `n.m1 / m0` and a variance up to `s² / m0²` (Scarf's bound; the
+//! variance of `n.l` is at most the spread). So `w` is exact for a point-like
+//! node, never below `max(0, n.m1)` (exact above the horizon but for a relative
+//! excess of about `s² / (4 (n.m1)²)`, which vanishes with a node's size), small but
+//! positive below the horizon, and positive wherever the node has spread: the pdf
+//! is positive wherever the map's light meets the cosine, and `L cos / pdf` is
+//! unbiased. Four records (64 bytes) and four square roots per level: `O(L)` per
+//! sample, no recursion across the horizon.
+//!
+//! **The top levels are exact.** The bound is loose for a node that spans a large
+//! part of the sphere across the horizon, and the first levels' choices move the
+//! most mass: with the bound alone, 3 to 20 % of the samples of courtyard's light
+//! fell below the horizon. So the weights of the nodes of levels
+//! `1..=`[`TOP_LEVELS`] (84 nodes) are tabulated exactly, `Σ_leaves max(0, n.m1)`,
+//! for a `G x G` grid of normals placed by their octahedral square points (nodes
+//! at `j / (G - 1)`, on the square's edges, so no cell crosses the seam), and
+//! interpolated bilinearly at the query; the bound times [`TOP_FLOOR`] stands
+//! under them, so a node that the query's normal sees keeps a positive weight
+//! even where the four grid normals around it see none of it.
+//!
+//! **Layout** ([`node_index`]): levels `1..=L` one after the other, each in Morton
+//! order, so a node's four children are four consecutive records (one 64-byte
+//! cache line when the table is 64-byte aligned): the record of child `(2x + i,
+//! 2y + j)` of level `l + 1` is `4 (morton(x, y)) + i + 2 j` past the level's
+//! first. The root's record is not stored.
+//!
+//! The square's pdf is the solid angle's times `4 pi` (the octahedral map has a
+//! constant Jacobian), so [`EnvmapTree::sample`] and [`EnvmapTree::pdf`] answer
+//! per steradian. Everything is generic over [`Real`] (`f32` in the runtime and
+//! shaders, `f64` in the tool), allocates nothing and never panics.
+
+use crate::quadtree::{self, ChildWeights, QuadtreeError, MAX_LEVELS};
+use crate::real::{clamp_unit, Real};
+use crate::sphere::{sphere_to_square_real, square_to_sphere_real};
+use bytemuck::{Pod, Zeroable};
+
+/// Most levels of an environment tree: `2^12 x 2^12` leaves (0.05° apart) are
+/// finer than any map's pixels, and the records (22 M of them, 358 MB) past any
+/// table worth shipping.
+pub const MAX_TREE_LEVELS: u32 = 12;
+
+/// One node of an environment tree (16 bytes, `#[repr(C)]`, little-endian):
+/// `m1` and `s` of the module docs.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct NodeRecord {
+    /// First moment `Σ mass l` of the node's light, `l` unit directions.
+    pub moment: [f32; 3],
+    /// Spread `s = sqrt(m0² - |m1|²) >= 0`.
+    pub spread: f32,
+}
+
+impl NodeRecord {
+    /// The record of a node with mass `m0 >= 0` and first moment `m1`, its spread
+    /// at least `floor * m0` (a floor keeps a node's weight positive for every
+    /// normal that sees part of it when the node's light was measured at too few
+    /// points to show its extent). `m0² - |m1|²` is formed in `f64`.
+    pub fn from_moments(m0: f64, m1: [f64; 3], floor: f64) -> Self {
+        let s2 = m0 * m0 - (m1[0] * m1[0] + m1[1] * m1[1] + m1[2] * m1[2]);
+        let s = libm::sqrt(s2.max(0.0)).max(floor * m0);
+        Self {
+            moment: m1.map(|v| v as f32),
+            spread: s as f32,
+        }
+    }
+
+    /// The node's mass `m0 = sqrt(|m1|² + s²)`.
+    pub fn mass(&self) -> f32 {
+        let [x, y, z] = self.moment;
+        libm::sqrtf(x * x + y * y + z * z + self.spread * self.spread)
+    }
+
+    /// The node's weight for the unit normal `n` (module docs): `(n.m1 +
+    /// sqrt((n.m1)² + s²)) / 2`, in `T`'s arithmetic.
+    #[inline]
+    pub fn weight<T: Real>(&self, n: [T; 3]) -> T {
+        let m = self.moment.map(|v| T::of(v as f64));
+        let a = n[0] * m[0] + n[1] * m[1] + n[2] * m[2];
+        let s = T::of(self.spread as f64);
+        (a + (a * a + s * s).sqrt()) * T::of(0.5)
+    }
+}
+
+/// Records of a tree with `levels` levels (levels `1..=L`): `(4^(L+1) - 4) / 3`.
+pub fn node_count(levels: u32) -> usize {
+    quadtree::pyramid_len(levels) - 1
+}
+
+/// Index of node `(x, y)` of level `1 <= level <= L` in the records (module docs'
+/// layout). `x, y < 2^level`.
+#[inline]
+pub fn node_index(level: u32, x: u32, y: u32) -> usize {
+    quadtree::level_offset(level) - 1 + morton(x, y) as usize
+}
+
+/// `x` on the even bits, `y` on the odd bits (16 bits each).
+#[inline]
+fn morton(x: u32, y: u32) -> u32 {
+    fn spread(mut v: u32) -> u32 {
+        v &= 0xffff;
+        v = (v | (v << 8)) & 0x00ff_00ff;
+        v = (v | (v << 4)) & 0x0f0f_0f0f;
+        v = (v | (v << 2)) & 0x3333_3333;
+        (v | (v << 1)) & 0x5555_5555
+    }
+    spread(x) | (spread(y) << 1)
+}
+
+/// Levels whose nodes' weights are tabulated over a grid of normals (module docs).
+pub const TOP_LEVELS: u32 = 3;
+
+const _: () = assert!(node_count_const(TOP_LEVELS) == 84);
+
+const fn node_count_const(levels: u32) -> usize {
+    ((1usize << (2 * (levels + 1))) - 4) / 3
+}
+
+/// Share of the bound that stands under a tabulated top-level weight.
+pub const TOP_FLOOR: f64 = 1e-3;
+
+/// Entries of a top-weight table on a grid of `grid x grid` normals: `grid² x
+/// node_count(TOP_LEVELS)` (84 per normal), `[normal j1 grid + j0][node]` with
+/// the nodes in the records' order.
+pub fn top_len(grid: u32) -> usize {
+    (grid as usize) * (grid as usize) * node_count(TOP_LEVELS)
+}
+
+/// The unit normal of top-table grid node `(j0, j1)` of `grid x grid`: the
+/// octahedral square's point `(j0, j1) / (grid - 1)` on the sphere.
+pub fn top_normal(grid: u32, j: [u32; 2]) -> [f64; 3] {
+    let g = (grid.max(2) - 1) as f64;
+    square_to_sphere_real([j[0] as f64 / g, j[1] as f64 / g])
+}
+
+/// One row of a top-weight table, for the unit normal `n`: the exact weight
+/// `Σ_leaves max(0, n.m1)` of each node of levels `1..=TOP_LEVELS`, summed from
+/// the leaf records of `nodes` (a tree of `levels >= TOP_LEVELS` levels). `row`
+/// holds [`node_count`]`(TOP_LEVELS)` values. `O(4^L)`.
+pub fn top_row(levels: u32, nodes: &[NodeRecord], n: [f64; 3], row: &mut [f32]) {
+    let mut sums = [0.0f64; 84];
+    let side = 1u32 << levels;
+    for y in 0..side {
+        for x in 0..side {
+            let Some(r) = nodes.get(node_index(levels, x, y)) else {
+                continue;
+            };
+            let m = r.moment;
+            let w = (n[0] * m[0] as f64 + n[1] * m[1] as f64 + n[2] * m[2] as f64).max(0.0);
+            for l in 1..=TOP_LEVELS.min(levels) {
+                let s = levels - l;
+                sums[node_index(l, x >> s, y >> s)] += w;
+            }
+        }
+    }
+    for (out, v) in row.iter_mut().zip(sums) {
+        *out = v as f32;
+    }
+}
+
+/// Spread floor of a node of level `l`, as a fraction of its mass: `SPREAD_FLOOR /
+/// 2^l`, about a quarter of the angular radius of a node of that level (a node is
+/// about `3.5 / 2^l` radians across).
+pub const SPREAD_FLOOR: f64 = 0.25;
+
+/// Fills `nodes` ([`node_count`]`(levels)` records) from the `2^L x 2^L` leaves'
+/// `[m0, m1.x, m1.y, m1.z]` (row-major, `f64`): every node's mass and moment are
+/// the sums over its leaves (in `f64`), its spread is formed from them with the
+/// floor [`SPREAD_FLOOR`]` / 2^l`. `O(L 4^L)`, no allocation. An error if the
+/// lengths or `levels` are wrong.
+pub fn build(
+    levels: u32,
+    leaves: &[[f64; 4]],
+    nodes: &mut [NodeRecord],
+) -> Result<(), QuadtreeError> {
+    if levels == 0 || levels > MAX_TREE_LEVELS {
+        return Err(QuadtreeError::Levels(levels));
+    }
+    let side = 1usize << levels;
+    for (expected, got) in [
+        (side * side, leaves.len()),
+        (node_count(levels), nodes.len()),
+    ] {
+        if expected != got {
+            return Err(QuadtreeError::Length {
+                expected: expected as u64,
+                got: got as u64,
+            });
+        }
+    }
+    for l in 1..=levels {
+        let (s, block) = (1usize << l, 1usize << (levels - l));
+        for y in 0..s {
+            for x in 0..s {
+                let mut sum = [0.0f64; 4];
+                for ly in y * block..(y + 1) * block {
+                    for leaf in &leaves[ly * side + x * block..ly * side + (x + 1) * block] {
+                        for c in 0..4 {
+                            sum[c] += leaf[c];
+                        }
+                    }
+                }
+                let floor = SPREAD_FLOOR / s as f64;
+                nodes[node_index(l, x as u32, y as u32)] =
+                    NodeRecord::from_moments(sum[0], [sum[1], sum[2], sum[3]], floor);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A borrowed environment tree (module docs).
+#[derive(Clone, Copy, Debug)]
+pub struct EnvmapTree<'a> {
+    levels: u32,
+    nodes: &'a [NodeRecord],
+    grid: u32,
+    top: &'a [f32],
+}
+
+impl<'a> EnvmapTree<'a> {
+    /// The tree of `levels` levels ([`TOP_LEVELS`] to [`MAX_TREE_LEVELS`]) over
+    /// `nodes`, with the top-weight table `top` on `grid x grid` normals (at
+    /// least 2 per axis): checks the counts ([`node_count`], [`top_len`]), every value
+    /// finite, every spread and top weight non-negative, and some light (a level-1
+    /// record with positive mass). A tree whose parents are not the sums of their
+    /// children, or whose top table is not theirs, still never panics; it
+    /// describes another warp, sampled as exactly.
+    pub fn new(
+        levels: u32,
+        nodes: &'a [NodeRecord],
+        grid: u32,
+        top: &'a [f32],
+    ) -> Result<Self, QuadtreeError> {
+        if !(TOP_LEVELS..=MAX_TREE_LEVELS.min(MAX_LEVELS)).contains(&levels) {
+            return Err(QuadtreeError::Levels(levels));
+        }
+        if !(2..=1024).contains(&grid) || top.len() != top_len(grid) {
+            return Err(QuadtreeError::Length {
+                expected: top_len(grid.clamp(2, 1024)) as u64,
+                got: top.len() as u64,
+            });
+        }
+        if let Some(i) = top.iter().position(|v| !(*v >= 0.0 && v.is_finite())) {
+            return Err(QuadtreeError::BadMass(i as u64));
+        }
+        if nodes.len() != node_count(levels) {
+            return Err(QuadtreeError::Length {
+                expected: node_count(levels) as u64,
+                got: nodes.len() as u64,
+            });
+        }
+        if let Some(i) = nodes.iter().position(|r| {
+            !(r.moment.iter().all(|v| v.is_finite()) && r.spread >= 0.0 && r.spread.is_finite())
+        }) {
+            return Err(QuadtreeError::BadMass(i as u64));
+        }
+        if !nodes[..4].iter().any(|r| r.mass() > 0.0) {
+            return Err(QuadtreeError::NoMass);
+        }
+        Ok(Self {
+            levels,
+            nodes,
+            grid,
+            top,
+        })
+    }
+
+    /// Levels below the root (`2^L x 2^L` leaves).
+    pub fn levels(&self) -> u32 {
+        self.levels
+    }
+
+    /// The records.
+    pub fn nodes(&self) -> &'a [NodeRecord] {
+        self.nodes
+    }
+
+    /// The tree lit by the cosine about `normal` (normalized here; a zero, tiny or
+    /// non-finite normal reads as `+z`).
+    #[inline]
+    pub fn lit<T: Real>(&self, normal: [T; 3]) -> Lit<'a, T> {
+        let n = unit_or_z(normal);
+        let p = sphere_to_square_real(n);
+        let g = self.grid - 1;
+        let cell = p.map(|c| {
+            let s = clamp_unit(c) * T::of(g as f64);
+            let j0 = (s.floor().to_f64() as u32).min(g - 1);
+            (j0, s - T::of(j0 as f64))
+        });
+        Lit {
+            tree: *self,
+            n,
+            cell,
+        }
+    }
+
+    /// Normals per axis of the top-weight table.
+    pub fn grid(&self) -> u32 {
+        self.grid
+    }
+
+    /// The top-weight table.
+    pub fn top(&self) -> &'a [f32] {
+        self.top
+    }
+
+    /// The direction at primary sample `u` in `[0,1]^2` (clamped) for `normal`,
+    /// and its solid-angle pdf ([`Self::pdf`]). `O(L)`; never panics.
+    #[inline]
+    pub fn sample<T: Real>(&self, normal: [T; 3], u: [T; 2]) -> ([T; 3], T) {
+        let (p, pdf) = quadtree::sample(&self.lit(normal), u);
+        (square_to_sphere_real(p), pdf / (T::of(4.0) * T::PI))
+    }
+
+    /// The solid-angle density of [`Self::sample`]'s directions at the unit
+    /// direction `d` for `normal`. `O(L)`; never panics.
+    #[inline]
+    pub fn pdf<T: Real>(&self, normal: [T; 3], d: [T; 3]) -> T {
+        quadtree::pdf(&self.lit(normal), sphere_to_square_real(d)) / (T::of(4.0) * T::PI)
+    }
+
+    /// The primary sample that [`Self::sample`] maps to the unit direction `d`.
+    pub fn invert<T: Real>(&self, normal: [T; 3], d: [T; 3]) -> [T; 2] {
+        quadtree::invert(&self.lit(normal), sphere_to_square_real(d))
+    }
+}
+
+/// An [`EnvmapTree`] lit by the cosine about one normal: its [`ChildWeights`].
+#[derive(Clone, Copy, Debug)]
+pub struct Lit<'a, T> {
+    tree: EnvmapTree<'a>,
+    n: [T; 3],
+    /// The top table's cell: lower node and fraction per axis.
+    cell: [(u32, T); 2],
+}
+
+impl<T: Real> Lit<'_, T> {
+    /// Bilinear interpolation of top-table node `node`'s weight at the normal.
+    #[inline]
+    fn top_weight(&self, node: usize) -> T {
+        let (g, per) = (self.tree.grid as usize, node_count(TOP_LEVELS));
+        let [(x0, tx), (y0, ty)] = self.cell;
+        let at = |dx: usize, dy: usize| {
+            let row = (y0 as usize + dy) * g + x0 as usize + dx;
+            T::of(self.tree.top.get(row * per + node).copied().unwrap_or(0.0) as f64)
+        };
+        let a = at(0, 0) + (at(1, 0) - at(0, 0)) * tx;
+        let b = at(0, 1) + (at(1, 1) - at(0, 1)) * tx;
+        a + (b - a) * ty
+    }
+}
+
+impl<T: Real> ChildWeights<T> for Lit<'_, T> {
+    fn levels(&self) -> u32 {
+        self.tree.levels
+    }
+
+    #[inline]
+    fn children(&self, level: u32, x: u32, y: u32) -> [T; 4] {
+        let first = node_index(level + 1, 2 * x, 2 * y);
+        let Some(c) = self.tree.nodes.get(first..first + 4) else {
+            return [T::ONE; 4];
+        };
+        let bound: [T; 4] = core::array::from_fn(|k| c[k].weight(self.n));
+        if level < TOP_LEVELS {
+            core::array::from_fn(|k| self.top_weight(first + k).max(bound[k] * T::of(TOP_FLOOR)))
+        } else {
+            bound
+        }
+    }
+}
+
+/// `v / |v|`, or `+z` where `|v|` is 0, tiny or not finite.
+fn unit_or_z<T: Real>(v: [T; 3]) -> [T; 3] {
+    let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    if len > T::of(1e-20) && len.is_finite() {
+        v.map(|c| c / len)
+    } else {
+        [T::ZERO, T::ZERO, T::ONE]
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,406 @@
+extern crate std;
+
+use super::*;
+use crate::sphere::square_to_sphere;
+use crate::test_rng::Rng;
+use glam::{DVec2, DVec3};
+use std::vec;
+use std::vec::Vec;
+
+/// A light with a broad sky, a small bright sun low in the sky and a dark ground:
+/// what the tree must resolve.
+fn light(d: DVec3) -> f64 {
+    let sun = DVec3::new(0.8, 0.3, 0.2).normalize();
+    let sky = if d.z > 0.0 { 0.5 + d.z } else { 0.02 };
+    sky + 400.0 * (-(1.0 - d.dot(sun)) * 2000.0).exp()
+}
+
+/// Leaf moments of `light` by `k x k` midpoints per leaf (each leaf has the same
+/// solid angle, `4 pi / 4^L`).
+fn leaves(levels: u32, k: usize) -> Vec<[f64; 4]> {
+    let side = 1usize << levels;
+    let area = 4.0 * core::f64::consts::PI / (side * side * k * k) as f64;
+    (0..side * side)
+        .map(|leaf| {
+            let (x, y) = (leaf % side, leaf / side);
+            let mut m = [0.0; 4];
+            for b in 0..k {
+                for a in 0..k {
+                    let d = square_to_sphere(DVec2::new(
+                        (x as f64 + (a as f64 + 0.5) / k as f64) / side as f64,
+                        (y as f64 + (b as f64 + 0.5) / k as f64) / side as f64,
+                    ));
+                    let v = light(d) * area;
+                    m[0] += v;
+                    m[1] += v * d.x;
+                    m[2] += v * d.y;
+                    m[3] += v * d.z;
+                }
+            }
+            m
+        })
+        .collect()
+}
+
+fn tree_nodes(levels: u32) -> Vec<NodeRecord> {
+    let mut nodes = vec![NodeRecord::zeroed(); node_count(levels)];
+    build(levels, &leaves(levels, 4), &mut nodes).unwrap();
+    nodes
+}
+
+const GRID: u32 = 9;
+
+fn top_table(levels: u32, nodes: &[NodeRecord]) -> Vec<f32> {
+    let per = node_count(TOP_LEVELS);
+    let mut top = vec![0.0; top_len(GRID)];
+    for (r, row) in top.chunks_mut(per).enumerate() {
+        let j = [r as u32 % GRID, r as u32 / GRID];
+        top_row(levels, nodes, top_normal(GRID, j), row);
+    }
+    top
+}
+
+fn normals() -> [[f64; 3]; 4] {
+    [
+        [0.0, 0.0, 1.0],
+        [0.6, -0.3, 0.1],
+        [-0.2, 0.9, -0.5],
+        [0.0, 0.0, -1.0],
+    ]
+}
+
+#[test]
+fn morton_layout_puts_a_nodes_children_side_by_side() {
+    assert_eq!(node_count(1), 4);
+    assert_eq!(node_count(3), 4 + 16 + 64);
+    for l in 1..6u32 {
+        let s = 1u32 << l;
+        let mut seen = vec![false; node_count(6)];
+        for y in 0..s {
+            for x in 0..s {
+                let i = node_index(l, x, y);
+                assert!(i >= node_count(l - 1) && i < node_count(l));
+                assert!(!seen[i]);
+                seen[i] = true;
+                if l < 5 {
+                    let c = node_index(l + 1, 2 * x, 2 * y);
+                    assert_eq!(c % 4, 0, "children start a group of four");
+                    assert_eq!(node_index(l + 1, 2 * x + 1, 2 * y), c + 1);
+                    assert_eq!(node_index(l + 1, 2 * x, 2 * y + 1), c + 2);
+                    assert_eq!(node_index(l + 1, 2 * x + 1, 2 * y + 1), c + 3);
+                }
+            }
+        }
+    }
+}
+
+/// Every node's weight is at least the brute-force `Σ mass max(0, n.l)` over its
+/// own light (the leaves' midpoints) and at least `max(0, n.m1)`, and for small
+/// nodes well above the horizon (`n.l > 0.3` on the node) within a few percent of
+/// it.
+#[test]
+fn a_nodes_weight_bounds_its_lit_mass_from_above_and_is_tight_above_the_horizon() {
+    let levels = 6;
+    let k = 4;
+    let side = 1usize << levels;
+    let area = 4.0 * core::f64::consts::PI / (side * side * k * k) as f64;
+    let nodes = tree_nodes(levels);
+    for n in normals().map(|n| DVec3::from_array(n).normalize()) {
+        for l in [2u32, 4, 6] {
+            let s = 1usize << l;
+            let block = side / s;
+            for node in (0..s * s).step_by(3) {
+                let (x, y) = (node % s, node / s);
+                let (mut lit, mut low, mut above) = (0.0, false, false);
+                for py in y * block * k..(y + 1) * block * k {
+                    for px in x * block * k..(x + 1) * block * k {
+                        let d = square_to_sphere(DVec2::new(
+                            (px as f64 + 0.5) / (side * k) as f64,
+                            (py as f64 + 0.5) / (side * k) as f64,
+                        ));
+                        lit += light(d) * area * n.dot(d).max(0.0);
+                        low |= n.dot(d) <= 0.3;
+                        above |= n.dot(d) > 0.0;
+                    }
+                }
+                let r = nodes[node_index(l, x as u32, y as u32)];
+                let w: f64 = r.weight(n.to_array());
+                let m1 = DVec3::from_array(r.moment.map(|v| v as f64));
+                assert!(
+                    w >= lit * (1.0 - 1e-5) - 1e-12,
+                    "level {l} {n}: {w} < {lit}"
+                );
+                assert!(w >= n.dot(m1).max(0.0) * (1.0 - 1e-6));
+                if above {
+                    assert!(w > 0.0);
+                }
+                if l == 6 && !low {
+                    assert!(w <= lit * 1.05, "level {l} {n}: {w} vs {lit}");
+                }
+            }
+        }
+    }
+}
+
+/// At a grid normal the top levels' weights are the exact lit masses of their
+/// leaves (a brute-force sum over the leaf records), within f32 rounding; between
+/// grid normals they are positive wherever the query's normal sees the node.
+#[test]
+fn top_weights_are_exact_at_grid_normals_and_positive_where_lit() {
+    let levels = 5;
+    let nodes = tree_nodes(levels);
+    let top = top_table(levels, &nodes);
+    let tree = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let side = 1u32 << levels;
+    let lit_mass = |n: DVec3, l: u32, x: u32, y: u32| {
+        let b = side >> l;
+        let mut w = 0.0;
+        for ly in y * b..(y + 1) * b {
+            for lx in x * b..(x + 1) * b {
+                let m = nodes[node_index(levels, lx, ly)].moment.map(|v| v as f64);
+                w += n.dot(DVec3::from_array(m)).max(0.0);
+            }
+        }
+        w
+    };
+    for j in [[0, 0], [3, 5], [8, 8], [4, 4]] {
+        let n = top_normal(GRID, j);
+        let lit = tree.lit(n);
+        for l in 0..TOP_LEVELS {
+            let s = 1u32 << l;
+            for node in 0..s * s {
+                let (x, y) = (node % s, node / s);
+                let w = lit.children(l, x, y);
+                for k in 0..4u32 {
+                    let exact = lit_mass(
+                        DVec3::from_array(n),
+                        l + 1,
+                        2 * x + (k & 1),
+                        2 * y + (k >> 1),
+                    );
+                    let floor = TOP_FLOOR
+                        * nodes[node_index(l + 1, 2 * x + (k & 1), 2 * y + (k >> 1))]
+                            .weight::<f64>(n);
+                    assert!((w[k as usize] - exact.max(floor)).abs() <= 1e-6 * exact.max(1e-9));
+                }
+            }
+        }
+    }
+    let mut r = Rng(8);
+    for _ in 0..300 {
+        let n = DVec3::new(r.next() - 0.5, r.next() - 0.5, r.next() - 0.5).normalize();
+        let lit = tree.lit(n.to_array());
+        for k in 0..4u32 {
+            let w = lit.children(0, 0, 0)[k as usize];
+            if lit_mass(n, 1, k & 1, k >> 1) > 0.0 {
+                assert!(w > 0.0);
+            }
+        }
+    }
+}
+
+#[test]
+fn the_pdf_integrates_to_one_over_the_sphere() {
+    let levels = 6;
+    let nodes = tree_nodes(levels);
+    let top = top_table(levels, &nodes);
+    let tree = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let m = 256;
+    for n in normals() {
+        let mut sum = 0.0;
+        for k in 0..m * m {
+            let d = square_to_sphere(DVec2::new(
+                ((k % m) as f64 + 0.5) / m as f64,
+                ((k / m) as f64 + 0.5) / m as f64,
+            ));
+            sum += tree.pdf(n, d.to_array()) * 4.0 * core::f64::consts::PI / (m * m) as f64;
+        }
+        assert!((sum - 1.0).abs() < 1e-9, "{n:?}: {sum}");
+    }
+}
+
+/// 10^6 samples on 64 x 64 bins of the square (each a union of leaves, where the
+/// pdf is constant): chi-square against the pdf; the returned pdf is the pdf at
+/// the sample; `invert` undoes `sample`.
+#[test]
+fn samples_follow_the_pdf_and_invert_undoes_sample() {
+    let levels = 6;
+    let nodes = tree_nodes(levels);
+    let top = top_table(levels, &nodes);
+    let tree = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let n = [0.6, -0.3, 0.1];
+    let bins = 64usize;
+    let samples = 1_000_000;
+    let mut counts = vec![0u32; bins * bins];
+    let mut r = Rng(5);
+    let mut worst: f64 = 0.0;
+    for s in 0..samples {
+        let u = [r.next(), r.next()];
+        let (d, pdf) = tree.sample(n, u);
+        let p = crate::sphere::sphere_to_square(DVec3::from_array(d));
+        let i = ((p.x * bins as f64) as usize).min(bins - 1);
+        let j = ((p.y * bins as f64) as usize).min(bins - 1);
+        counts[j * bins + i] += 1;
+        if s % 50 == 0 {
+            let inside = |c: f64| ((c * 64.0).fract() - 0.5).abs() < 0.499;
+            if inside(p.x) && inside(p.y) {
+                assert!((tree.pdf(n, d) - pdf).abs() <= 1e-9 * pdf);
+                let back = tree.invert(n, d);
+                worst = worst
+                    .max((back[0] - u[0]).abs())
+                    .max((back[1] - u[1]).abs());
+            }
+        }
+    }
+    assert!(worst < 1e-6, "{worst}");
+    let (mut chi2, mut dof) = (0.0, 0);
+    for j in 0..bins {
+        for i in 0..bins {
+            let c = square_to_sphere(DVec2::new(
+                (i as f64 + 0.5) / bins as f64,
+                (j as f64 + 0.5) / bins as f64,
+            ));
+            let expected = samples as f64 * tree.pdf(n, c.to_array()) * 4.0 * core::f64::consts::PI
+                / (bins * bins) as f64;
+            let got = counts[j * bins + i] as f64;
+            if expected > 0.0 {
+                chi2 += (got - expected).powi(2) / expected;
+                dof += 1;
+            } else {
+                assert_eq!(got, 0.0);
+            }
+        }
+    }
+    let sd = (2.0 * dof as f64).sqrt();
+    assert!(chi2 < dof as f64 + 5.0 * sd, "chi-square {chi2} over {dof}");
+}
+
+/// `(1/M) Σ L cos / pdf` over the tree's samples is the irradiance by an
+/// independent quadrature (a fine midpoint rule on the square, `L` the light
+/// itself, not the tree's leaves), for normals facing the sun, the sky and the
+/// ground.
+#[test]
+fn the_estimate_with_the_pdf_is_the_irradiance() {
+    let levels = 7;
+    let nodes = tree_nodes(levels);
+    let top = top_table(levels, &nodes);
+    let tree = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let m = 1024;
+    for (t, n) in normals().into_iter().enumerate() {
+        let nv = DVec3::from_array(n).normalize();
+        let mut exact = 0.0;
+        for k in 0..m * m {
+            let d = square_to_sphere(DVec2::new(
+                ((k % m) as f64 + 0.5) / m as f64,
+                ((k / m) as f64 + 0.5) / m as f64,
+            ));
+            exact += light(d) * nv.dot(d).max(0.0) * 4.0 * core::f64::consts::PI / (m * m) as f64;
+        }
+        let mut r = Rng(40 + t as u64);
+        let count = 200_000;
+        let (mut sum, mut sq) = (0.0, 0.0);
+        for _ in 0..count {
+            let (d, pdf) = tree.sample(n, [r.next(), r.next()]);
+            let d = DVec3::from_array(d);
+            let v = if pdf > 0.0 {
+                light(d) * nv.dot(d).max(0.0) / pdf
+            } else {
+                0.0
+            };
+            sum += v;
+            sq += v * v;
+        }
+        let mean = sum / count as f64;
+        let se = ((sq / count as f64 - mean * mean) / count as f64).sqrt();
+        assert!(
+            (mean - exact).abs() < 4.0 * se + 1e-4 * exact,
+            "{n:?}: {mean} vs {exact} (se {se})"
+        );
+        // The cosine product puts samples where the light meets the cosine: the
+        // relative error of one sample stays near that of a perfect importance
+        // sampler's for these smooth parts, far below the map's alone.
+        assert!(se * (count as f64).sqrt() < 3.0 * exact, "{n:?}: {se}");
+    }
+}
+
+#[test]
+fn f32_agrees_with_f64() {
+    let levels = 6;
+    let nodes = tree_nodes(levels);
+    let top = top_table(levels, &nodes);
+    let tree = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let mut r = Rng(3);
+    for _ in 0..2000 {
+        let u = [r.next(), r.next()];
+        let n = [r.next() - 0.5, r.next() - 0.5, r.next() - 0.5];
+        let (d64, p64) = tree.sample(n, u);
+        let (d32, p32) = tree.sample(n.map(|v| v as f32), u.map(|v| v as f32));
+        let err = (0..3)
+            .map(|c| (d64[c] - d32[c] as f64).abs())
+            .fold(0.0, f64::max);
+        // A sample on a split's edge may fall on either side in f32.
+        if err < 1e-3 {
+            assert!(((p32 as f64) - p64).abs() <= 1e-3 * p64, "{p32} vs {p64}");
+        }
+    }
+}
+
+#[test]
+fn bad_trees_are_refused_and_hostile_queries_do_not_panic() {
+    let nodes = tree_nodes(4);
+    let top = top_table(4, &nodes);
+    let new = |l, n: &[NodeRecord]| EnvmapTree::new(l, n, GRID, &top).map(|_| ());
+    assert_eq!(new(2, &nodes), Err(QuadtreeError::Levels(2)));
+    assert_eq!(new(13, &nodes), Err(QuadtreeError::Levels(13)));
+    assert!(matches!(
+        new(3, &nodes),
+        Err(QuadtreeError::Length { expected: 84, .. })
+    ));
+    assert!(matches!(
+        EnvmapTree::new(4, &nodes, GRID + 1, &top),
+        Err(QuadtreeError::Length { .. })
+    ));
+    assert!(EnvmapTree::new(4, &nodes, 1, &top[..84]).is_err());
+    let mut bad_top = top.clone();
+    bad_top[5] = -1.0;
+    assert_eq!(
+        EnvmapTree::new(4, &nodes, GRID, &bad_top).map(|_| ()),
+        Err(QuadtreeError::BadMass(5))
+    );
+    let mut bad = nodes.clone();
+    bad[7].spread = -1.0;
+    assert_eq!(new(4, &bad), Err(QuadtreeError::BadMass(7)));
+    bad[7].spread = 1.0;
+    bad[9].moment[1] = f32::NAN;
+    assert_eq!(new(4, &bad), Err(QuadtreeError::BadMass(9)));
+    let dark = vec![NodeRecord::zeroed(); node_count(4)];
+    assert_eq!(new(4, &dark), Err(QuadtreeError::NoMass));
+    let mut leaves_short = leaves(3, 1);
+    let nodes = tree_nodes(4);
+    leaves_short.pop();
+    let mut out = vec![NodeRecord::zeroed(); node_count(3)];
+    assert!(build(3, &leaves_short, &mut out).is_err());
+
+    // Parents that are not their children's sums, zero normals, NaN and huge
+    // inputs: finite or zero answers, no panic.
+    let mut odd = nodes.clone();
+    for r in odd.iter_mut().step_by(5) {
+        r.moment = [1e30, -1e30, 0.0];
+    }
+    let tree = EnvmapTree::new(4, &odd, GRID, &top).unwrap();
+    for n in [
+        [0.0f32; 3],
+        [f32::NAN, 0.0, 1.0],
+        [f32::INFINITY, 1.0, 0.0],
+        [1e30, 0.0, 0.0],
+    ] {
+        for u in [[0.0f32, 0.0], [1.0, 1.0], [f32::NAN, 0.5], [-3.0, 7.0]] {
+            let (d, pdf) = tree.sample(n, u);
+            assert!(d.iter().all(|c| c.is_finite()) && pdf >= 0.0 && pdf.is_finite());
+            assert!(tree.pdf(n, d) >= 0.0);
+            let back = tree.invert(n, d);
+            assert!(back.iter().all(|c| (0.0..=1.0).contains(c)));
+        }
+        assert!(tree.pdf(n, [f32::NAN; 3]) >= 0.0);
+    }
+}
