@@ -485,6 +485,7 @@ fn conditional_blob(path: &Path) {
         params,
         table,
         weights,
+        prior: None,
     };
     let meta = nuld_core::blob::Metadata {
         generator: "cli-test",
@@ -515,7 +516,7 @@ fn sample_prints_what_the_runtime_serves_and_rejects_bad_input() {
             mode,
         ]));
         let mut lines = csv.lines();
-        assert_eq!(lines.next(), Some("index,x,y,z,weight"));
+        assert_eq!(lines.next(), Some("index,x,y,z,weight,pdf"));
         let rows: Vec<Vec<f32>> = lines
             .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
             .collect();
@@ -533,6 +534,7 @@ fn sample_prints_what_the_runtime_serves_and_rejects_bad_input() {
                 s.direction.y,
                 s.direction.z,
                 s.weight,
+                s.pdf,
             ];
             assert_eq!(row.as_slice(), want.as_slice(), "{mode} {i}");
         }
@@ -550,7 +552,10 @@ fn sample_prints_what_the_runtime_serves_and_rejects_bad_input() {
     .to_string();
     let s = cs.sample(Vec2::new(1.0, 0.0), 0, 0);
     let d = s.direction;
-    assert_eq!(first, format!("0,{},{},{},{}", d.x, d.y, d.z, s.weight));
+    assert_eq!(
+        first,
+        format!("0,{},{},{},{},{}", d.x, d.y, d.z, s.weight, s.pdf)
+    );
     // A condition outside the blob's range is clamped, and stderr says so in one
     // line; one inside the range prints nothing there.
     for (cond, warned) in [("2,-10", true), ("0.35,47.5", false)] {

@@ -99,6 +99,51 @@ impl NodeRecord {
     }
 }
 
+/// The environment prior's info section (16 bytes, `#[repr(C)]`, little-endian).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
+pub struct TreeInfo {
+    /// Levels below the root, [`TOP_LEVELS`] to [`MAX_TREE_LEVELS`].
+    pub levels: u32,
+    /// Normals per axis of the top-weight table, 2 to 1024.
+    pub grid: u32,
+    /// Reserved, zero.
+    pub reserved: [u32; 2],
+}
+
+/// Size of [`TreeInfo`] in bytes.
+pub const TREE_INFO_LEN: usize = core::mem::size_of::<TreeInfo>();
+
+const _: () = assert!(TREE_INFO_LEN == 16 && core::mem::size_of::<NodeRecord>() == 16);
+
+/// The three sections of an environment prior, in the order `core/FORMAT.md`
+/// lists them, ready for [`crate::blob::write`] (after a conditional blob's own,
+/// [`crate::conditional::sections`]). Checks no length: a reader validates them.
+pub fn sections<'s>(
+    info: &'s TreeInfo,
+    nodes: &'s [NodeRecord],
+    top: &'s [f32],
+) -> [crate::blob::SectionSpec<'s>; 3] {
+    use crate::blob::{SectionSpec, SectionTag};
+    [
+        SectionSpec {
+            tag: SectionTag::EnvmapTreeInfo,
+            elem_size: TREE_INFO_LEN as u32,
+            bytes: bytemuck::bytes_of(info),
+        },
+        SectionSpec {
+            tag: SectionTag::EnvmapTreeNodes,
+            elem_size: 16,
+            bytes: bytemuck::cast_slice(nodes),
+        },
+        SectionSpec {
+            tag: SectionTag::EnvmapTreeTop,
+            elem_size: 4,
+            bytes: bytemuck::cast_slice(top),
+        },
+    ]
+}
+
 /// Records of a tree with `levels` levels (levels `1..=L`): `(4^(L+1) - 4) / 3`.
 pub fn node_count(levels: u32) -> usize {
     quadtree::pyramid_len(levels) - 1
@@ -249,6 +294,20 @@ impl<'a> EnvmapTree<'a> {
         grid: u32,
         top: &'a [f32],
     ) -> Result<Self, QuadtreeError> {
+        let tree = Self::view(levels, nodes, grid, top)?;
+        tree.check_values()?;
+        Ok(tree)
+    }
+
+    /// [`Self::new`] without the per-value checks: the levels, grid and counts
+    /// only, `O(1)` (for a reader that checked the values once). A tree with bad
+    /// values still never panics; it describes another warp.
+    pub fn view(
+        levels: u32,
+        nodes: &'a [NodeRecord],
+        grid: u32,
+        top: &'a [f32],
+    ) -> Result<Self, QuadtreeError> {
         if !(TOP_LEVELS..=MAX_TREE_LEVELS.min(MAX_LEVELS)).contains(&levels) {
             return Err(QuadtreeError::Levels(levels));
         }
@@ -258,22 +317,11 @@ impl<'a> EnvmapTree<'a> {
                 got: top.len() as u64,
             });
         }
-        if let Some(i) = top.iter().position(|v| !(*v >= 0.0 && v.is_finite())) {
-            return Err(QuadtreeError::BadMass(i as u64));
-        }
         if nodes.len() != node_count(levels) {
             return Err(QuadtreeError::Length {
                 expected: node_count(levels) as u64,
                 got: nodes.len() as u64,
             });
-        }
-        if let Some(i) = nodes.iter().position(|r| {
-            !(r.moment.iter().all(|v| v.is_finite()) && r.spread >= 0.0 && r.spread.is_finite())
-        }) {
-            return Err(QuadtreeError::BadMass(i as u64));
-        }
-        if !nodes[..4].iter().any(|r| r.mass() > 0.0) {
-            return Err(QuadtreeError::NoMass);
         }
         Ok(Self {
             levels,
@@ -281,6 +329,27 @@ impl<'a> EnvmapTree<'a> {
             grid,
             top,
         })
+    }
+
+    /// The per-value checks of [`Self::new`]: every top weight finite and
+    /// non-negative, every record finite with a non-negative spread, some light
+    /// on level 1. `O(records)`.
+    pub fn check_values(&self) -> Result<(), QuadtreeError> {
+        if let Some(i) = self.top.iter().position(|v| !(*v >= 0.0 && v.is_finite())) {
+            return Err(QuadtreeError::BadTopWeight(i as u64));
+        }
+        if let Some(i) = self.nodes.iter().position(|r| {
+            !(r.moment.iter().all(|v| v.is_finite()) && r.spread >= 0.0 && r.spread.is_finite())
+        }) {
+            return Err(QuadtreeError::BadMass(i as u64));
+        }
+        if !self.nodes[..4]
+            .iter()
+            .any(|r| r.mass() > 0.0 && r.mass().is_finite())
+        {
+            return Err(QuadtreeError::NoMass);
+        }
+        Ok(())
     }
 
     /// Levels below the root (`2^L x 2^L` leaves).
@@ -298,9 +367,24 @@ impl<'a> EnvmapTree<'a> {
     #[inline]
     pub fn lit<T: Real>(&self, normal: [T; 3]) -> Lit<'a, T> {
         let n = unit_or_z(normal);
-        let p = sphere_to_square_real(n);
-        let g = self.grid - 1;
-        let cell = p.map(|c| {
+        self.lit_with(n, sphere_to_square_real(n))
+    }
+
+    /// The tree lit by the cosine about the normal whose octahedral square point
+    /// is `q` (clamped into the square): the normal `square_to_sphere(q)`, the top
+    /// table's cell read from `q` itself. What the runtime and the shaders use, whose
+    /// condition is that point: no inverse trigonometry on the way.
+    #[inline]
+    pub fn lit_square<T: Real>(&self, q: [T; 2]) -> Lit<'a, T> {
+        let q = q.map(clamp_unit);
+        self.lit_with(unit_or_z(square_to_sphere_real(q)), q)
+    }
+
+    /// The tree lit by the unit normal `n` whose octahedral square point is `q`.
+    #[inline]
+    fn lit_with<T: Real>(&self, n: [T; 3], q: [T; 2]) -> Lit<'a, T> {
+        let g = self.grid.max(2) - 1;
+        let cell = q.map(|c| {
             let s = clamp_unit(c) * T::of(g as f64);
             let j0 = (s.floor().to_f64() as u32).min(g - 1);
             (j0, s - T::of(j0 as f64))
@@ -328,6 +412,20 @@ impl<'a> EnvmapTree<'a> {
     pub fn sample<T: Real>(&self, normal: [T; 3], u: [T; 2]) -> ([T; 3], T) {
         let (p, pdf) = quadtree::sample(&self.lit(normal), u);
         (square_to_sphere_real(p), pdf / (T::of(4.0) * T::PI))
+    }
+
+    /// [`Self::sample`] for the normal whose octahedral square point is `q`
+    /// ([`Self::lit_square`]). `O(L)`; never panics.
+    #[inline]
+    pub fn sample_square<T: Real>(&self, q: [T; 2], u: [T; 2]) -> ([T; 3], T) {
+        let (p, pdf) = quadtree::sample(&self.lit_square(q), u);
+        (square_to_sphere_real(p), pdf / (T::of(4.0) * T::PI))
+    }
+
+    /// [`Self::pdf`] for the normal whose octahedral square point is `q`.
+    #[inline]
+    pub fn pdf_square<T: Real>(&self, q: [T; 2], d: [T; 3]) -> T {
+        quadtree::pdf(&self.lit_square(q), sphere_to_square_real(d)) / (T::of(4.0) * T::PI)
     }
 
     /// The solid-angle density of [`Self::sample`]'s directions at the unit

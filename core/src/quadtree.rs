@@ -46,6 +46,9 @@ pub enum QuadtreeError {
     BadMass(u64),
     /// The root's mass is 0.
     NoMass,
+    /// A tabulated weight ([`crate::envmap_tree`]'s top table) is negative, NaN or
+    /// infinite (index into the table).
+    BadTopWeight(u64),
 }
 
 impl core::fmt::Display for QuadtreeError {
@@ -57,6 +60,9 @@ impl core::fmt::Display for QuadtreeError {
             }
             Self::BadMass(i) => write!(f, "quadtree mass {i} is negative or not finite"),
             Self::NoMass => write!(f, "quadtree without mass"),
+            Self::BadTopWeight(i) => {
+                write!(f, "top-level weight {i} is negative or not finite")
+            }
         }
     }
 }
@@ -305,7 +311,8 @@ pub fn pdf<T: Real>(tree: &impl ChildWeights<T>, p: [T; 2]) -> T {
         let shift = levels - l - 1;
         let w = usable(tree.children(l, lx >> (shift + 1), ly >> (shift + 1)));
         let k = ((lx >> shift) & 1) + 2 * ((ly >> shift) & 1);
-        prob = prob * w[k as usize] / sum4(w);
+        // `share`'s order of operations: the pdf of a sample is its pdf bit for bit.
+        prob = prob * (w[k as usize] / sum4(w));
     }
     let side = T::of((1u64 << levels) as f64);
     prob * side * side

@@ -53,6 +53,9 @@ const NULD_TAG_CONDITIONAL_INFO: u32 = 3u;
 const NULD_TAG_NETWORK_PARAMS: u32 = 4u;
 const NULD_TAG_POINT_TABLE: u32 = 5u;
 const NULD_TAG_WEIGHT_TABLE: u32 = 6u;
+const NULD_TAG_ENVMAP_TREE_INFO: u32 = 7u;
+const NULD_TAG_ENVMAP_TREE_NODES: u32 = 8u;
+const NULD_TAG_ENVMAP_TREE_TOP: u32 = 9u;
 
 // `Domain` codes.
 const NULD_DOMAIN_SQUARE: u32 = 0u;
@@ -92,8 +95,21 @@ const NULD_ACTIVATION_SILU: u32 = 1u;
 // `PointWarp` codes (core/src/conditional/mod.rs).
 const NULD_WARP_EQUAL_AREA: u32 = 0u;
 const NULD_WARP_BRDF_MIXTURE: u32 = 1u;
-// `ConditionalTarget::EnvmapNormal`: table mode interpolates directions.
-const NULD_TARGET_ENVMAP_NORMAL: u32 = 2u;
+const NULD_WARP_ENVMAP_TREE: u32 = 2u;
+// `TreeInfo` fields (core/src/envmap_tree.rs).
+const NULD_TREE_INFO_LEVELS: u32 = 0u;
+const NULD_TREE_INFO_GRID: u32 = 4u;
+// `TOP_LEVELS`, `node_count(TOP_LEVELS)`, `quadtree::MAX_LEVELS`.
+const NULD_TREE_TOP_LEVELS: u32 = 3u;
+const NULD_TREE_TOP_NODES: u32 = 84u;
+const NULD_TREE_MAX_LEVELS: u32 = 24u;
+// `TOP_FLOOR` and the smallest usable normal length of `unit_or_z`, as the f32
+// `T::of` rounds them to (bits 0x3a83126f, 0x1e3ce508).
+const NULD_TREE_TOP_FLOOR: f32 = 0.001000000047497451305389404296875;
+const NULD_TREE_UNIT_MIN: f32 = 9.999999682655225388967887463487205224055287544615566730499267578125e-21;
+// The salts of `randomization_shift` (core/src/conditional/mod.rs).
+const NULD_RANDOMIZE_SALT_A: u32 = 0x5eed0b1au;
+const NULD_RANDOMIZE_SALT_B: u32 = 0x68e31da4u;
 
 // `f32` constants written as the runtime's `f32` values (a decimal literal would be
 // rounded from the exact value, which is not always the same `f32`).
@@ -781,7 +797,7 @@ fn nuld_network_evaluate(cs: NuldConditional, row: u32, input: array<f32, 11>) -
         nuld_param(params, bias) + nuld_dot(params, off, &a, fan_in),
         nuld_param(params, bias + 1u) + nuld_dot(params, off + fan_in, &a, fan_in),
     );
-    if info.warp == NULD_WARP_BRDF_MIXTURE {
+    if info.warp != NULD_WARP_EQUAL_AREA {
         // Rust: `lattice_logit`: the outputs are a residual on the logit of the
         // shifted lattice point, read back from its input features.
         for (var o = 0u; o < NULD_OUTPUTS; o++) {
@@ -806,48 +822,270 @@ fn nuld_network_square_point_of(cs: NuldConditional, u: vec2<f32>, instance: u32
     return vec2<f32>(nuld_sigmoid(out.x), nuld_sigmoid(out.y));
 }
 
+// ---- The environment prior (core/src/envmap_tree.rs, core/src/quadtree.rs) ----
+
+// Rust: `EnvmapTree` (`EnvmapTree::view`): the byte offsets of the records and the
+// top table, the levels and the top grid.
+struct NuldTree {
+    nodes: u32,
+    top: u32,
+    levels: u32,
+    grid: u32,
+}
+
+// Rust: `ConditionalSampler::tree`: the blob's environment prior.
+fn nuld_tree() -> NuldTree {
+    let info = nuld_section(NULD_TAG_ENVMAP_TREE_INFO);
+    return NuldTree(
+        nuld_section(NULD_TAG_ENVMAP_TREE_NODES),
+        nuld_section(NULD_TAG_ENVMAP_TREE_TOP),
+        min(nuld_u32(info + NULD_TREE_INFO_LEVELS), NULD_TREE_MAX_LEVELS),
+        max(nuld_u32(info + NULD_TREE_INFO_GRID), 2u),
+    );
+}
+
+// Rust: `morton`: `x` on the even bits, `y` on the odd bits.
+fn nuld_morton(x: u32, y: u32) -> u32 {
+    var a = x & 0xffffu;
+    a = (a | (a << 8u)) & 0x00ff00ffu;
+    a = (a | (a << 4u)) & 0x0f0f0f0fu;
+    a = (a | (a << 2u)) & 0x33333333u;
+    a = (a | (a << 1u)) & 0x55555555u;
+    var b = y & 0xffffu;
+    b = (b | (b << 8u)) & 0x00ff00ffu;
+    b = (b | (b << 4u)) & 0x0f0f0f0fu;
+    b = (b | (b << 2u)) & 0x33333333u;
+    b = (b | (b << 1u)) & 0x55555555u;
+    return a | (b << 1u);
+}
+
+// Rust: `node_index`: the record of node `(x, y)` of level `level >= 1`.
+fn nuld_node_index(level: u32, x: u32, y: u32) -> u32 {
+    return ((1u << (2u * level)) - 1u) / 3u - 1u + nuld_morton(x, y);
+}
+
+// Rust: `NodeRecord::weight`: `(n.m1 + sqrt((n.m1)^2 + s^2)) / 2` of record `r`.
+fn nuld_node_weight(t: NuldTree, r: u32, n: vec3<f32>) -> f32 {
+    let o = t.nodes + 16u * r;
+    let a = n.x * nuld_f32(o) + n.y * nuld_f32(o + 4u) + n.z * nuld_f32(o + 8u);
+    let s = nuld_f32(o + 12u);
+    return (a + sqrt(a * a + s * s)) * 0.5;
+}
+
+// Rust: `Lit`: the tree lit by the normal `n`, with the top table's cell.
+struct NuldLit {
+    n: vec3<f32>,
+    j0: vec2<u32>,
+    t: vec2<f32>,
+}
+
+// Rust: `unit_or_z`: `v / |v|`, or `+z` for a zero, tiny or non-finite length.
+fn nuld_unit_or_z(v: vec3<f32>) -> vec3<f32> {
+    let len = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+    if len > NULD_TREE_UNIT_MIN && nuld_is_finite(len) {
+        return vec3<f32>(v.x / len, v.y / len, v.z / len);
+    }
+    return vec3<f32>(0.0, 0.0, 1.0);
+}
+
+// Rust: `EnvmapTree::lit_square`: lit by the normal whose octahedral square point
+// is `q` (clamped), the top table's cell read from `q`.
+fn nuld_lit_square(t: NuldTree, q0: vec2<f32>) -> NuldLit {
+    let q = vec2<f32>(nuld_clamp01(q0.x), nuld_clamp01(q0.y));
+    var lit: NuldLit;
+    lit.n = nuld_unit_or_z(nuld_square_to_sphere(q));
+    let g = t.grid - 1u;
+    for (var a = 0u; a < 2u; a++) {
+        let s = nuld_clamp01(q[a]) * f32(g);
+        let j0 = min(u32(floor(s)), g - 1u);
+        lit.j0[a] = j0;
+        lit.t[a] = s - f32(j0);
+    }
+    return lit;
+}
+
+// Rust: `Lit::top_weight`: top-table node `node` interpolated at the normal.
+fn nuld_top_weight(t: NuldTree, lit: NuldLit, node: u32) -> f32 {
+    let row = lit.j0.y * t.grid + lit.j0.x;
+    let w00 = nuld_f32(t.top + 4u * (row * NULD_TREE_TOP_NODES + node));
+    let w10 = nuld_f32(t.top + 4u * ((row + 1u) * NULD_TREE_TOP_NODES + node));
+    let w01 = nuld_f32(t.top + 4u * ((row + t.grid) * NULD_TREE_TOP_NODES + node));
+    let w11 = nuld_f32(t.top + 4u * ((row + t.grid + 1u) * NULD_TREE_TOP_NODES + node));
+    let a = w00 + (w10 - w00) * lit.t.x;
+    let b = w01 + (w11 - w01) * lit.t.x;
+    return a + (b - a) * lit.t.y;
+}
+
+// Rust: `Lit::children` then `usable`: the four children's weights of node
+// `(x, y)` of level `level` (`[i + 2 j]`), negative, NaN and infinite ones as 0,
+// four zeros as four ones.
+fn nuld_children(t: NuldTree, lit: NuldLit, level: u32, x: u32, y: u32) -> vec4<f32> {
+    let first = nuld_node_index(level + 1u, 2u * x, 2u * y);
+    var w: vec4<f32>;
+    for (var k = 0u; k < 4u; k++) {
+        var v = nuld_node_weight(t, first + k, lit.n);
+        if level < NULD_TREE_TOP_LEVELS {
+            v = max(nuld_top_weight(t, lit, first + k), v * NULD_TREE_TOP_FLOOR);
+        }
+        if !(v > 0.0 && nuld_is_finite(v)) {
+            v = 0.0;
+        }
+        w[k] = v;
+    }
+    let sum = (w.x + w.y) + (w.z + w.w);
+    if sum > 0.0 && nuld_is_finite(sum) {
+        return w;
+    }
+    return vec4<f32>(1.0, 1.0, 1.0, 1.0);
+}
+
+// Rust: `choose` for one axis: the part of `u` below `p` (side 0) or above it
+// (side 1), `u` rescaled into it; an empty part is never picked.
+struct NuldSplit {
+    u: f32,
+    side: u32,
+}
+
+fn nuld_split(u: f32, p: f32, low: f32, high: f32) -> NuldSplit {
+    if (u < p && low > 0.0) || high <= 0.0 {
+        return NuldSplit(nuld_clamp01(u / p), 0u);
+    }
+    return NuldSplit(nuld_clamp01((u - p) / (1.0 - p)), 1u);
+}
+
+// Rust: `EnvmapTree::sample_square` (`quadtree::sample`): the direction at primary
+// point `u` for the normal whose octahedral square point is `q`, and its
+// solid-angle pdf.
+struct NuldTreeSample {
+    direction: vec3<f32>,
+    pdf: f32,
+}
+
+fn nuld_tree_sample_square(t: NuldTree, q: vec2<f32>, u: vec2<f32>) -> NuldTreeSample {
+    let lit = nuld_lit_square(t, q);
+    var ux = nuld_clamp01(u.x);
+    var uy = nuld_clamp01(u.y);
+    var x = 0u;
+    var y = 0u;
+    var p = 1.0;
+    for (var l = 0u; l < t.levels; l++) {
+        let w = nuld_children(t, lit, l, x, y);
+        let left = w.x + w.z;
+        let right = w.y + w.w;
+        let cx = nuld_split(ux, left / (left + right), left, right);
+        ux = cx.u;
+        let bottom = w[cx.side];
+        let top = w[cx.side + 2u];
+        let cy = nuld_split(uy, bottom / (bottom + top), bottom, top);
+        uy = cy.u;
+        p = p * (w[cx.side + 2u * cy.side] / ((w.x + w.y) + (w.z + w.w)));
+        x = 2u * x + cx.side;
+        y = 2u * y + cy.side;
+    }
+    let side = f32(1u << t.levels);
+    let point = vec2<f32>(min((f32(x) + ux) / side, 1.0), min((f32(y) + uy) / side, 1.0));
+    return NuldTreeSample(nuld_square_to_sphere(point), p * side * side / (4.0 * NULD_PI));
+}
+
+// Rust: `EnvmapTree::pdf_square` (`quadtree::pdf`): the solid-angle pdf at the
+// unit direction `d` for the normal whose octahedral square point is `q`. The
+// direction's square point goes through the driver's `atan`
+// (`nuld_sphere_to_square`): a direction within its rounding of a leaf's edge may
+// be read in the neighbouring leaf.
+fn nuld_tree_pdf_square(t: NuldTree, q: vec2<f32>, d: vec3<f32>) -> f32 {
+    let lit = nuld_lit_square(t, q);
+    let sq = nuld_sphere_to_square(d);
+    let side = 1u << t.levels;
+    let lx = min(u32(floor(nuld_clamp01(sq.x) * f32(side))), side - 1u);
+    let ly = min(u32(floor(nuld_clamp01(sq.y) * f32(side))), side - 1u);
+    var prob = 1.0;
+    for (var l = 0u; l < t.levels; l++) {
+        let shift = t.levels - l - 1u;
+        let w = nuld_children(t, lit, l, lx >> (shift + 1u), ly >> (shift + 1u));
+        let k = ((lx >> shift) & 1u) + 2u * ((ly >> shift) & 1u);
+        prob = prob * (w[k] / ((w.x + w.y) + (w.z + w.w)));
+    }
+    let s = f32(side);
+    return prob * s * s / (4.0 * NULD_PI);
+}
+
+// Rust: `sphere_to_square_real` (core/src/sphere.rs), with the driver's `atan`.
+fn nuld_sphere_to_square(d: vec3<f32>) -> vec2<f32> {
+    let x = abs(d.x);
+    let y = abs(d.y);
+    let z = abs(d.z);
+    let r = sqrt(max(1.0 - z, 0.0));
+    let a = max(x, y);
+    let b = min(x, y);
+    var ratio = 0.0;
+    if a != 0.0 {
+        ratio = b / a;
+    }
+    var phi = atan(ratio) / NULD_FRAC_PI_2;
+    if x < y {
+        phi = 1.0 - phi;
+    }
+    var v = phi * r;
+    var u = r - v;
+    if d.z < 0.0 {
+        let w = u;
+        u = 1.0 - v;
+        v = 1.0 - w;
+    }
+    u = nuld_copysign(u, d.x);
+    v = nuld_copysign(v, d.y);
+    return vec2<f32>(0.5 * (u + 1.0), 0.5 * (v + 1.0));
+}
+
+// Rust: `randomization_shift`: the unbiased mode's shift for `seed`, two 24-bit
+// unorms.
+fn nuld_randomization_shift(seed: u32) -> vec2<f32> {
+    let a = nuld_hash_u32(seed ^ NULD_RANDOMIZE_SALT_A);
+    let b = nuld_hash_u32(a ^ NULD_RANDOMIZE_SALT_B);
+    return vec2<f32>(f32(a >> 8u) * NULD_INSTANCE_UNIT, f32(b >> 8u) * NULD_INSTANCE_UNIT);
+}
+
+// Rust: `torus_shift`: `p + shift` on the unit torus, in `[0, 1)`.
+fn nuld_torus_shift(p: vec2<f32>, shift: vec2<f32>) -> vec2<f32> {
+    var out = vec2<f32>(0.0, 0.0);
+    for (var a = 0u; a < 2u; a++) {
+        let x = p[a] + shift[a];
+        let f = x - floor(x);
+        if f < 1.0 && f >= 0.0 {
+            out[a] = f;
+        }
+    }
+    return out;
+}
+
 // ---- Samples (runtime/src/brdf.rs) -------------------------------------
 
-// Rust: `Sample`: a unit direction (local frame, `z` = normal) and the estimator
-// weight of its condition. 16 bytes in a storage buffer.
+// Rust: `Sample`: a unit direction (local frame, `z` = normal), the estimator
+// weight of its condition, and the prior's solid-angle pdf at the direction (0
+// for a sampler without an exact prior). 32 bytes in a storage buffer.
 struct NuldSample {
     direction: vec3<f32>,
     weight: f32,
+    pdf: f32,
 }
 
 // Rust: `ConditionalSampler::sample` (table mode): direction `i` (mod n) of
 // instance `instance` (mod instances) at condition `cond` (blob units; for BRDF
-// samplers `(roughness, theta_o in degrees)`, the view in the xz-plane, `+x` side).
+// samplers `(roughness, theta_o in degrees)`, the view in the xz-plane, `+x` side;
+// for environment samplers the normal's octahedral square point).
 fn nuld_sample(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
     let cs = nuld_conditional();
     let u = nuld_normalize(cs.info, cond);
-    if cs.info.target_code == NULD_TARGET_ENVMAP_NORMAL {
-        let weight = nuld_weight_table_lerp(cs, nuld_locate(u, cs.info.weight_grid), 0u);
-        return NuldSample(nuld_table_direction_of(cs, u, instance, i), weight);
-    }
     return nuld_mapped(cs, nuld_square_point_of(cs, u, instance, i), u);
 }
 
-// Rust: `ConditionalSampler::table_direction_at` (environment samplers): the four
-// corners' points through the equal-area map, blended by `GridCell::nlerp`.
-fn nuld_table_direction_of(cs: NuldConditional, u: vec2<f32>, instance: u32, i: u32) -> vec3<f32> {
-    let cell = nuld_locate(u, cs.info.grid);
-    let k = instance % cs.info.instances;
-    let j = i % cs.info.n;
-    let d00 = nuld_to_direction(cs.info.domain, nuld_corner_point(cs, cell, 0u, 0u, k, j));
-    let d10 = nuld_to_direction(cs.info.domain, nuld_corner_point(cs, cell, 1u, 0u, k, j));
-    let d01 = nuld_to_direction(cs.info.domain, nuld_corner_point(cs, cell, 0u, 1u, k, j));
-    let d11 = nuld_to_direction(cs.info.domain, nuld_corner_point(cs, cell, 1u, 1u, k, j));
-    let m = vec3<f32>(
-        nuld_lerp(cell, d00.x, d10.x, d01.x, d11.x),
-        nuld_lerp(cell, d00.y, d10.y, d01.y, d11.y),
-        nuld_lerp(cell, d00.z, d10.z, d01.z, d11.z),
-    );
-    let len = sqrt(m.x * m.x + m.y * m.y + m.z * m.z);
-    if len > 1e-6 && nuld_is_finite(len) {
-        return m / len;
-    }
-    return d00;
+// Rust: `ConditionalSampler::sample_randomized` (table mode, the unbiased mode):
+// the table's point shifted on the torus by `nuld_randomization_shift(seed)`.
+fn nuld_sample_randomized(cond: vec2<f32>, instance: u32, i: u32, seed: u32) -> NuldSample {
+    let cs = nuld_conditional();
+    let u = nuld_normalize(cs.info, cond);
+    let p = nuld_square_point_of(cs, u, instance, i);
+    return nuld_mapped(cs, nuld_torus_shift(p, nuld_randomization_shift(seed)), u);
 }
 
 // Rust: `NetworkSampler::sample` (network mode): as `nuld_sample`;
@@ -858,12 +1096,38 @@ fn nuld_sample_network(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
     return nuld_mapped(cs, nuld_network_square_point_of(cs, u, instance, i), u);
 }
 
+// Rust: `NetworkSampler::sample_randomized`: the unbiased mode in network mode.
+fn nuld_sample_network_randomized(cond: vec2<f32>, instance: u32, i: u32, seed: u32) -> NuldSample {
+    let cs = nuld_conditional();
+    let u = nuld_normalize(cs.info, cond);
+    let p = nuld_network_square_point_of(cs, u, instance, i);
+    return nuld_mapped(cs, nuld_torus_shift(p, nuld_randomization_shift(seed)), u);
+}
+
+// Rust: `ConditionalSampler::pdf`: the prior's solid-angle pdf at the unit
+// `direction` for condition `cond` (environment samplers; 0 for the others).
+fn nuld_pdf(cond: vec2<f32>, direction: vec3<f32>) -> f32 {
+    let cs = nuld_conditional();
+    if cs.info.warp != NULD_WARP_ENVMAP_TREE {
+        return 0.0;
+    }
+    let u = nuld_normalize(cs.info, cond);
+    return nuld_tree_pdf_square(nuld_tree(), nuld_denormalize(cs.info, u), direction);
+}
+
 // Rust: `ConditionalSampler::mapped`: the sample of the square point `p` at the
 // normalized condition `u`: the direction of the blob's point warp (warp 0: the
 // domain's equal-area map; warp 1: the BRDF mixture at the clamped condition with
-// the lobe probability of the weight section's second table) and the weight.
+// the lobe probability of the weight section's second table; warp 2: the
+// environment tree at the normal of the clamped condition, with its pdf) and the
+// weight.
 fn nuld_mapped(cs: NuldConditional, p: vec2<f32>, u: vec2<f32>) -> NuldSample {
     let cell = nuld_locate(u, cs.info.weight_grid);
+    let weight = nuld_weight_table_lerp(cs, cell, 0u);
+    if cs.info.warp == NULD_WARP_ENVMAP_TREE {
+        let s = nuld_tree_sample_square(nuld_tree(), nuld_denormalize(cs.info, u), p);
+        return NuldSample(s.direction, weight, s.pdf);
+    }
     var direction: vec3<f32>;
     if cs.info.warp == NULD_WARP_BRDF_MIXTURE {
         let c = nuld_denormalize(cs.info, u);
@@ -871,7 +1135,7 @@ fn nuld_mapped(cs: NuldConditional, p: vec2<f32>, u: vec2<f32>) -> NuldSample {
     } else {
         direction = nuld_to_direction(cs.info.domain, p);
     }
-    return NuldSample(direction, nuld_weight_table_lerp(cs, cell, 0u));
+    return NuldSample(direction, weight, 0.0);
 }
 
 // `libm::acosf`'s constants (FreeBSD e_acosf.c): pi/2 split in a high part
@@ -959,7 +1223,7 @@ fn nuld_rotate(s: NuldSample, azimuth: vec2<f32>) -> NuldSample {
     let d = s.direction;
     let c = azimuth.x;
     let sn = azimuth.y;
-    return NuldSample(vec3<f32>(c * d.x - sn * d.y, sn * d.x + c * d.y, d.z), s.weight);
+    return NuldSample(vec3<f32>(c * d.x - sn * d.y, sn * d.x + c * d.y, d.z), s.weight, s.pdf);
 }
 
 // Rust: `BrdfSampler::sample` (table mode, glTF BRDF samplers): the set

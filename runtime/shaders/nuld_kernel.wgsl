@@ -4,7 +4,8 @@
 //
 // Bindings (group 0):
 //   0: the blob, unchanged (`nuld_blob`, as nuld.wgsl expects it);
-//   1: the output, one `NuldSample` (16 bytes: direction xyz, weight) per sample;
+//   1: the output, one `NuldSample` (32 bytes: direction xyz, weight, pdf, and
+//      12 bytes of padding) per sample;
 //   2: the range, a `NuldKernelParams` uniform (64 bytes; the Rust mirror is
 //      `nuld_runtime::shader::KernelParams`).
 //
@@ -21,8 +22,12 @@
 //   kind 3, mode 2: `nuld_sample_brdf` at the view `view.xyz`, roughness = the
 //                   condition's x (its y unused);
 //   kind 3, mode 3: `nuld_sample_brdf_network`, likewise;
-//   kind 2: `nuld_direction(instance, index)` (the instance is the set), weight 1;
-//   kind 1: `nuld_point(instance, index)` as `(x, y, 0)`, weight 1.
+//   kind 3, mode 4: `nuld_sample_randomized` with seed `e` (the unbiased mode);
+//   kind 3, mode 5: `nuld_sample_network_randomized` with seed `e`;
+//   kind 3, mode 6: `nuld_sample`, its pdf replaced by `nuld_pdf` at its direction;
+//   kind 2: `nuld_direction(instance, index)` (the instance is the set), weight 1,
+//           pdf 0;
+//   kind 1: `nuld_point(instance, index)` as `(x, y, 0)`, weight 1, pdf 0.
 
 @group(0) @binding(0) var<storage, read> nuld_blob: array<u32>;
 @group(0) @binding(1) var<storage, read_write> nuld_samples: array<NuldSample>;
@@ -50,6 +55,9 @@ const NULD_MODE_TABLE: u32 = 0u;
 const NULD_MODE_NETWORK: u32 = 1u;
 const NULD_MODE_BRDF_TABLE: u32 = 2u;
 const NULD_MODE_BRDF_NETWORK: u32 = 3u;
+const NULD_MODE_TABLE_RANDOMIZED: u32 = 4u;
+const NULD_MODE_NETWORK_RANDOMIZED: u32 = 5u;
+const NULD_MODE_PDF: u32 = 6u;
 
 // Rust: `KernelParams::sample_count`.
 fn nuld_kernel_sample_count(p: NuldKernelParams) -> u32 {
@@ -86,14 +94,21 @@ fn nuld_fill(
             out = nuld_sample_brdf(p.view.xyz, cond.x, instance, index);
         } else if p.mode == NULD_MODE_BRDF_NETWORK {
             out = nuld_sample_brdf_network(p.view.xyz, cond.x, instance, index);
+        } else if p.mode == NULD_MODE_TABLE_RANDOMIZED {
+            out = nuld_sample_randomized(cond, instance, index, e);
+        } else if p.mode == NULD_MODE_NETWORK_RANDOMIZED {
+            out = nuld_sample_network_randomized(cond, instance, index, e);
+        } else if p.mode == NULD_MODE_PDF {
+            out = nuld_sample(cond, instance, index);
+            out.pdf = nuld_pdf(cond, out.direction);
         } else {
             // NULD_MODE_TABLE, and any other code.
             out = nuld_sample(cond, instance, index);
         }
     } else if kind == NULD_KIND_DIRECTION_SET {
-        out = NuldSample(nuld_direction(instance, index), 1.0);
+        out = NuldSample(nuld_direction(instance, index), 1.0, 0.0);
     } else {
-        out = NuldSample(vec3<f32>(nuld_point(instance, index), 0.0), 1.0);
+        out = NuldSample(vec3<f32>(nuld_point(instance, index), 0.0), 1.0, 0.0);
     }
     nuld_samples[e] = out;
 }

@@ -205,6 +205,6 @@ fn rotate(s: Sample, azimuth: Vec2) -> Sample {
     let (c, sn) = (azimuth.x, azimuth.y);
     Sample {
         direction: Vec3::new(c * d.x - sn * d.y, sn * d.x + c * d.y, d.z),
-        weight: s.weight,
+        ..s
     }
 }

@@ -1,6 +1,22 @@
 //! The environment-map sampler's typed views (blobs of `build-tool bake --envmap`):
 //! a surface normal in, a direction of the set for that normal's `L cos` out, in
-//! table mode ([`EnvmapSampler`]) or network mode ([`EnvmapNetwork`]).
+//! table mode ([`EnvmapSampler`]) or network mode ([`EnvmapNetwork`]), with the
+//! exact pdf of the sampler's prior and an unbiased mode.
+//!
+//! **The prior.** Every set is the exact product warp of the map's light and the
+//! normal's cosine ([`nuld_core::envmap_tree`]) applied to learned points of its
+//! primary sample space. [`Sample::pdf`] is that warp's solid-angle density at the
+//! direction; [`EnvmapSampler::pdf`] answers it for any direction (for multiple
+//! importance sampling with a BRDF sampler). Two estimators of `∫ L f cos`:
+//!
+//! * `(1/N) Σ L(l_i) f(l_i) cos_i / pdf_i`, the renderer's usual one: exact in
+//!   expectation in the **unbiased mode** ([`EnvmapSampler::sample_randomized`],
+//!   a per-pixel random shift of the primary points, under which every sample is
+//!   distributed exactly as its pdf); in the fixed-instance modes the learned
+//!   points follow the pdf only approximately, so it carries a small bias that
+//!   shrinks with the set's discrepancy;
+//! * `(E / N) Σ f(l_i)` with `weight = E(n)`, the irradiance, as before the prior
+//!   existed: cheaper (no `L` lookup), the same bias in fixed-instance modes.
 
 use crate::conditional::{scaled_to_largest, ConditionalSampler, NetworkSampler, Sample};
 use glam::{Vec2, Vec3};
@@ -9,8 +25,9 @@ use nuld_core::conditional::ConditionalTarget;
 
 /// An environment-map sampler in **table mode**: for a surface normal `n` (world
 /// frame, the map's `+z` up), the directions of a low-discrepancy set for
-/// `q(l | n) ∝ L(l) max(0, n.l)` and the estimator weight, the irradiance `E(n)`,
-/// so that `∫ L f max(0, n.l) ≈ (E / N) Σ f(l_i)`.
+/// `q(l | n) ∝ L(l) max(0, n.l)`, the estimator weight, the irradiance `E(n)`,
+/// so that `∫ L f max(0, n.l) ≈ (E / N) Σ f(l_i)`, and the prior's pdf (module
+/// docs).
 ///
 /// Obtained from [`crate::Blob::envmap`], which refuses any other blob; a copyable
 /// view on the blob's bytes. Every method is `O(1)`, allocates nothing and never
@@ -78,6 +95,36 @@ impl<'a> EnvmapSampler<'a> {
         self.0.sample(normal_condition(normal), instance, i)
     }
 
+    /// The unbiased mode: [`Self::sample`] with the primary point shifted on the
+    /// torus by a random vector drawn from `seed` (the pixel's random number,
+    /// [`nuld_core::conditional::randomization_shift`]), so that each sample is
+    /// distributed exactly as its [`Sample::pdf`] and `L f cos / pdf` is unbiased
+    /// whatever the table learned. O(1), never panics.
+    ///
+    /// ```
+    /// # let bytes = nuld_runtime::doc_example_envmap_blob();
+    /// use nuld_runtime::glam::Vec3;
+    /// let env = nuld_runtime::Blob::parse(&bytes.0)?.envmap()?;
+    /// let n = Vec3::new(0.3, -0.2, 0.9);
+    /// let s = env.sample_randomized(n, 0, 1, 0xdead_beef);
+    /// assert!(s.pdf > 0.0);
+    /// assert!((env.pdf(n, s.direction) - s.pdf).abs() <= 1e-4 * s.pdf);
+    /// # Ok::<(), nuld_runtime::BlobError>(())
+    /// ```
+    #[inline]
+    pub fn sample_randomized(&self, normal: Vec3, instance: u32, i: u32, seed: u32) -> Sample {
+        self.0
+            .sample_randomized(normal_condition(normal), instance, i, seed)
+    }
+
+    /// The solid-angle density of the sampler's prior at the unit `direction` for
+    /// `normal`: [`Sample::pdf`] of a sample there, for any direction (multiple
+    /// importance sampling). `O(tree levels)`, never panics.
+    #[inline]
+    pub fn pdf(&self, normal: Vec3, direction: Vec3) -> f32 {
+        self.0.pdf(normal_condition(normal), direction)
+    }
+
     /// The same model in network mode, reading the blob's f16 weights (zero-copy).
     #[inline]
     pub fn network(&self) -> EnvmapNetwork<'a> {
@@ -122,6 +169,19 @@ impl<'a> EnvmapNetwork<'a> {
     #[inline]
     pub fn sample(&self, normal: Vec3, instance: u32, i: u32) -> Sample {
         self.0.sample(normal_condition(normal), instance, i)
+    }
+
+    /// The unbiased mode in network mode ([`EnvmapSampler::sample_randomized`]).
+    #[inline]
+    pub fn sample_randomized(&self, normal: Vec3, instance: u32, i: u32, seed: u32) -> Sample {
+        self.0
+            .sample_randomized(normal_condition(normal), instance, i, seed)
+    }
+
+    /// The prior's pdf ([`EnvmapSampler::pdf`]; both modes share the prior).
+    #[inline]
+    pub fn pdf(&self, normal: Vec3, direction: Vec3) -> f32 {
+        self.0.pdf(normal_condition(normal), direction)
     }
 
     /// The target-agnostic network view, conditions in the blob's units.

@@ -302,20 +302,79 @@ pub fn doc_example_conditional_blob() -> Aligned<[u8; 400]> {
     doc_example_sampler(ConditionalTarget::GltfBrdf, [0.1, 0.0], [1.0, 89.0])
 }
 
-/// [`doc_example_conditional_blob`] as an environment sampler: conditions the
-/// normal's octahedral square point in `[0, 1]^2`, directions on the sphere.
+/// [`doc_example_conditional_blob`] as an environment sampler on its prior: conditions
+/// the normal's octahedral square point in `[0, 1]^2`, directions on the sphere, a
+/// tree of 3 levels over a sky brighter towards `+z` with its top weights on 2 x 2
+/// normals.
 #[doc(hidden)]
-pub fn doc_example_envmap_blob() -> Aligned<[u8; 400]> {
-    doc_example_sampler(ConditionalTarget::EnvmapNormal, [0.0, 0.0], [1.0, 1.0])
+pub fn doc_example_envmap_blob() -> Aligned<[u8; 3200]> {
+    use nuld_core::envmap_tree::{
+        build, node_count, top_normal, top_row, NodeRecord, TreeInfo, TOP_LEVELS,
+    };
+    let (info, params, table, _) =
+        doc_example_parts(ConditionalTarget::EnvmapNormal, [0.0, 0.0], [1.0, 1.0]);
+    let info = ConditionalInfo {
+        warp: nuld_core::conditional::PointWarp::EnvmapTree as u32,
+        ..info
+    };
+    let weights: [f32; 4] = [1.0, 0.95, 1.2, 0.98];
+    let levels = TOP_LEVELS;
+    let mut leaves = [[0.0f64; 4]; 64];
+    for (k, leaf) in leaves.iter_mut().enumerate() {
+        let p = [
+            (k % 8) as f64 / 8.0 + 1.0 / 16.0,
+            (k / 8) as f64 / 8.0 + 1.0 / 16.0,
+        ];
+        let d = nuld_core::sphere::square_to_sphere_real(p);
+        let light = (1.0 + 3.0 * d[2].max(0.0)) / 64.0;
+        *leaf = [light, light * d[0], light * d[1], light * d[2]];
+    }
+    let mut nodes = [NodeRecord {
+        moment: [0.0; 3],
+        spread: 0.0,
+    }; 84];
+    let _ = build(levels, &leaves, &mut nodes[..node_count(levels)]);
+    let mut top = [0.0f32; 4 * 84];
+    for (r, row) in top.chunks_mut(84).enumerate() {
+        top_row(
+            levels,
+            &nodes,
+            top_normal(2, [r as u32 % 2, r as u32 / 2]),
+            row,
+        );
+    }
+    let tree = TreeInfo {
+        levels,
+        grid: 2,
+        reserved: [0; 2],
+    };
+    let meta = [
+        3, b'd', b'o', b'c', 7, b'e', b'n', b'v', b'-', b'd', b'o', b'c', 0,
+    ];
+    let [a, b, c, d] = nuld_core::conditional::sections(&info, &params, &table, &weights);
+    let [e, f, g] = nuld_core::envmap_tree::sections(&tree, &nodes, &top);
+    // 48 + 7 x 32 + 13 -> 288; info 80 -> 368; params 36 -> 416; table 64 -> 480;
+    // weights 16 -> 496; tree info 16 -> 512; 84 nodes 1344 -> 1856; top 1344 ->
+    // 3200 bytes.
+    let mut out = Aligned([0u8; 3200]);
+    let _ = nuld_core::blob::write(
+        &mut out.0,
+        BlobKind::Conditional,
+        &meta,
+        &[a, b, c, d, e, f, g],
+    );
+    out
 }
 
-fn doc_example_sampler(
+/// The info, parameters and point table of the documentation's samplers (2
+/// points, 2 instances, a 2 x 2 grid, a network of one hidden unit), and its
+/// weights.
+#[allow(clippy::type_complexity)]
+fn doc_example_parts(
     target: ConditionalTarget,
     cond_min: [f32; 2],
     cond_max: [f32; 2],
-) -> Aligned<[u8; 400]> {
-    use nuld_core::blob::write;
-    use nuld_core::conditional::pack_point;
+) -> (ConditionalInfo, [u16; 18], [u32; 16], [f32; 4]) {
     let info = ConditionalInfo {
         n: 2,
         instances: 2,
@@ -338,9 +397,19 @@ fn doc_example_sampler(
     // [node][instance][index]: 4 nodes x 2 instances x 2 indices.
     let table: [u32; 16] = core::array::from_fn(|e| {
         let e = e as u32;
-        pack_point((e * 3_001 + 9_000) as u16, (60_000 - e * 2_503) as u16)
+        nuld_core::conditional::pack_point((e * 3_001 + 9_000) as u16, (60_000 - e * 2_503) as u16)
     });
     let weights: [f32; 4] = [1.0, 0.95, 1.2, 0.98];
+    (info, params, table, weights)
+}
+
+fn doc_example_sampler(
+    target: ConditionalTarget,
+    cond_min: [f32; 2],
+    cond_max: [f32; 2],
+) -> Aligned<[u8; 400]> {
+    use nuld_core::blob::write;
+    let (info, params, table, weights) = doc_example_parts(target, cond_min, cond_max);
     let meta = [
         3, b'd', b'o', b'c', 7, b'g', b'l', b't', b'f', b'-', b'd', b'o', 0,
     ];

@@ -61,9 +61,9 @@ pub const KERNEL_WORKGROUP_SIZE: u32 = 64;
 /// Workgroups per dispatch dimension that every WebGPU and Vulkan device accepts.
 pub const MAX_WORKGROUPS_PER_DIMENSION: u32 = 65_535;
 
-/// Bytes per sample in the kernel's output buffer (`vec3<f32>` direction and
-/// `f32` weight, std430).
-pub const SAMPLE_STRIDE: u64 = 16;
+/// Bytes per sample in the kernel's output buffer (`vec3<f32>` direction, `f32`
+/// weight, `f32` pdf, padded to the struct's 16-byte alignment, std430).
+pub const SAMPLE_STRIDE: u64 = 32;
 
 /// The complete kernel module, [`WGSL`] then [`KERNEL_WGSL`], as one string.
 ///
@@ -96,6 +96,15 @@ pub enum KernelMode {
     /// `nuld_sample_brdf_network`
     /// ([`crate::BrdfNetwork::sample`]).
     BrdfNetwork = 3,
+    /// `nuld_sample_randomized` with seed = the sample's position `e` in the range
+    /// ([`crate::ConditionalSampler::sample_randomized`]).
+    TableRandomized = 4,
+    /// `nuld_sample_network_randomized` with seed `e`
+    /// ([`crate::NetworkSampler::sample_randomized`]).
+    NetworkRandomized = 5,
+    /// `nuld_sample`, its pdf replaced by `nuld_pdf` at its direction
+    /// ([`crate::ConditionalSampler::pdf`]).
+    Pdf = 6,
 }
 
 /// The kernel's uniform (binding 2; WGSL `NuldKernelParams`, 64 bytes, the same

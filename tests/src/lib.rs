@@ -90,3 +90,41 @@ pub fn distilled_parts(
         weight_grid,
     )
 }
+
+/// A tree of 4 levels (top weights on 3 x 3 normals) over a closed-form light, a
+/// sky brighter towards `+z` and a small sun: the prior of the environment
+/// fixtures (built once per test binary).
+pub fn fixture_tree() -> std::sync::Arc<nuld_build_tool::sphere::EnvmapTree> {
+    static TREE: std::sync::OnceLock<std::sync::Arc<nuld_build_tool::sphere::EnvmapTree>> =
+        std::sync::OnceLock::new();
+    let tree = TREE.get_or_init(|| {
+        let sun = nuld_runtime::glam::DVec3::new(0.6, -0.3, 0.5).normalize();
+        let light = move |d: nuld_runtime::glam::DVec3| {
+            0.2 + d.z.max(0.0) + 20.0 * (-(1.0 - d.dot(sun)) * 300.0).exp()
+        };
+        std::sync::Arc::new(
+            nuld_build_tool::sphere::EnvmapTree::from_light(light, 4, 3).expect("a lit fixture"),
+        )
+    });
+    std::sync::Arc::clone(tree)
+}
+
+/// `parts` as an environment sampler on its prior: the sphere, conditions the
+/// octahedral square, the tree warp ([`fixture_tree`]); the shape's output a
+/// lattice residual (as [`shape`] makes for a non-equal-area warp).
+pub fn as_envmap(
+    mut parts: nuld_build_tool::conditional::blob::ConditionalParts,
+) -> nuld_build_tool::conditional::blob::ConditionalParts {
+    use nuld_core::conditional::{ConditionalTarget, PointWarp};
+    parts.info.domain = Domain::Sphere as u32;
+    parts.info.target = ConditionalTarget::EnvmapNormal as u32;
+    parts.info.cond_min = [0.0; 2];
+    parts.info.cond_max = [1.0; 2];
+    parts.info.warp = PointWarp::EnvmapTree as u32;
+    // The mixture's lobe probabilities are a BRDF table: one weight table here.
+    parts
+        .weights
+        .truncate(parts.info.weight_table_len() as usize);
+    parts.prior = Some(fixture_tree());
+    parts
+}

@@ -12,24 +12,31 @@ use nuld_core::quantize::f16_decode;
 use nuld_core::real::Real;
 use nuld_core::sphere::square_to_hemisphere_real;
 use nuld_runtime::{Blob, ConditionalSampler};
-use nuld_tests::{conditional_parts, shape, META};
+use nuld_tests::{as_envmap, conditional_parts, fixture_tree, shape, META};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 /// The shapes of the runtime benchmark: n 64, hidden [32, 32], ReLU and SiLU,
 /// with the equal-area map and (ReLU) with the BRDF mixture warp, without
 /// instance slots and (the default bake's) with 64, and 7 slots (instances wrap
-/// at another count than the table's 16).
+/// at another count than the table's 16); and an environment sampler on its tree
+/// ([`as_envmap`]).
 fn fixtures() -> Vec<ConditionalParts> {
     [
         (Activation::Relu, PointWarp::EqualArea, 0, 1),
         (Activation::Silu, PointWarp::EqualArea, 7, 2),
         (Activation::Relu, PointWarp::BrdfMixture, 0, 3),
         (Activation::Relu, PointWarp::BrdfMixture, 64, 4),
+        (Activation::Silu, PointWarp::EnvmapTree, 64, 5),
     ]
     .into_iter()
     .map(|(act, warp, slots, seed)| {
-        conditional_parts(shape(64, &[32, 32], act, warp, slots), 16, [10, 9], seed)
+        let parts = conditional_parts(shape(64, &[32, 32], act, warp, slots), 16, [10, 9], seed);
+        if warp == PointWarp::EnvmapTree {
+            as_envmap(parts)
+        } else {
+            parts
+        }
     })
     .collect()
 }
@@ -67,10 +74,14 @@ fn normalize<T: Real>(parts: &ConditionalParts, c: Vec2) -> [T; 2] {
     })
 }
 
-/// A condition drawn over the blob's range and a little beyond (to exercise the
-/// clamp), with the occasional NaN.
-fn condition(rng: &mut Pcg64Mcg) -> Vec2 {
-    let mut c = Vec2::new(rng.random_range(0.0..1.1), rng.random_range(-5.0..95.0));
+/// A condition drawn over the blob's range and a tenth of it beyond on each side
+/// (to exercise the clamp), with the occasional NaN.
+fn condition(rng: &mut Pcg64Mcg, parts: &ConditionalParts) -> Vec2 {
+    let mut c = Vec2::from(std::array::from_fn(|a| {
+        let (lo, hi) = range::<f64>(parts, a);
+        let margin = 0.1 * (hi - lo);
+        rng.random_range(lo - margin..hi + margin) as f32
+    }));
     if rng.random_bool(0.02) {
         c.x = f32::NAN;
     }
@@ -101,9 +112,14 @@ fn network_mode_equals_the_tools_f64_evaluation_of_the_f16_weights() {
         };
         let mut rng = Pcg64Mcg::seed_from_u64(7);
         let (mut worst_square, mut worst_direction) = (0.0f64, 0.0f64);
+        let fixture = fixture_tree();
+        let tree = fixture.tree();
+        // Samples whose f32 and f64 descents take the two sides of one of the
+        // tree's splits (a jump, not a rounding): counted, held to a small share.
+        let (mut split_sides, mut count) = (0u32, 0u32);
         with_sampler(&parts, |cs| {
             for _ in 0..20_000 {
-                let c = condition(&mut rng);
+                let c = condition(&mut rng, &parts);
                 let k: u32 = rng.random();
                 let i = rng.random_range(0..200);
                 let u = normalize::<f64>(&parts, c);
@@ -126,9 +142,19 @@ fn network_mode_equals_the_tools_f64_evaluation_of_the_f16_weights() {
                         let cond = clamped(&parts, u);
                         DVec3::from_array(brdf_mixture_direction(cond, p_s, p.to_array()))
                     }
+                    PointWarp::EnvmapTree => {
+                        let q = clamped(&parts, u);
+                        DVec3::from_array(tree.sample_square(q, p.to_array()).0)
+                    }
                 };
                 let s = cs.network().sample(c, k, i);
-                worst_direction = worst_direction.max((s.direction.as_dvec3() - d).length());
+                let gap = (s.direction.as_dvec3() - d).length();
+                count += 1;
+                if parts.info.point_warp() == Some(PointWarp::EnvmapTree) && gap > 1e-2 {
+                    split_sides += 1;
+                    continue;
+                }
+                worst_direction = worst_direction.max(gap);
             }
         });
         eprintln!(
@@ -137,12 +163,16 @@ fn network_mode_equals_the_tools_f64_evaluation_of_the_f16_weights() {
         );
         assert!(worst_square < 1e-5, "{worst_square}");
         // The mixture warp's GGX lobe magnifies square differences by up to
-        // ~1/alpha = 100 at roughness 0.1.
+        // ~1/alpha = 100 at roughness 0.1; the tree's warp by the inverse square
+        // root of its pdf, up to a few hundred where the map is dim.
         let bound = match parts.info.point_warp().unwrap() {
             PointWarp::EqualArea => 1e-5,
             PointWarp::BrdfMixture => 5e-4,
+            PointWarp::EnvmapTree => 2e-3,
         };
         assert!(worst_direction < bound, "{worst_direction}");
+        eprintln!("  split sides taken apart: {split_sides} of {count}");
+        assert!(split_sides * 200 <= count, "{split_sides} of {count}");
     }
 }
 
@@ -167,12 +197,14 @@ fn bilinear(u: [f32; 2], nodes: [u32; 2], value: impl Fn(usize) -> f32) -> f32 {
 /// bit, in the square and (through the `f32` hemisphere map) as directions.
 #[test]
 fn table_mode_equals_the_reference_interpolation_bit_for_bit() {
+    let fixture = fixture_tree();
+    let tree = fixture.tree();
     for parts in fixtures() {
         let info = parts.info;
         let mut rng = Pcg64Mcg::seed_from_u64(8);
         with_sampler(&parts, |cs| {
             for _ in 0..50_000 {
-                let c = condition(&mut rng);
+                let c = condition(&mut rng, &parts);
                 let k: u32 = rng.random();
                 let i: u32 = rng.random();
                 let (ks, is) = (k % info.instances, i % info.n);
@@ -194,6 +226,11 @@ fn table_mode_equals_the_reference_interpolation_bit_for_bit() {
                         let p_s = bilinear(u, info.weight_grid, |node| parts.weights[nodes + node]);
                         brdf_mixture_direction(clamped(&parts, u), p_s, p)
                     }
+                    PointWarp::EnvmapTree => {
+                        let (d, pdf) = tree.sample_square(clamped(&parts, u), p);
+                        assert_eq!(cs.sample(c, k, i).pdf, pdf);
+                        d
+                    }
                 };
                 assert_eq!(cs.sample(c, k, i).direction.to_array(), d);
             }
@@ -210,7 +247,7 @@ fn weights_equal_the_reference_bilinear_interpolation() {
         let mut rng = Pcg64Mcg::seed_from_u64(9);
         with_sampler(&parts, |cs| {
             for _ in 0..50_000 {
-                let c = condition(&mut rng);
+                let c = condition(&mut rng, &parts);
                 let want = bilinear(normalize::<f32>(&parts, c), info.weight_grid, |node| {
                     parts.weights[node]
                 });
@@ -238,6 +275,38 @@ fn weights_equal_the_reference_bilinear_interpolation() {
             }
         });
     }
+}
+
+/// Table mode's environment samples through the tree whose pdf they carry: the
+/// prior's f32 descent on the interpolated point (the test above), and here that
+/// the pdf the runtime returns is the `f64` tree's at the direction to `f32`
+/// rounding, but for directions on a leaf's edge.
+#[test]
+fn environment_pdfs_are_the_trees_f64_pdfs() {
+    let parts = fixtures().pop().unwrap();
+    assert_eq!(parts.info.point_warp(), Some(PointWarp::EnvmapTree));
+    let fixture = fixture_tree();
+    let tree = fixture.tree();
+    let mut rng = Pcg64Mcg::seed_from_u64(10);
+    let (mut worst, mut edges) = (0.0f64, 0);
+    with_sampler(&parts, |cs| {
+        for _ in 0..20_000 {
+            let c = condition(&mut rng, &parts);
+            let s = cs.sample(c, rng.random(), rng.random());
+            let q = clamped(&parts, normalize::<f64>(&parts, c));
+            let want = tree.pdf_square(q, s.direction.as_dvec3().to_array());
+            let rel = (s.pdf as f64 - want).abs() / want;
+            if rel > 1e-2 {
+                edges += 1;
+                continue;
+            }
+            worst = worst.max(rel);
+            assert_eq!(cs.pdf(c, s.direction), s.pdf);
+        }
+    });
+    eprintln!("environment pdf vs f64 tree: relative {worst:.2e}, {edges} of 20000 on an edge");
+    assert!(worst < 1e-4, "{worst}");
+    assert!(edges <= 100, "{edges}");
 }
 
 /// `BrdfSampler::sample` in the xz-plane on the `+x` side is `sample` at

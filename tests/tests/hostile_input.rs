@@ -12,7 +12,7 @@ use nuld_core::network::Activation;
 use nuld_core::quantize::f16_decode;
 use nuld_runtime::glam::{Vec2, Vec3};
 use nuld_runtime::{Blob, BlobKind};
-use nuld_tests::{conditional_parts, shape, sobol_blob, META};
+use nuld_tests::{as_envmap, conditional_parts, shape, sobol_blob, META};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -67,6 +67,9 @@ fn parse_and_touch(bytes: &[u8]) -> Result<(), BlobError> {
                     if let Some(e) = envmap {
                         check_sample(e.sample(wo, k, i));
                         check_sample(e.network().sample(wo, k, i));
+                        check_sample(e.sample_randomized(wo, k, i, k ^ i));
+                        let pdf = e.pdf(wo, e.sample(wo, k, i).direction);
+                        assert!(pdf.is_finite() && pdf >= 0.0);
                     }
                 }
             }
@@ -75,11 +78,13 @@ fn parse_and_touch(bytes: &[u8]) -> Result<(), BlobError> {
     Ok(())
 }
 
-/// A sample a parsed blob serves: a unit direction and a finite weight `>= 0`.
+/// A sample a parsed blob serves: a unit direction, a finite weight `>= 0` and a
+/// finite pdf `>= 0`.
 fn check_sample(s: nuld_runtime::Sample) {
     let d = s.direction;
     assert!((d.length() - 1.0).abs() < 1e-5, "{d}");
     assert!(s.weight.is_finite() && s.weight >= 0.0, "{}", s.weight);
+    assert!(s.pdf.is_finite() && s.pdf >= 0.0, "{}", s.pdf);
 }
 
 /// A small conditional blob with random contents (n 4, hidden [3, 2], 2 instances,
@@ -91,16 +96,13 @@ fn conditional_blob() -> AlignedBytes {
         .unwrap()
 }
 
-/// [`conditional_blob`]'s shape as an environment sampler (sphere, condition
-/// the octahedral square, the equal-area output).
+/// [`conditional_blob`]'s shape as an environment sampler on its prior (sphere,
+/// condition the octahedral square, the tree warp and its three sections).
 fn envmap_blob() -> AlignedBytes {
-    let shape = shape(4, &[3, 2], Activation::Relu, PointWarp::EqualArea, 0);
-    let mut parts = conditional_parts(shape, 2, [3, 2], 6);
-    parts.info.domain = Domain::Sphere as u32;
-    parts.info.target = nuld_core::conditional::ConditionalTarget::EnvmapNormal as u32;
-    parts.info.cond_min = [0.0; 2];
-    parts.info.cond_max = [1.0; 2];
-    parts.to_blob(&META).unwrap()
+    let shape = shape(4, &[3, 2], Activation::Relu, PointWarp::EnvmapTree, 0);
+    as_envmap(conditional_parts(shape, 2, [3, 2], 6))
+        .to_blob(&META)
+        .unwrap()
 }
 
 fn valid_blobs() -> Vec<AlignedBytes> {
@@ -582,8 +584,10 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
         && ranges_ok
         && info.activation <= 1
         && widths_ok
-        // Warp 1 (the BRDF mixture) exists for the glTF BRDF on the hemisphere only.
-        && (info.warp == 0 || (info.warp == 1 && info.domain == 2))
+        // Warps 0 and 1 (the BRDF mixture, on the hemisphere only) are the glTF
+        // BRDF's; warp 2 (the environment tree) is a map's, which requires it.
+        && ((info.target == 1 && (info.warp == 0 || (info.warp == 1 && info.domain == 2)))
+            || (info.target == 2 && info.warp == 2))
         && info.reserved == 0)
     {
         return false;
@@ -607,7 +611,8 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
     let weight_len = info.weight_grid[0] as u128
         * info.weight_grid[1] as u128
         * if info.warp == 1 { 2 } else { 1 };
-    pe.elem_size == 2
+    (info.warp != 2 || tree_semantics_hold(&layout))
+        && pe.elem_size == 2
         && te.elem_size == 4
         && we.elem_size == 4
         && params.len() as u128 == 2 * expected_params
@@ -617,6 +622,54 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
             .chunks_exact(2)
             .all(|b| f16_decode(u16::from_le_bytes([b[0], b[1]])).is_finite())
         && weights.chunks_exact(4).all(|b| {
+            let w = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+            w.is_finite() && w >= 0.0
+        })
+}
+
+/// The environment prior's sections (core/FORMAT.md, tags 7-9), checked from the
+/// raw bytes: a 16-byte info (its `elem_size`, as the conditional info's, unread)
+/// with levels 3 to 12, a grid of 2 to 1024 normals and
+/// zero reserved words; `(4^(L+1) - 4) / 3` records of four finite `f32` with a
+/// spread >= 0 and some level-1 record with mass; `84 G^2` finite top weights >= 0.
+fn tree_semantics_hold(layout: &Layout<'_>) -> bool {
+    let section = |tag| layout.section(tag).ok();
+    let (Some((_, info)), Some((ne, nodes)), Some((oe, top))) = (
+        section(SectionTag::EnvmapTreeInfo),
+        section(SectionTag::EnvmapTreeNodes),
+        section(SectionTag::EnvmapTreeTop),
+    ) else {
+        return false;
+    };
+    if info.len() != 16 || ne.elem_size != 16 || oe.elem_size != 4 {
+        return false;
+    }
+    let word = |b: &[u8], at: usize| u32::from_le_bytes(b[at..at + 4].try_into().unwrap());
+    let (levels, grid) = (word(info, 0), word(info, 4));
+    if !((3..=12).contains(&levels) && (2..=1024).contains(&grid))
+        || word(info, 8) != 0
+        || word(info, 12) != 0
+    {
+        return false;
+    }
+    let records = ((1u128 << (2 * (levels + 1))) - 4) / 3;
+    if nodes.len() as u128 != 16 * records || top.len() as u128 != 4 * 84 * (grid as u128).pow(2) {
+        return false;
+    }
+    let real = |b: &[u8], at: usize| f32::from_bits(word(b, at));
+    let record = |r: usize| [0, 4, 8, 12].map(|o| real(nodes, 16 * r + o));
+    let sound = (0..records as usize).all(|r| {
+        let v = record(r);
+        v.iter().all(|x| x.is_finite()) && v[3] >= 0.0
+    });
+    let lit = (0..4).any(|r| {
+        let v = record(r);
+        let mass = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]).sqrt();
+        mass > 0.0 && mass.is_finite()
+    });
+    sound
+        && lit
+        && top.chunks_exact(4).all(|b| {
             let w = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
             w.is_finite() && w >= 0.0
         })

@@ -33,11 +33,15 @@ mod shader_sample;
 
 use nuld_core::blob::Domain;
 use nuld_core::conditional::PointWarp;
+use nuld_core::conditional::{randomization_shift, torus_shift};
 use nuld_core::network::Activation;
 use nuld_runtime::glam::{DVec3, Vec2, Vec3};
+use nuld_runtime::shader::SAMPLE_STRIDE;
 use nuld_runtime::shader::{kernel_wgsl, KernelMode, KernelParams, KERNEL_ENTRY_POINT};
 use nuld_runtime::{Blob, BrdfSampler, ConditionalSampler, Sample};
-use nuld_tests::{conditional_parts, distilled_parts, shape, sobol_blob, META};
+use nuld_tests::{
+    as_envmap, conditional_parts, distilled_parts, fixture_tree, shape, sobol_blob, META,
+};
 use shader_sample::Gpu;
 use std::sync::OnceLock;
 
@@ -53,15 +57,22 @@ struct Kernel {
     pipeline: wgpu::ComputePipeline,
 }
 
+/// One `NuldSample` read back: direction xyz and weight, then pdf and padding.
+type GpuSample = ([f32; 4], [f32; 4]);
+
 impl Kernel {
     /// The kernel's samples of `p` over `blob`.
-    fn run(&self, blob: &[u8], p: &KernelParams) -> Vec<[f32; 4]> {
+    fn run(&self, blob: &[u8], p: &KernelParams) -> Vec<GpuSample> {
         let count = p.sample_count().expect("a small range") as u64;
         let uniform = Some(bytemuck::bytes_of(p));
         let groups = p.workgroups();
-        self.gpu
-            .run(&self.pipeline, blob, uniform, count, groups, 1)
-            .0
+        // A sample is two 16-byte slots of the host's buffer.
+        let slots = SAMPLE_STRIDE / 16;
+        let out = self
+            .gpu
+            .run(&self.pipeline, blob, uniform, slots * count, groups, 1)
+            .0;
+        out.chunks_exact(2).map(|c| (c[0], c[1])).collect()
     }
 }
 
@@ -135,9 +146,16 @@ fn sample_of(p: &KernelParams, e: u32) -> (Vec2, u32, u32) {
 }
 
 /// Largest absolute difference of direction components and weight.
-fn gap(gpu: &[f32; 4], cpu: Sample) -> f32 {
-    let d = Vec3::new(gpu[0], gpu[1], gpu[2]) - cpu.direction;
-    d.abs().max_element().max((gpu[3] - cpu.weight).abs())
+/// The largest difference of direction components and weight, and the pdf's
+/// relative difference.
+fn gap(gpu: &GpuSample, cpu: Sample) -> f32 {
+    let (g, more) = gpu;
+    let d = Vec3::new(g[0], g[1], g[2]) - cpu.direction;
+    let pdf = (more[0] - cpu.pdf).abs() / cpu.pdf.max(f32::MIN_POSITIVE);
+    d.abs()
+        .max_element()
+        .max((g[3] - cpu.weight).abs())
+        .max(pdf)
 }
 
 #[test]
@@ -167,12 +185,14 @@ fn shader_point_and_direction_sets_match_the_runtime() {
             let (set, i) = (set as usize, i as usize);
             if domain == Domain::Square {
                 let want = blob.point_set_2d().unwrap().point(set, i);
-                assert_eq!(*got, [want.x, want.y, 0.0, 1.0], "set {set} index {i}");
+                assert_eq!(got.0, [want.x, want.y, 0.0, 1.0], "set {set} index {i}");
+                assert_eq!(got.1[0], 0.0);
             } else {
                 let dirs = blob.direction_set().unwrap();
                 let want = Sample {
                     direction: dirs.direction(set, i),
                     weight: 1.0,
+                    pdf: 0.0,
                 };
                 worst = worst.max(gap(got, want));
             }
@@ -188,24 +208,30 @@ fn shader_point_and_direction_sets_match_the_runtime() {
 
 /// How much the blob's point warp at condition `cond` (blob units) amplifies a
 /// perturbation of the square point `p`, the factor on the tolerances: 1 for the
-/// equal-area maps; for the BRDF mixture `1 + J`, `J` the largest column norm of
-/// the warp's Jacobian (`PointWarp::direction_differences` in `f64`, step
-/// `2^-20`). The mixture's GGX branch is ill-conditioned where `u.x / p_s`
+/// equal-area maps; for the BRDF mixture and the environment tree `1 + J`, `J`
+/// the largest column norm of the warp's Jacobian
+/// (`PointWarp::direction_differences` in `f64`, step `2^-20`; for the tree
+/// [`fixture_tree`], the prior of every environment fixture here, and at a
+/// split of the tree a jump, where a rounding may choose the other side). The mixture's GGX branch is ill-conditioned where `u.x / p_s`
 /// nears 1 (the rim of the visible-normal disk, where `sqrt(1 - p1^2 - p2^2)`
 /// cancels): there the same `f32` operations, rounded by another `sqrt`, `sin` or
 /// division, move the direction by far more than a few ulps (the runtime's own
 /// `f32` result is as far from the exact direction).
 fn warp_gain(cs: &ConditionalSampler, cond: Vec2, p: Vec2) -> f32 {
     let info = cs.info();
-    let Some(warp @ PointWarp::BrdfMixture) = info.point_warp() else {
+    let warp = info.point_warp().expect("a parsed blob's warp");
+    if warp == PointWarp::EqualArea {
         return 1.0;
-    };
+    }
     // The clamped condition, as the runtime's tables and warp see it.
     let c = info.denormalize(info.normalize(cond.to_array()));
+    let fixture = fixture_tree();
+    let tree = fixture.tree();
     let columns = warp.direction_differences(
-        Domain::Hemisphere,
+        cs.domain(),
         c.map(f64::from),
         cs.lobe_probability(cond) as f64,
+        Some(&tree),
         p.as_dvec2().to_array(),
         1.0 / 1_048_576.0,
     );
@@ -259,10 +285,14 @@ fn runtime_sample(cs: &ConditionalSampler, p: &KernelParams, e: u32) -> (Sample,
         KernelMode::Network,
         KernelMode::BrdfTable,
         KernelMode::BrdfNetwork,
+        KernelMode::TableRandomized,
+        KernelMode::NetworkRandomized,
+        KernelMode::Pdf,
     ]
     .into_iter()
     .find(|&m| m as u32 == p.mode)
     .expect("a kernel mode");
+    let shifted = |q: Vec2| Vec2::from(torus_shift(q.to_array(), randomization_shift(e)));
     let (want, cond, point) = match mode {
         KernelMode::Table => (cs.sample(c, k, i), c, cs.square_point(c, k, i)),
         KernelMode::Network => (
@@ -270,6 +300,24 @@ fn runtime_sample(cs: &ConditionalSampler, p: &KernelParams, e: u32) -> (Sample,
             c,
             cs.network().square_point(c, k, i),
         ),
+        KernelMode::TableRandomized => (
+            cs.sample_randomized(c, k, i, e),
+            c,
+            shifted(cs.square_point(c, k, i)),
+        ),
+        KernelMode::NetworkRandomized => (
+            cs.network().sample_randomized(c, k, i, e),
+            c,
+            shifted(cs.network().square_point(c, k, i)),
+        ),
+        KernelMode::Pdf => {
+            let s = cs.sample(c, k, i);
+            let s = Sample {
+                pdf: cs.pdf(c, s.direction),
+                ..s
+            };
+            (s, c, cs.square_point(c, k, i))
+        }
         KernelMode::BrdfTable => {
             let cond = brdf_cond();
             (
@@ -323,8 +371,25 @@ fn check_conditional(kernel: &Kernel, bytes: &[u8], label: &str) {
             0..cs.len() + 3,
         )
     };
-    let worst_table = compare(kernel, bytes, &cs, &grid(KernelMode::Table));
-    let worst_network = compare(kernel, bytes, &cs, &grid(KernelMode::Network));
+    let mut worst_table = compare(kernel, bytes, &cs, &grid(KernelMode::Table));
+    let mut worst_network = compare(kernel, bytes, &cs, &grid(KernelMode::Network));
+    // The unbiased mode and the pdf of any direction: environment samplers'.
+    let env = cs.target() == nuld_core::conditional::ConditionalTarget::EnvmapNormal;
+    if env {
+        worst_table.merge(compare(
+            kernel,
+            bytes,
+            &cs,
+            &grid(KernelMode::TableRandomized),
+        ));
+        worst_table.merge(compare(kernel, bytes, &cs, &grid(KernelMode::Pdf)));
+        worst_network.merge(compare(
+            kernel,
+            bytes,
+            &cs,
+            &grid(KernelMode::NetworkRandomized),
+        ));
+    }
     // Views: generic, along z, grazing, below the horizon, zero, huge, tiny, NaN.
     let views = [
         Vec3::new(0.3, 0.4, 0.866),
@@ -421,14 +486,14 @@ fn shader_random_samplers_of_every_shape_match_the_runtime() {
             // A generator whose products `i g` overflow 32 bits: the shader's
             // 64-bit-free `(i g) mod n`.
             parts.info.lattice_generator = g;
-            if s == 2 && warp == PointWarp::EqualArea {
-                // The sphere map: an environment sampler (whose table mode blends
-                // the corners' directions); BRDF samplers use the hemisphere.
-                parts.info.domain = Domain::Sphere as u32;
-                parts.info.target = nuld_core::conditional::ConditionalTarget::EnvmapNormal as u32;
+            let mut label = format!("random {s} {warp:?}");
+            if s == 2 && warp == PointWarp::BrdfMixture {
+                // An environment sampler on its tree: the sphere, the tree's warp.
+                parts = as_envmap(parts);
+                label = format!("random {s} {:?}", PointWarp::EnvmapTree);
             }
             let bytes = parts.to_blob(&META).unwrap();
-            check_conditional(kernel, bytes.as_slice(), &format!("random {s} {warp:?}"));
+            check_conditional(kernel, bytes.as_slice(), &label);
         }
     }
 }
@@ -461,8 +526,10 @@ fn shader_readme_example_gives_the_runtime_samples() {
     let mut worst = 0.0f32;
     for (e, got) in out.iter().enumerate() {
         let (pixel, i) = (e as u32 / cs.len(), e as u32 % cs.len());
+        // The README's shader writes direction and weight only: a zero pdf, as
+        // the BRDF sampler's.
         worst = worst.max(gap(
-            got,
+            &(*got, [0.0; 4]),
             BrdfSampler::try_from(cs).unwrap().sample(wo, 0.4, pixel, i),
         ));
     }

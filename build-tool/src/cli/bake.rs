@@ -30,10 +30,10 @@ pub struct BakeArgs {
     /// [default: 10,12]; the normal's octahedral square u,v for --envmap [default: 13,13].
     #[arg(long, value_delimiter = ',')]
     pub grid: Option<Vec<u32>>,
-    /// Training steps after the 300 steps of pretraining on the warp (the default
-    /// N = 64 BRDF bake takes 191 s on 2 cores).
-    #[arg(long, default_value_t = TrainConfig::default().steps, allow_negative_numbers = true, value_parser = super::count)]
-    pub steps: usize,
+    /// Training steps after the 300 steps of pretraining on the warp [default:
+    /// 12000 for --brdf (191 s at N = 64 on 2 cores), 3000 for --envmap].
+    #[arg(long, allow_negative_numbers = true, value_parser = super::count)]
+    pub steps: Option<usize>,
     /// Seed; fixes the output bit for bit whatever the thread count.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -51,10 +51,10 @@ pub struct BakeArgs {
     /// Instance slots M of the network: instance k is slot k mod M, a set with its own
     /// offset and learned per-point biases (0: every instance its own offset, no
     /// per-instance biases). Keep --instances <= M: table instances beyond M repeat
-    /// sets [default: 64 for --brdf, 0 for --envmap].
+    /// sets [default: 64].
     #[arg(long, allow_negative_numbers = true, value_parser = super::count)]
     pub instance_slots: Option<usize>,
-    /// Weight of the union-of-instances term [default: 0.5 for --brdf, 4 for --envmap].
+    /// Weight of the union-of-instances term [default: 0.5].
     #[arg(long)]
     pub union_weight: Option<f64>,
     /// Initial Adam step.
@@ -100,7 +100,8 @@ pub fn run(a: BakeArgs) -> Result<()> {
         grid.len() == 2 && grid.iter().all(|&g| (2..=256).contains(&g)),
         "--grid must be two node counts in 2..=256, like 10,12"
     );
-    ensure!(a.steps >= 1, "--steps must be at least 1");
+    let steps = a.steps.unwrap_or(defaults.train.steps);
+    ensure!(steps >= 1, "--steps must be at least 1");
     let instance_slots = a
         .instance_slots
         .unwrap_or(defaults.train.instance_slots as usize);
@@ -122,7 +123,7 @@ pub fn run(a: BakeArgs) -> Result<()> {
         hidden: a.hidden,
         silu: a.silu,
         instance_slots: instance_slots as u32,
-        steps: a.steps,
+        steps,
         union_weight,
         learning_rate: a.lr,
         seed: a.seed,

@@ -29,6 +29,11 @@ pub struct SampleArgs {
     /// Table lookups or the network evaluated per sample.
     #[arg(long, value_enum, default_value = "table")]
     pub mode: SampleMode,
+    /// The unbiased mode: the set's primary points shifted on the torus by a
+    /// random vector drawn from SEED (a renderer passes each pixel's random
+    /// number), so that every sample is distributed exactly as its pdf.
+    #[arg(long, value_name = "SEED")]
+    pub randomize: Option<u32>,
 }
 
 /// A parsed `--cond`: two finite numbers.
@@ -80,15 +85,17 @@ fn parse_normal(s: &str) -> Result<Normal, String> {
     }
 }
 
-/// Writes the CSV `index,x,y,z,weight` of every index `0..n` of instance `instance`
-/// at `at` to `out`: values as the runtime returns them (f32, shortest round-trip
-/// decimal). Fails for a blob that is not a conditional sampler, or a normal given
-/// to a sampler whose condition is not one.
+/// Writes the CSV `index,x,y,z,weight,pdf` of every index `0..n` of instance
+/// `instance` at `at` to `out`, in the unbiased mode when `randomize` gives a
+/// seed: values as the runtime returns them (f32, shortest round-trip decimal;
+/// `pdf` per steradian, 0 for a sampler without an exact prior). Fails for a blob
+/// that is not a conditional sampler, or a normal given to a sampler whose
+/// condition is not one.
 pub fn write_csv(
     bytes: &[u8],
     at: At,
     instance: u32,
-    mode: SampleMode,
+    (mode, randomize): (SampleMode, Option<u32>),
     out: &mut impl Write,
 ) -> Result<()> {
     let blob = Blob::parse(bytes).map_err(|e| anyhow!("{e}"))?;
@@ -113,16 +120,27 @@ pub fn write_csv(
         View::Normal(env, _) => env.len(),
         View::Condition(cs, _) => cs.len(),
     };
-    writeln!(out, "index,x,y,z,weight")?;
+    writeln!(out, "index,x,y,z,weight,pdf")?;
     for i in 0..len {
-        let s = match (view, mode) {
-            (View::Normal(env, n), SampleMode::Table) => env.sample(n, instance, i),
-            (View::Normal(env, n), SampleMode::Network) => env.network().sample(n, instance, i),
-            (View::Condition(cs, c), SampleMode::Table) => cs.sample(c, instance, i),
-            (View::Condition(cs, c), SampleMode::Network) => cs.network().sample(c, instance, i),
+        let k = instance;
+        let s = match (view, mode, randomize) {
+            (View::Normal(env, n), SampleMode::Table, None) => env.sample(n, k, i),
+            (View::Normal(env, n), SampleMode::Table, Some(r)) => env.sample_randomized(n, k, i, r),
+            (View::Normal(env, n), SampleMode::Network, None) => env.network().sample(n, k, i),
+            (View::Normal(env, n), SampleMode::Network, Some(r)) => {
+                env.network().sample_randomized(n, k, i, r)
+            }
+            (View::Condition(cs, c), SampleMode::Table, None) => cs.sample(c, k, i),
+            (View::Condition(cs, c), SampleMode::Table, Some(r)) => {
+                cs.sample_randomized(c, k, i, r)
+            }
+            (View::Condition(cs, c), SampleMode::Network, None) => cs.network().sample(c, k, i),
+            (View::Condition(cs, c), SampleMode::Network, Some(r)) => {
+                cs.network().sample_randomized(c, k, i, r)
+            }
         };
         let d = s.direction;
-        writeln!(out, "{i},{},{},{},{}", d.x, d.y, d.z, s.weight)?;
+        writeln!(out, "{i},{},{},{},{},{}", d.x, d.y, d.z, s.weight, s.pdf)?;
     }
     Ok(())
 }
@@ -168,8 +186,9 @@ pub fn run(a: SampleArgs) -> Result<()> {
     if let Some(warning) = clamp_warning(bytes.as_slice(), at) {
         eprintln!("{warning}");
     }
-    let written = write_csv(bytes.as_slice(), at, a.instance, a.mode, &mut out)
-        .and_then(|()| Ok(out.flush()?));
+    let how = (a.mode, a.randomize);
+    let written =
+        write_csv(bytes.as_slice(), at, a.instance, how, &mut out).and_then(|()| Ok(out.flush()?));
     match written {
         Err(e) if super::export::is_broken_pipe(&e) => Ok(()),
         other => other.map_err(|e| anyhow!("{}: {e}", a.file.display())),
@@ -196,20 +215,34 @@ mod tests {
         let map = crate::sphere::envmap::tiny_map(&dir);
         let blob = crate::lab::render::blobs::tiny_envmap_blob(4, &map);
         let at = At::Normal(Normal([0.2, 0.9, -0.3]));
-        let mut out = Vec::new();
-        write_csv(blob.as_slice(), at, 3, SampleMode::Network, &mut out).unwrap();
-        let text = String::from_utf8(out).unwrap();
         let env = Blob::parse(blob.as_slice()).unwrap().envmap().unwrap();
-        let rows: Vec<&str> = text.lines().collect();
-        assert_eq!(rows[0], "index,x,y,z,weight");
-        for i in 0..4u32 {
-            let s = env.network().sample(Vec3::new(0.2, 0.9, -0.3), 3, i);
-            let d = s.direction;
-            let want = format!("{i},{},{},{},{}", d.x, d.y, d.z, s.weight);
-            assert_eq!(rows[1 + i as usize], want);
+        let n = Vec3::new(0.2, 0.9, -0.3);
+        for randomize in [None, Some(99)] {
+            let mut out = Vec::new();
+            write_csv(
+                blob.as_slice(),
+                at,
+                3,
+                (SampleMode::Network, randomize),
+                &mut out,
+            )
+            .unwrap();
+            let text = String::from_utf8(out).unwrap();
+            let rows: Vec<&str> = text.lines().collect();
+            assert_eq!(rows[0], "index,x,y,z,weight,pdf");
+            for i in 0..4u32 {
+                let s = match randomize {
+                    None => env.network().sample(n, 3, i),
+                    Some(r) => env.network().sample_randomized(n, 3, i, r),
+                };
+                assert!(s.pdf > 0.0);
+                let d = s.direction;
+                let want = format!("{i},{},{},{},{},{}", d.x, d.y, d.z, s.weight, s.pdf);
+                assert_eq!(rows[1 + i as usize], want);
+            }
         }
         let brdf = nuld_runtime::doc_example_conditional_blob();
-        let e = write_csv(&brdf.0, at, 0, SampleMode::Table, &mut Vec::new())
+        let e = write_csv(&brdf.0, at, 0, (SampleMode::Table, None), &mut Vec::new())
             .unwrap_err()
             .to_string();
         assert!(e.contains("--normal needs an environment sampler"), "{e}");

@@ -2,10 +2,12 @@
 //! and their encoding through [`nuld_core::blob::write`].
 
 use crate::pointset::AlignedBytes;
+use crate::sphere::EnvmapTree;
 use anyhow::{bail, Context, Result};
 use nuld_core::blob::{encoded_len, write, BlobKind, Metadata};
 use nuld_core::conditional::{sections, ConditionalInfo};
 use std::path::Path;
+use std::sync::Arc;
 
 /// Everything a conditional blob holds besides its metadata (layouts in
 /// `core/FORMAT.md` and [`nuld_core::conditional`]).
@@ -21,6 +23,9 @@ pub struct ConditionalParts {
     /// [`nuld_core::conditional::PointWarp::BrdfMixture`] followed by the lobe
     /// probabilities on the same nodes.
     pub weights: Vec<f32>,
+    /// The environment prior of a [`nuld_core::conditional::PointWarp::EnvmapTree`]
+    /// sampler, written as its three sections after the four above.
+    pub prior: Option<Arc<EnvmapTree>>,
 }
 
 impl ConditionalParts {
@@ -54,7 +59,11 @@ impl ConditionalParts {
             );
         }
         let meta_bytes = postcard::to_allocvec(meta).context("cannot encode metadata")?;
-        let sections = sections(info, &self.params, &self.table, &self.weights);
+        let mut sections = sections(info, &self.params, &self.table, &self.weights).to_vec();
+        let tree_info = self.prior.as_ref().map(|t| t.info());
+        if let (Some(tree), Some(tree_info)) = (&self.prior, &tree_info) {
+            sections.extend(tree.sections(tree_info));
+        }
         let mut out = AlignedBytes::zeroed(encoded_len(&meta_bytes, &sections));
         write(
             out.as_mut_slice(),

@@ -11,7 +11,10 @@
 //!   [`crate::sphere::brdf_albedo::lobe_probability`] computes, from the same
 //!   quadrature); for an environment sampler ([`nuld_core::conditional::ConditionalTarget::EnvmapNormal`])
 //!   the irradiance `E(n)` of the map at every node's normal
-//!   ([`EnvmapDensity::irradiance`]).
+//!   ([`EnvmapDensity::irradiance`]);
+//! * **prior**: an environment sampler on the tree
+//!   ([`PointWarp::EnvmapTree`]) carries the map's tree, which the pool trained
+//!   through.
 
 use super::ConditionalParts;
 use crate::network::Params;
@@ -25,10 +28,11 @@ use nuld_core::network::{Shape, MAX_HIDDEN_LAYERS};
 use nuld_core::quantize::unorm16_encode;
 use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// The info record of a sampler of `target` over its condition range
 /// ([`LoadedTarget::condition_range`]) and domain, with a network of `shape` (its
-/// point warp [`PointWarp::of_shape`]), `instances` stored instances, and the given
+/// point warp [`PointWarp::of`]), `instances` stored instances, and the given
 /// point and weight grids (nodes per axis, each `>= 2`).
 pub fn info(
     shape: &Shape,
@@ -53,7 +57,7 @@ pub fn info(
         hidden,
         activation: shape.activation() as u32,
         lattice_generator: shape.lattice_generator(),
-        warp: PointWarp::of_shape(shape) as u32,
+        warp: PointWarp::of(kind, shape) as u32,
         instance_slots: shape.instance_slots(),
         reserved: 0,
     }
@@ -90,15 +94,19 @@ pub fn distill(
             })
         })
         .collect();
-    let weights = match target {
-        LoadedTarget::GltfBrdf => brdf_weights(&info),
-        LoadedTarget::Envmap(map) => envmap_weights(&info, map),
+    let (weights, prior) = match target {
+        LoadedTarget::GltfBrdf => (brdf_weights(&info), None),
+        LoadedTarget::Envmap(env) => (
+            envmap_weights(&info, &env.map),
+            (info.point_warp() == Some(PointWarp::EnvmapTree)).then(|| Arc::new(env.tree.clone())),
+        ),
     };
     ConditionalParts {
         info,
         params: params.to_f16_bits(),
         table,
         weights,
+        prior,
     }
 }
 

@@ -22,14 +22,16 @@ use crate::progress::Progress;
 use crate::sphere::metrics::diversity;
 use crate::sphere::metrics::{CapRadius, MeasuredCaps};
 use crate::sphere::{BrdfTarget, DirectionDensity};
-use crate::train::target::LoadedTarget;
+use crate::train::target::{EnvmapTarget, LoadedTarget};
 use anyhow::Result;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
-use nuld_core::conditional::PointWarp;
+use nuld_core::conditional::{randomization_shift, ConditionalTarget, PointWarp};
+use nuld_core::envmap_tree::EnvmapTree as CoreTree;
 use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
 use serde::Serialize;
+use std::sync::Arc;
 
 /// Settings of [`evaluate`].
 #[derive(Clone, Debug, Serialize)]
@@ -82,6 +84,10 @@ pub struct ConditionQuality {
     pub baseline: f64,
     /// `ours / baseline`.
     pub ratio: f64,
+    /// The unbiased mode's sets (each instance's points shifted on the torus by
+    /// `randomization_shift(k)` before the warp) over the baseline: mean over the
+    /// instances.
+    pub randomized_ratio: f64,
     /// `D_cap,2` of the union of instances over `ours`.
     pub union_ratio: f64,
     /// Nearest-neighbour angle across instances over within a set.
@@ -96,6 +102,8 @@ pub struct Quality {
     pub conditions: Vec<ConditionQuality>,
     /// Mean of the ratios.
     pub mean_ratio: f64,
+    /// Mean of the unbiased mode's ratios.
+    pub mean_randomized_ratio: f64,
     /// Largest ratio.
     pub worst_ratio: f64,
     /// Mean union ratio.
@@ -109,24 +117,37 @@ pub struct Quality {
 /// [`PointWarp::direction`]).
 pub fn instance_directions(params: &Params, cond: [f64; 2], p_s: f64, k: u32) -> Vec<DVec3> {
     let unit = LoadedTarget::GltfBrdf.normalized(cond);
-    directions_at(params, unit, cond, Domain::Hemisphere, p_s, k)
+    let warp = PointWarp::of(ConditionalTarget::GltfBrdf, &params.shape);
+    directions_at(
+        params,
+        unit,
+        cond,
+        (Domain::Hemisphere, warp, None),
+        p_s,
+        (k, false),
+    )
 }
 
 /// Instance `k`'s directions at the condition `cond` (blob units; `unit` its
-/// normalized form, the network's input) on `domain`.
+/// normalized form, the network's input) on `domain` through `warp` (and its
+/// environment tree); in the unbiased mode (`randomized`) each point shifted on
+/// the torus by `randomization_shift(k)` first.
 fn directions_at(
     params: &Params,
     unit: [f64; 2],
     cond: [f64; 2],
-    domain: Domain,
+    (domain, warp, tree): (Domain, PointWarp, Option<&CoreTree<'_>>),
     p_s: f64,
-    k: u32,
+    (k, randomized): (u32, bool),
 ) -> Vec<DVec3> {
-    let warp = PointWarp::of_shape(&params.shape);
+    let shift = randomization_shift(k).map(f64::from);
     (0..params.shape.n())
         .map(|i| {
-            let s = params.square_point(unit, k, i);
-            DVec3::from_array(warp.direction(domain, cond, p_s, s))
+            let mut s = params.square_point(unit, k, i);
+            if randomized {
+                s = std::array::from_fn(|a| (s[a] + shift[a]).rem_euclid(1.0));
+            }
+            DVec3::from_array(warp.direction(domain, cond, p_s, tree, s))
         })
         .collect()
 }
@@ -145,6 +166,10 @@ struct HeldOut {
     domain: Domain,
     /// The BRDF mixture's `p_s` (0 for a map: its warp does not read it).
     lobe_probability: f64,
+    /// The target's kind.
+    kind: ConditionalTarget,
+    /// An environment sampler's map and tree.
+    env: Option<Arc<EnvmapTarget>>,
 }
 
 impl HeldOut {
@@ -161,11 +186,13 @@ impl HeldOut {
                     domain: Domain::Hemisphere,
                     lobe_probability: t.lobe_probability(),
                     density: Box::new(t),
+                    kind: ConditionalTarget::GltfBrdf,
+                    env: None,
                 })
             }
-            LoadedTarget::Envmap(map) => {
+            LoadedTarget::Envmap(env) => {
                 let normal = square_to_sphere(DVec2::from(cond));
-                let (lit, irradiance) = map.cosine_weighted(normal)?;
+                let (lit, irradiance) = env.map.cosine_weighted(normal)?;
                 (irradiance > 0.0).then(|| Self {
                     unit,
                     cond,
@@ -173,6 +200,8 @@ impl HeldOut {
                     domain: Domain::Sphere,
                     lobe_probability: 0.0,
                     density: Box::new(lit) as Box<dyn DirectionDensity>,
+                    kind: ConditionalTarget::EnvmapNormal,
+                    env: Some(Arc::clone(env)),
                 })
             }
         })
@@ -190,11 +219,22 @@ impl HeldOut {
             |w, t| density.cap_measure(w, t),
         );
         let d = |pts: &[DVec3]| caps.l2_squared(pts, CapRadius::ThetaUniform).0.sqrt();
+        let tree = self.env.as_ref().map(|e| e.tree.tree());
+        let warp = PointWarp::of(self.kind, &shipped.shape);
         let sets: Vec<Vec<DVec3>> = (0..config.union_instances.max(config.instances).max(2))
             .into_par_iter()
             .map(|k| {
                 let (unit, cond, p_s) = (self.unit, self.cond, self.lobe_probability);
-                directions_at(shipped, unit, cond, self.domain, p_s, k)
+                let how = (self.domain, warp, tree.as_ref());
+                directions_at(shipped, unit, cond, how, p_s, (k, false))
+            })
+            .collect();
+        let randomized: Vec<f64> = (0..config.instances)
+            .into_par_iter()
+            .map(|k| {
+                let (unit, cond, p_s) = (self.unit, self.cond, self.lobe_probability);
+                let how = (self.domain, warp, tree.as_ref());
+                d(&directions_at(shipped, unit, cond, how, p_s, (k, true)))
             })
             .collect();
         let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len() as f64;
@@ -225,6 +265,7 @@ impl HeldOut {
             ours,
             baseline,
             ratio: ours / baseline,
+            randomized_ratio: mean(randomized) / baseline,
             union_ratio: spread.as_ref().map_or(f64::NAN, |s| s.union_ratio),
             nn_ratio: spread.as_ref().map_or(f64::NAN, |s| s.nn_ratio),
         }
@@ -248,6 +289,7 @@ pub fn evaluate(params: &Params, target: &LoadedTarget, config: &QualityConfig) 
     let m = conditions.len().max(1) as f64;
     Ok(Quality {
         mean_ratio: conditions.iter().map(|c| c.ratio).sum::<f64>() / m,
+        mean_randomized_ratio: conditions.iter().map(|c| c.randomized_ratio).sum::<f64>() / m,
         worst_ratio: conditions.iter().map(|c| c.ratio).fold(0.0, f64::max),
         mean_union_ratio: conditions.iter().map(|c| c.union_ratio).sum::<f64>() / m,
         mean_nn_ratio: conditions.iter().map(|c| c.nn_ratio).sum::<f64>() / m,

@@ -12,10 +12,12 @@ use nuld_core::blob::{
     SECTION_ENTRY_LEN,
 };
 use nuld_core::brdf::{MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
-use nuld_core::conditional::{ConditionalInfo, ConditionalTarget, PointWarp};
+use nuld_core::conditional::{ConditionalInfo, PointWarp, RANDOMIZE_SALTS};
+use nuld_core::envmap_tree::{node_count, TreeInfo, TOP_FLOOR, TOP_LEVELS};
 use nuld_core::network::{
     Activation, DOT_LANES, INPUTS, LATTICE_LOGIT_EPS, MAX_HIDDEN_LAYERS, MAX_WIDTH, OUTPUTS,
 };
+use nuld_core::quadtree::MAX_LEVELS;
 use nuld_core::quantize::{f16_decode_finite, UNORM16_CELLS};
 use nuld_runtime::shader::{KernelMode, KernelParams, KERNEL_WORKGROUP_SIZE, SAMPLE_STRIDE};
 use std::mem::{offset_of, size_of};
@@ -135,6 +137,25 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_TAG_NETWORK_PARAMS", SectionTag::NetworkParams as u64),
         ("NULD_TAG_POINT_TABLE", SectionTag::PointTable as u64),
         ("NULD_TAG_WEIGHT_TABLE", SectionTag::WeightTable as u64),
+        (
+            "NULD_TAG_ENVMAP_TREE_INFO",
+            SectionTag::EnvmapTreeInfo as u64,
+        ),
+        (
+            "NULD_TAG_ENVMAP_TREE_NODES",
+            SectionTag::EnvmapTreeNodes as u64,
+        ),
+        ("NULD_TAG_ENVMAP_TREE_TOP", SectionTag::EnvmapTreeTop as u64),
+        ("NULD_WARP_ENVMAP_TREE", PointWarp::EnvmapTree as u64),
+        ("NULD_TREE_INFO_LEVELS", at!(TreeInfo, levels)),
+        ("NULD_TREE_INFO_GRID", at!(TreeInfo, grid)),
+        ("NULD_TREE_TOP_LEVELS", TOP_LEVELS as u64),
+        ("NULD_TREE_TOP_NODES", node_count(TOP_LEVELS) as u64),
+        ("NULD_TREE_MAX_LEVELS", MAX_LEVELS as u64),
+        ("NULD_TREE_TOP_FLOOR", f(TOP_FLOOR as f32)),
+        ("NULD_TREE_UNIT_MIN", f(1e-20f64 as f32)),
+        ("NULD_RANDOMIZE_SALT_A", RANDOMIZE_SALTS[0] as u64),
+        ("NULD_RANDOMIZE_SALT_B", RANDOMIZE_SALTS[1] as u64),
         ("NULD_DOMAIN_SQUARE", Domain::Square as u64),
         ("NULD_DOMAIN_SPHERE", Domain::Sphere as u64),
         ("NULD_DOMAIN_HEMISPHERE", Domain::Hemisphere as u64),
@@ -143,10 +164,6 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_POINT_SET_DOMAIN", at!(PointSetInfo, domain)),
         ("NULD_WARP_EQUAL_AREA", PointWarp::EqualArea as u64),
         ("NULD_WARP_BRDF_MIXTURE", PointWarp::BrdfMixture as u64),
-        (
-            "NULD_TARGET_ENVMAP_NORMAL",
-            ConditionalTarget::EnvmapNormal as u64,
-        ),
         ("NULD_INPUTS", INPUTS as u64),
         ("NULD_MAX_WIDTH", MAX_WIDTH as u64),
         ("NULD_MAX_HIDDEN_LAYERS", MAX_HIDDEN_LAYERS as u64),
@@ -183,6 +200,15 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_MODE_NETWORK", KernelMode::Network as u64),
         ("NULD_MODE_BRDF_TABLE", KernelMode::BrdfTable as u64),
         ("NULD_MODE_BRDF_NETWORK", KernelMode::BrdfNetwork as u64),
+        (
+            "NULD_MODE_TABLE_RANDOMIZED",
+            KernelMode::TableRandomized as u64,
+        ),
+        (
+            "NULD_MODE_NETWORK_RANDOMIZED",
+            KernelMode::NetworkRandomized as u64,
+        ),
+        ("NULD_MODE_PDF", KernelMode::Pdf as u64),
     ];
     constants.extend(info_fields().map(|(constant, _, offset)| (constant, offset)));
     constants
@@ -222,10 +248,11 @@ fn rust_structs() -> Vec<(&'static str, u64)> {
         ("NuldKernelParams.mode", at!(KernelParams, mode)),
         ("NuldKernelParams.reserved", at!(KernelParams, reserved)),
         ("NuldKernelParams.view", at!(KernelParams, view)),
-        // Direction xyz then weight: one `[f32; 4]` per sample on the host.
+        // Direction xyz, weight, pdf: two `[f32; 4]` per sample on the host.
         ("NuldSample", SAMPLE_STRIDE),
         ("NuldSample.direction", 0),
         ("NuldSample.weight", 3 * size_of::<f32>() as u64),
+        ("NuldSample.pdf", 4 * size_of::<f32>() as u64),
     ]);
     structs
 }

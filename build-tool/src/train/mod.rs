@@ -58,10 +58,13 @@ pub struct TrainConfig {
     /// `true` for SiLU hidden units, `false` for ReLU.
     pub silu: bool,
     /// `true`: the network emits a residual on the logit of the shifted lattice
-    /// point in the primary sample space of the renderer's mixture warp
-    /// ([`nuld_core::conditional::PointWarp::BrdfMixture`]); `false`: a point of
-    /// the equal-area square.
-    pub mixture_prior: bool,
+    /// point in the primary sample space of the target's prior, the renderer's
+    /// mixture warp for the BRDF
+    /// ([`nuld_core::conditional::PointWarp::BrdfMixture`]), the map's tree for
+    /// an environment ([`nuld_core::conditional::PointWarp::EnvmapTree`]);
+    /// `false`: a point of the equal-area square.
+    #[serde(alias = "mixture_prior")]
+    pub prior: bool,
     /// Gradient steps on the cap loss.
     pub steps: usize,
     /// Steps before those that fit the network to the renderer's warp of its
@@ -103,7 +106,7 @@ impl Default for TrainConfig {
             n: 64,
             hidden: vec![32, 32],
             silu: false,
-            mixture_prior: true,
+            prior: true,
             steps: 12_000,
             pretrain_steps: 300,
             conditions_per_step: 8,
@@ -131,7 +134,7 @@ impl TrainConfig {
             Activation::Relu
         };
         Shape::new(self.n, &self.hidden, act, lattice_generator(self.n))
-            .map(|s| s.with_lattice_residual(self.mixture_prior))
+            .map(|s| s.with_lattice_residual(self.prior))
             .and_then(|s| s.with_instance_slots(self.instance_slots))
     }
 }
@@ -598,7 +601,7 @@ mod tests {
             learning_rate: 1e-2,
             // The equal-area output, whose start is far from the warp; with the
             // mixture prior the start is the warp already.
-            mixture_prior: false,
+            prior: false,
             ..TrainConfig::default()
         };
         let mut t = Trainer::new(cfg, None).unwrap();

@@ -13,9 +13,10 @@
 //! An environment sampler's pool ([`TrainTarget::Envmap`]) holds normals instead,
 //! spread uniformly over the sphere (the condition is the normal's equal-area
 //! octahedral square point), each with the caps of `q(l | n) ∝ L(l) max(0, n.l)`
-//! measured on the mass-adaptive rule of [`EnvmapDensity::cosine_weighted`].
+//! measured on the mass-adaptive rule of
+//! [`crate::sphere::EnvmapDensity::cosine_weighted`].
 
-use super::target::{LoadedTarget, TrainTarget};
+use super::target::{EnvmapTarget, LoadedTarget, TrainTarget};
 use crate::baselines::{seeded_owen_sobol, warped_owen_sobol_directions};
 use crate::descent::local_factor;
 use crate::discrepancy::caps::epoch_caps;
@@ -23,12 +24,12 @@ use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use crate::discrepancy::GradientPath;
 use crate::seeding::derive_seed;
 use crate::sphere::geometry::map_jacobian;
-use crate::sphere::{BrdfTarget, CapMeasureTable, DirectionDensity, EnvmapDensity, TabulatedWarp};
+use crate::sphere::{BrdfTarget, CapMeasureTable, DirectionDensity, TabulatedWarp};
 use anyhow::Result;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
 use nuld_core::brdf::{view_direction, BrdfModel};
-use nuld_core::conditional::PointWarp;
+use nuld_core::conditional::{ConditionalTarget, PointWarp};
 use nuld_core::network::{instance_offset, shifted_lattice_point, Shape};
 use nuld_core::sphere::{hemisphere_to_square, sphere_to_square, square_to_sphere};
 use rayon::prelude::*;
@@ -59,8 +60,8 @@ pub enum ConditionDensity {
     Envmap {
         /// The unit normal.
         normal: DVec3,
-        /// The map, shared by the pool.
-        map: Arc<EnvmapDensity>,
+        /// The map and its tree, shared by the pool.
+        env: Arc<EnvmapTarget>,
         /// `1 / ∫ pdf_map(l) max(0, n.l) dl`, the normalizer.
         scale: f64,
     },
@@ -94,7 +95,7 @@ pub struct PoolCondition {
     /// The specular share `p_s = A_spec / A` of the albedo, the mixture warp's lobe
     /// probability (0 for a map).
     pub lobe_probability: f64,
-    /// How the network's points become directions ([`PointWarp::of_shape`]).
+    /// How the network's points become directions ([`PointWarp::of`]).
     pub warp: PointWarp,
 }
 
@@ -106,8 +107,8 @@ impl PoolCondition {
             ConditionDensity::Brdf { wo, albedo } => {
                 BrdfModel::Gltf.cosine_weighted(*wo, x, self.cond[0]) / albedo
             }
-            ConditionDensity::Envmap { normal, map, scale } => {
-                map.pdf(x) * normal.dot(x).max(0.0) * scale
+            ConditionDensity::Envmap { normal, env, scale } => {
+                env.map.pdf(x) * normal.dot(x).max(0.0) * scale
             }
         }
     }
@@ -119,15 +120,22 @@ impl PoolCondition {
     }
 
     /// The direction of the network's point `p` ([`PointWarp::direction`]) and its
-    /// derivatives along `p.x` and `p.y`: for the mixture warp by central
-    /// differences of step `1e-6`, zeroed where they straddle the lobe boundary (a
-    /// jump that no gradient can follow); for the hemisphere map exact.
+    /// derivatives along `p.x` and `p.y`: for the mixture warp and the
+    /// environment tree by central differences of step `1e-6`, zeroed where they
+    /// straddle a lobe boundary or a split of the tree (a jump that no gradient
+    /// can follow); for the equal-area maps exact.
     pub fn direction(&self, p: DVec2) -> (DVec3, DVec3, DVec3) {
+        let tree = match &self.density {
+            ConditionDensity::Envmap { env, .. } => Some(env.tree.tree()),
+            ConditionDensity::Brdf { .. } => None,
+        };
+        let tree = tree.as_ref();
         let warp = |u: DVec2| {
             DVec3::from_array(self.warp.direction(
                 self.domain,
                 self.cond,
                 self.lobe_probability,
+                tree,
                 u.to_array(),
             ))
         };
@@ -141,6 +149,7 @@ impl PoolCondition {
                 self.domain,
                 self.cond,
                 self.lobe_probability,
+                tree,
                 p.to_array(),
                 1e-6,
             )
@@ -206,13 +215,6 @@ impl ConditionPool {
         seed: u64,
     ) -> Result<Self> {
         let loaded = target.load()?;
-        if let LoadedTarget::Envmap(_) = loaded {
-            // A lattice residual is a warp of the BRDF mixture's primary space only.
-            anyhow::ensure!(
-                PointWarp::of_shape(shape) == PointWarp::EqualArea,
-                "environment samplers use the equal-area output (no mixture prior)"
-            );
-        }
         let scramble = derive_seed(seed, 0x706f_6f6c) as u32;
         let conditions = (0..count)
             .into_par_iter()
@@ -225,8 +227,8 @@ impl ConditionPool {
                 let cond = loaded.condition(u);
                 match &loaded {
                     LoadedTarget::GltfBrdf => condition(cond, caps, window, shape, seed),
-                    LoadedTarget::Envmap(map) => {
-                        envmap_condition(map, cond, caps, window, shape, seed)
+                    LoadedTarget::Envmap(env) => {
+                        envmap_condition(env, cond, caps, window, shape, seed)
                     }
                 }
             })
@@ -273,7 +275,7 @@ fn condition(
         warp_targets: warp_targets(&target, shape),
         baseline_loss: 0.0,
         lobe_probability: target.lobe_probability(),
-        warp: PointWarp::of_shape(shape),
+        warp: PointWarp::of(ConditionalTarget::GltfBrdf, shape),
     };
     Ok(pc.measured(
         caps,
@@ -327,10 +329,12 @@ impl PoolCondition {
 
 /// The pool condition of the normal whose octahedral square point is `u`: caps
 /// measured on the mass-adaptive rule of the map lit through the cosine about the
-/// normal; pretraining targets and the baseline from that density's inverse CDF
-/// (what the renderer's map sampler would do for this normal alone).
+/// normal; the baseline from that density's inverse CDF (what the renderer's map
+/// sampler would do for this normal alone); pretraining targets the shifted
+/// lattice itself for a network on the tree's primary space (a zero residual),
+/// else that inverse CDF applied to the lattice.
 fn envmap_condition(
-    map: &Arc<EnvmapDensity>,
+    env: &Arc<EnvmapTarget>,
     u: [f64; 2],
     caps: usize,
     window: usize,
@@ -338,9 +342,11 @@ fn envmap_condition(
     seed: u64,
 ) -> Result<PoolCondition> {
     let n = shape.n() as usize;
+    let map = &env.map;
     let normal = square_to_sphere(DVec2::from(u));
     // A normal that no light reaches trains on the cosine lobe (its weight is 0).
     let (lit, irradiance) = map.cosine_weighted(normal)?;
+    let residual = shape.lattice_residual();
     let table = CapMeasureTable::new(&lit.mass_rule(POOL_RULE_POINTS));
     let share = irradiance / map.integral();
     let warp_targets = (0..PRETRAIN_INSTANCES)
@@ -349,8 +355,12 @@ fn envmap_condition(
             let g = shape.lattice_generator();
             let lit = &lit;
             (0..shape.n()).map(move |i| {
-                let p = shifted_lattice_point(i, shape.n(), g, z);
-                sphere_to_square(lit.sample(DVec2::new(p[0], p[1])))
+                let p = DVec2::from(shifted_lattice_point(i, shape.n(), g, z));
+                if residual {
+                    p
+                } else {
+                    sphere_to_square(lit.sample(p))
+                }
             })
         })
         .collect();
@@ -359,7 +369,7 @@ fn envmap_condition(
         unit: u,
         density: ConditionDensity::Envmap {
             normal,
-            map: Arc::clone(map),
+            env: Arc::clone(env),
             scale: if share > 0.0 { 1.0 / share } else { 0.0 },
         },
         domain: Domain::Sphere,
@@ -368,7 +378,7 @@ fn envmap_condition(
         warp_targets,
         baseline_loss: 0.0,
         lobe_probability: 0.0,
-        warp: PointWarp::EqualArea,
+        warp: PointWarp::of(ConditionalTarget::EnvmapNormal, shape),
     };
     Ok(pc.measured(
         caps,
@@ -386,7 +396,7 @@ mod tests {
 
     /// An environment pool condition measures its caps on the lit map: its
     /// measures agree with the exact cap measure of the lit map
-    /// ([`EnvmapDensity::cap_measure`], a quadrature independent of the rule); a
+    /// ([`crate::sphere::EnvmapDensity::cap_measure`], a quadrature independent of the rule); a
     /// cap a little wider than the hemisphere about the normal holds all the mass,
     /// one a little narrower than the opposite hemisphere none (the tiny map's
     /// pixels are 11 degrees tall, and a pixel lit at its centre reaches below the
@@ -424,9 +434,10 @@ mod tests {
         let shape = Shape::new(8, &[4], Activation::Relu, 3).unwrap();
         let pool =
             ConditionPool::new(&TrainTarget::envmap(&map).unwrap(), 3, 64, 32, &shape, 5).unwrap();
-        let LoadedTarget::Envmap(density) = &pool.target else {
+        let LoadedTarget::Envmap(env) = &pool.target else {
             panic!("an envmap target")
         };
+        let density = &env.map;
         for pc in &pool.conditions {
             let ConditionDensity::Envmap { normal, .. } = pc.density else {
                 panic!("an envmap condition")

@@ -3,7 +3,8 @@
 //! use the same), and [`LoadedTarget`], the data a pool is built from.
 
 use crate::seeding::content_hash;
-use crate::sphere::EnvmapDensity;
+use crate::sphere::envmap_tree::{PRIOR_GRID, PRIOR_LEVELS};
+use crate::sphere::{EnvmapDensity, EnvmapTree};
 use anyhow::{Context, Result};
 use nuld_core::blob::Domain;
 use nuld_core::brdf::{CONDITION_MAX, CONDITION_MIN};
@@ -65,7 +66,9 @@ impl TrainTarget {
             Self::Envmap { path, .. } => {
                 let map = EnvmapDensity::from_file_filtered(path, Domain::Sphere)
                     .with_context(|| format!("environment map {}", path.display()))?;
-                Ok(LoadedTarget::Envmap(Arc::new(map)))
+                let tree = EnvmapTree::new(&map, PRIOR_LEVELS, PRIOR_GRID)
+                    .with_context(|| format!("environment map {}", path.display()))?;
+                Ok(LoadedTarget::Envmap(Arc::new(EnvmapTarget { map, tree })))
             }
         }
     }
@@ -76,9 +79,20 @@ impl TrainTarget {
 pub enum LoadedTarget {
     /// The glTF BRDF (closed form, nothing to read).
     GltfBrdf,
+    /// The map's bilinearly filtered luminance as a density on the sphere, and its
+    /// tree, the sampler's prior.
+    Envmap(Arc<EnvmapTarget>),
+}
+
+/// An environment map as a sampler is trained on it.
+#[derive(Clone, Debug)]
+pub struct EnvmapTarget {
     /// The map's bilinearly filtered luminance as a density on the sphere
     /// ([`EnvmapDensity::from_luminance_filtered`]).
-    Envmap(Arc<EnvmapDensity>),
+    pub map: EnvmapDensity,
+    /// The map's tree ([`PRIOR_LEVELS`] levels, top weights on [`PRIOR_GRID`]
+    /// normals): the prior whose primary space the network refines.
+    pub tree: EnvmapTree,
 }
 
 impl LoadedTarget {

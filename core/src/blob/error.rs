@@ -451,6 +451,27 @@ pub enum ConditionalError {
         /// Its `f32` bits.
         bits: u32,
     },
+    /// An environment sampler without the prior of the current format
+    /// ([`crate::conditional::PointWarp::EnvmapTree`] and its tree sections): a
+    /// blob baked before the prior existed.
+    EnvmapWithoutPrior,
+    /// The [`SectionTag::EnvmapTreeInfo`] section is not one
+    /// [`crate::envmap_tree::TreeInfo`] long.
+    TreeInfoSize {
+        /// Its length in bytes.
+        got: u64,
+        /// [`crate::envmap_tree::TREE_INFO_LEN`].
+        expected: u64,
+    },
+    /// The reserved words of the tree info are not zero.
+    TreeReserved,
+    /// The [`SectionTag::EnvmapTreeNodes`] elements are not 16 bytes.
+    TreeNodeElementSize(u32),
+    /// The [`SectionTag::EnvmapTreeTop`] elements are not 4 bytes (f32).
+    TreeTopElementSize(u32),
+    /// The tree's levels, counts or values are refused
+    /// ([`crate::envmap_tree::EnvmapTree::new`]).
+    Tree(crate::quadtree::QuadtreeError),
 }
 
 impl core::fmt::Display for ConditionalError {
@@ -538,6 +559,22 @@ impl core::fmt::Display for ConditionalError {
                 "blob weight {index} is {}, not finite and >= 0",
                 f32::from_bits(bits)
             ),
+            Self::EnvmapWithoutPrior => write!(
+                f,
+                "environment sampler of an earlier format (no exact prior): bake it again with `build-tool bake --envmap`"
+            ),
+            Self::TreeInfoSize { got, expected } => write!(
+                f,
+                "blob environment tree info section is {got} bytes, not {expected}"
+            ),
+            Self::TreeReserved => write!(f, "blob environment tree info's reserved words are not 0"),
+            Self::TreeNodeElementSize(e) => {
+                write!(f, "blob environment tree nodes are {e} bytes each, not 16")
+            }
+            Self::TreeTopElementSize(e) => {
+                write!(f, "blob environment tree top weights are {e} bytes each, not 4")
+            }
+            Self::Tree(e) => write!(f, "blob environment tree: {e}"),
         }
     }
 }

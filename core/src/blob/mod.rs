@@ -129,6 +129,15 @@ pub enum SectionTag {
     PointTable = 5,
     /// The weight table, `f32` per weight-grid node, axis 0 fastest (`elem_size` 4).
     WeightTable = 6,
+    /// One [`crate::envmap_tree::TreeInfo`] (16 bytes): the environment prior's
+    /// levels and top grid (samplers with [`crate::conditional::PointWarp::EnvmapTree`]).
+    EnvmapTreeInfo = 7,
+    /// The environment prior's [`crate::envmap_tree::NodeRecord`]s (`elem_size` 16),
+    /// levels `1..=L` in Morton order ([`crate::envmap_tree::node_index`]).
+    EnvmapTreeNodes = 8,
+    /// The environment prior's top-level weights, `f32` (`elem_size` 4),
+    /// `[normal][node]` ([`crate::envmap_tree::top_len`]).
+    EnvmapTreeTop = 9,
 }
 
 /// Contents of the [`SectionTag::PointSetInfo`] section.

@@ -20,6 +20,7 @@
 
 use crate::blob::{SectionSpec, SectionTag};
 use crate::domain::Domain;
+use crate::envmap_tree::EnvmapTree;
 use crate::network::{Activation, Shape, MAX_HIDDEN_LAYERS};
 use crate::real::Real;
 
@@ -46,6 +47,14 @@ pub enum PointWarp {
     /// shifted lattice, so the network only learns a smooth correction, and
     /// instances differ by construction. glTF BRDF blobs only.
     BrdfMixture = 1,
+    /// The network's point is a point of the primary sample space of the
+    /// environment prior ([`crate::envmap_tree`], the blob's tree sections): a
+    /// residual on the logit of the instance's shifted lattice point as for
+    /// [`Self::BrdfMixture`], and the direction is the tree's exact product warp of
+    /// the map's light and the cosine about the normal whose octahedral square
+    /// point is the condition. Its density at the direction is the sampler's pdf.
+    /// Environment blobs only.
+    EnvmapTree = 2,
 }
 
 impl PointWarp {
@@ -54,19 +63,27 @@ impl PointWarp {
         match code {
             0 => Some(Self::EqualArea),
             1 => Some(Self::BrdfMixture),
+            2 => Some(Self::EnvmapTree),
             _ => None,
         }
     }
 
-    /// The warp a network of `shape` is trained for: [`BrdfMixture`](Self::BrdfMixture)
-    /// for a [lattice residual](Shape::lattice_residual), else
-    /// [`EqualArea`](Self::EqualArea).
-    pub fn of_shape(shape: &Shape) -> Self {
-        if shape.lattice_residual() {
-            Self::BrdfMixture
-        } else {
-            Self::EqualArea
+    /// The warp a network of `shape` is trained for on `target`: for a [lattice
+    /// residual](Shape::lattice_residual) the target's prior
+    /// ([`BrdfMixture`](Self::BrdfMixture) or [`EnvmapTree`](Self::EnvmapTree)),
+    /// else [`EqualArea`](Self::EqualArea).
+    pub fn of(target: ConditionalTarget, shape: &Shape) -> Self {
+        match (shape.lattice_residual(), target) {
+            (false, _) => Self::EqualArea,
+            (true, ConditionalTarget::GltfBrdf) => Self::BrdfMixture,
+            (true, ConditionalTarget::EnvmapNormal) => Self::EnvmapTree,
         }
+    }
+
+    /// Whether the network's outputs are a residual on the shifted lattice's
+    /// logit ([`Shape::lattice_residual`]): every warp but the equal-area map.
+    pub fn lattice_residual(self) -> bool {
+        self != Self::EqualArea
     }
 
     /// The direction of a sampler's point `p` (the network's output, or the table's
@@ -74,12 +91,23 @@ impl PointWarp {
     /// `domain`'s equal-area map; [`BrdfMixture`](Self::BrdfMixture) warps it with
     /// [`brdf_mixture_direction`] at the condition `cond = (roughness, theta_o in
     /// degrees)` and lobe probability `p_s`. A warp ignores the arguments it does not
-    /// use. Unit vectors; never panics.
+    /// use. [`EnvmapTree`](Self::EnvmapTree) samples `tree` at the normal whose
+    /// octahedral square point is `cond` ([`EnvmapTree::sample_square`]; without a
+    /// tree, which no parsed blob lacks, the equal-area map stands in). Unit vectors; never
+    /// panics.
     #[inline]
-    pub fn direction<T: Real>(self, domain: Domain, cond: [T; 2], p_s: T, p: [T; 2]) -> [T; 3] {
-        match self {
-            Self::EqualArea => domain.to_direction_real(p),
-            Self::BrdfMixture => brdf_mixture_direction(cond, p_s, p),
+    pub fn direction<T: Real>(
+        self,
+        domain: Domain,
+        cond: [T; 2],
+        p_s: T,
+        tree: Option<&EnvmapTree<'_>>,
+        p: [T; 2],
+    ) -> [T; 3] {
+        match (self, tree) {
+            (Self::BrdfMixture, _) => brdf_mixture_direction(cond, p_s, p),
+            (Self::EnvmapTree, Some(tree)) => tree.sample_square(cond, p).0,
+            _ => domain.to_direction_real(p),
         }
     }
 
@@ -92,6 +120,7 @@ impl PointWarp {
         domain: Domain,
         cond: [T; 2],
         p_s: T,
+        tree: Option<&EnvmapTree<'_>>,
         p: [T; 2],
         h: T,
     ) -> [[T; 3]; 2] {
@@ -99,7 +128,7 @@ impl PointWarp {
             let step = |sign: T| {
                 let mut q = p;
                 q[a] = q[a] + sign * h;
-                self.direction(domain, cond, p_s, q)
+                self.direction(domain, cond, p_s, tree, q)
             };
             let (hi, lo) = (step(T::ONE), step(T::ZERO - T::ONE));
             core::array::from_fn(|c| (hi[c] - lo[c]) / (T::of(2.0) * h))
@@ -298,7 +327,7 @@ impl ConditionalInfo {
             return None;
         }
         let act = Activation::from_code(self.activation)?;
-        let residual = PointWarp::from_code(self.warp)? == PointWarp::BrdfMixture;
+        let residual = PointWarp::from_code(self.warp)?.lattice_residual();
         Shape::new(self.n, &self.hidden[..layers], act, self.lattice_generator)
             .map(|s| s.with_lattice_residual(residual))
     }
@@ -394,6 +423,38 @@ pub fn sections<'s>(
     ]
 }
 
+/// The salts of [`randomization_shift`]'s two hashes (the shaders hold them too).
+pub const RANDOMIZE_SALTS: [u32; 2] = [0x5eed_0b1a, 0x68e3_1da4];
+
+/// The unbiased mode's toroidal shift of primary points for the caller's random
+/// number `seed` (e.g. one per pixel): two 24-bit unorms hashed from it
+/// ([`crate::network::hash_u32`], salted apart from the instance offsets), in
+/// `[0, 1)`. A uniform shift makes any primary point uniform, so each sample of
+/// the shifted point is distributed as the warp's pdf (to the shift's `2^-24`
+/// resolution), whatever the table or network learned.
+#[inline]
+pub fn randomization_shift(seed: u32) -> [f32; 2] {
+    let a = crate::network::hash_u32(seed ^ RANDOMIZE_SALTS[0]);
+    let b = crate::network::hash_u32(a ^ RANDOMIZE_SALTS[1]);
+    let unit = |h: u32| (h >> 8) as f32 * (1.0 / 16_777_216.0);
+    [unit(a), unit(b)]
+}
+
+/// `p + shift` on the unit torus, per axis `x - floor(x)` in `f32`, a result
+/// rounded up to 1 read as 0: in `[0, 1)`. NaN reads as 0. Never panics.
+#[inline]
+pub fn torus_shift(p: [f32; 2], shift: [f32; 2]) -> [f32; 2] {
+    core::array::from_fn(|a| {
+        let x = p[a] + shift[a];
+        let f = x - libm::floorf(x);
+        if (0.0..1.0).contains(&f) {
+            f
+        } else {
+            0.0
+        }
+    })
+}
+
 /// Packs a square point's u16 unorm codes as one table entry: `x | y << 16`.
 #[inline]
 pub fn pack_point(qx: u16, qy: u16) -> u32 {
@@ -451,8 +512,8 @@ mod tests {
     fn direction_differences_of_the_equal_area_maps_have_their_area_scale() {
         for domain in [Domain::Sphere, Domain::Hemisphere] {
             for p in [[0.3, 0.12], [0.62, 0.41], [0.15, 0.7], [0.8, 0.9]] {
-                let [jx, jy] =
-                    PointWarp::EqualArea.direction_differences(domain, [0.0; 2], 0.0, p, 1e-6);
+                let [jx, jy] = PointWarp::EqualArea
+                    .direction_differences(domain, [0.0; 2], 0.0, None, p, 1e-6);
                 let cross = [
                     jx[1] * jy[2] - jx[2] * jy[1],
                     jx[2] * jy[0] - jx[0] * jy[2],

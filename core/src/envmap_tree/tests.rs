@@ -365,7 +365,7 @@ fn bad_trees_are_refused_and_hostile_queries_do_not_panic() {
     bad_top[5] = -1.0;
     assert_eq!(
         EnvmapTree::new(4, &nodes, GRID, &bad_top).map(|_| ()),
-        Err(QuadtreeError::BadMass(5))
+        Err(QuadtreeError::BadTopWeight(5))
     );
     let mut bad = nodes.clone();
     bad[7].spread = -1.0;

@@ -9,8 +9,10 @@
 use glam::{Vec2, Vec3};
 use nuld_core::blob::{BlobError, Domain};
 use nuld_core::conditional::{
-    unpack_point, ConditionalInfo, ConditionalTarget, GridCell, PointWarp,
+    randomization_shift, torus_shift, unpack_point, ConditionalInfo, ConditionalTarget, GridCell,
+    PointWarp,
 };
+use nuld_core::envmap_tree::EnvmapTree;
 use nuld_core::network::{input_features, F16Params, Network, Parameters, Shape};
 use nuld_core::quantize::unorm16_decode;
 
@@ -21,15 +23,29 @@ mod validate;
 
 pub use network::NetworkSampler;
 
-/// One sample: a unit direction and the estimator weight of every sample of its
+/// One sample: a unit direction, the estimator weight of every sample of its
 /// condition (for BRDF samplers the directional albedo `A`, so that
-/// `∫ L f cos ≈ (A / N) Σ L(direction_i)`).
+/// `∫ L f cos ≈ (A / N) Σ L(direction_i)`; for environment samplers the
+/// irradiance `E(n)`, so that `∫ L f cos ≈ (E / N) Σ f(direction_i)`), and the
+/// solid-angle density of the sampler's prior warp at the direction.
+///
+/// **`pdf`** (per steradian) is the density the *unbiased mode*
+/// ([`ConditionalSampler::sample_randomized`]) draws each sample from, exactly:
+/// with it `(1/N) Σ g(direction_i) / pdf_i` is an unbiased estimate of `∫ g` for
+/// any `g`, and it is what multiple importance sampling weighs with
+/// ([`ConditionalSampler::pdf`] answers it for any direction). Environment samplers
+/// ([`nuld_core::conditional::PointWarp::EnvmapTree`]) return the exact pdf of their
+/// prior, the map's light times the cosine; a BRDF sampler's prior pdf is not
+/// served yet, and it returns 0 there: use its `weight`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sample {
     /// A unit vector (`z >= 0` on the hemisphere), in the local frame (`z` = normal).
     pub direction: Vec3,
     /// The estimator weight, finite and `>= 0`.
     pub weight: f32,
+    /// The prior's solid-angle density at `direction`, finite and `>= 0` (0 for
+    /// a sampler without an exact prior).
+    pub pdf: f32,
 }
 
 /// A conditional sampler in **table mode** ([`Self::sample`]: stored square points
@@ -55,6 +71,8 @@ pub struct ConditionalSampler<'a> {
     params: NetworkParams<'a>,
     table: &'a [u32],
     weights: &'a [f32],
+    /// The environment prior ([`PointWarp::EnvmapTree`] samplers).
+    tree: Option<EnvmapTree<'a>>,
 }
 
 /// Where network mode reads its parameters: the blob's f16 bits (zero-copy), or
@@ -296,52 +314,78 @@ impl<'a> ConditionalSampler<'a> {
     /// assert_eq!(cs.sample(Vec2::new(f32::NAN, -5.0), 0, 0), cs.sample(cs.info().cond_min.into(), 0, 0));
     /// # Ok::<(), nuld_runtime::BlobError>(())
     /// ```
-    ///
-    /// An environment sampler ([`ConditionalTarget::EnvmapNormal`]) interpolates
-    /// directions instead: each corner's stored point through the map, the four
-    /// unit vectors blended by [`GridCell::nlerp`] with the cell's bilinear weights
-    /// ([`crate::EnvmapSampler::sample`] takes a normal).
     #[inline]
     pub fn sample(&self, cond: Vec2, instance: u32, i: u32) -> Sample {
         let u = self.info.normalize(cond.to_array());
-        if self.target == ConditionalTarget::EnvmapNormal {
-            return Sample {
-                direction: Vec3::from_array(self.table_direction_at(u, instance, i)),
-                weight: self.weight_table_lerp(&self.weight_cell_at(u), 0),
-            };
-        }
         self.mapped(self.square_point_at(u, instance, i), u)
     }
 
-    /// Table mode's direction for an environment sampler: the four corners'
-    /// stored square points decoded by `(q + 0.5) / 65536`, each through the
-    /// domain's equal-area map in `f32`, then [`GridCell::nlerp`].
+    /// The **unbiased mode** of table mode: [`Self::sample`]'s point shifted on the
+    /// unit torus by [`randomization_shift`]`(seed)` before the warp
+    /// ([`torus_shift`]), so that for a random `seed` (one per pixel) every sample
+    /// is distributed exactly as its [`Sample::pdf`], whatever the table learned;
+    /// the shift keeps the set's structure (a lattice's quality survives any
+    /// shift; an optimized set's partly). O(1), never panics.
     #[inline]
-    fn table_direction_at(&self, u: [f32; 2], instance: u32, i: u32) -> [f32; 3] {
-        let (cell, corner) = self.table_corners(u, instance, i);
-        let d = |dx, dy| self.domain.to_direction_real(corner(dx, dy));
-        cell.nlerp(d(0, 0), d(1, 0), d(0, 1), d(1, 1))
+    pub fn sample_randomized(&self, cond: Vec2, instance: u32, i: u32, seed: u32) -> Sample {
+        let u = self.info.normalize(cond.to_array());
+        let p = torus_shift(
+            self.square_point_at(u, instance, i).to_array(),
+            randomization_shift(seed),
+        );
+        self.mapped(Vec2::from_array(p), u)
+    }
+
+    /// The solid-angle density at the unit `direction` of the sampler's prior at
+    /// `cond` (blob units): what [`Sample::pdf`] returns for a sample there, for
+    /// any direction (multiple importance sampling). For environment samplers the
+    /// tree's exact pdf ([`EnvmapTree::pdf_square`]) at the normal whose
+    /// octahedral square point is the clamped condition; 0 for samplers without an
+    /// exact prior. O(tree levels), never
+    /// panics.
+    #[inline]
+    pub fn pdf(&self, cond: Vec2, direction: Vec3) -> f32 {
+        let u = self.info.normalize(cond.to_array());
+        match (self.warp, &self.tree) {
+            (PointWarp::EnvmapTree, Some(tree)) => {
+                tree.pdf_square(self.info.denormalize(u), direction.to_array())
+            }
+            _ => 0.0,
+        }
     }
 
     /// The sample of point `p` at the normalized condition `u`: the direction of
-    /// [`PointWarp::direction`], the weight of [`Self::weight`]; one weight-grid
-    /// cell serves the weight and the lobe probability.
+    /// [`PointWarp::direction`] (with the prior's pdf for the tree), the weight of
+    /// [`Self::weight`]; one weight-grid cell serves the weight and the lobe
+    /// probability.
     #[inline]
     pub(crate) fn mapped(&self, p: Vec2, u: [f32; 2]) -> Sample {
         let cell = self.weight_cell_at(u);
+        if let (PointWarp::EnvmapTree, Some(tree)) = (self.warp, &self.tree) {
+            // The clamped condition is the normal's octahedral square point.
+            let (direction, pdf) = tree.sample_square(self.info.denormalize(u), p.to_array());
+            return Sample {
+                direction: Vec3::from_array(direction),
+                weight: self.weight_table_lerp(&cell, 0),
+                pdf,
+            };
+        }
         // Only the mixture warp reads the condition and `p_s`; the equal-area map
         // skips their lookups.
         let (cond, p_s) = match self.warp {
-            PointWarp::EqualArea => ([0.0; 2], 0.0),
             PointWarp::BrdfMixture => {
                 // The clamped condition in blob units, as the tables see it.
                 (self.info.denormalize(u), self.weight_table_lerp(&cell, 1))
             }
+            _ => ([0.0; 2], 0.0),
         };
-        let direction = self.warp.direction(self.domain, cond, p_s, p.to_array());
+        let direction = self
+            .warp
+            .direction(self.domain, cond, p_s, None, p.to_array());
         Sample {
             direction: Vec3::from_array(direction),
             weight: self.weight_table_lerp(&cell, 0),
+            pdf: 0.0,
         }
     }
 }

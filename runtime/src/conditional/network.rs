@@ -68,4 +68,24 @@ impl<'a> NetworkSampler<'a> {
         self.0
             .mapped(self.0.network_square_point_at(u, instance, i), u)
     }
+
+    /// The unbiased mode in network mode: as
+    /// [`ConditionalSampler::sample_randomized`], the network's point shifted on the
+    /// torus by `randomization_shift(seed)` before the warp.
+    #[inline]
+    pub fn sample_randomized(&self, cond: Vec2, instance: u32, i: u32, seed: u32) -> Sample {
+        let u = self.0.info().normalize(cond.to_array());
+        let p = nuld_core::conditional::torus_shift(
+            self.0.network_square_point_at(u, instance, i).to_array(),
+            nuld_core::conditional::randomization_shift(seed),
+        );
+        self.0.mapped(Vec2::from_array(p), u)
+    }
+
+    /// The prior's pdf at `direction` ([`ConditionalSampler::pdf`]; the same
+    /// prior serves both modes).
+    #[inline]
+    pub fn pdf(&self, cond: Vec2, direction: glam::Vec3) -> f32 {
+        self.0.pdf(cond, direction)
+    }
 }

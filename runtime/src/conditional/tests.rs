@@ -2,10 +2,15 @@ extern crate std;
 use super::*;
 use crate::Blob;
 use crate::{BrdfNetwork, BrdfSampler, EnvmapNetwork, EnvmapSampler};
+use bytemuck::Zeroable;
 use nuld_core::blob::{encoded_len, write, BlobKind};
-use nuld_core::blob::{BlobError, ConditionalError};
-use nuld_core::conditional::sections;
+use nuld_core::blob::{BlobError, ConditionalError, SectionTag};
+use nuld_core::conditional::{randomization_shift, sections, torus_shift};
+use nuld_core::envmap_tree::{
+    build, node_count, top_len, top_normal, top_row, EnvmapTree, NodeRecord, TreeInfo,
+};
 use nuld_core::network::Activation;
+use nuld_core::quadtree::QuadtreeError;
 use nuld_core::quantize::{f16_decode_finite, f16_encode};
 use std::vec::Vec;
 
@@ -16,7 +21,12 @@ struct Parts {
     params: Vec<u16>,
     table: Vec<u32>,
     weights: Vec<f32>,
+    /// An environment prior.
+    tree: Option<TreeParts>,
 }
+
+/// An environment prior's sections, owned: info, records, top weights.
+type TreeParts = (TreeInfo, Vec<NodeRecord>, Vec<f32>);
 
 /// A 16-byte aligned blob.
 struct Bytes(Vec<u128>, usize);
@@ -71,6 +81,7 @@ fn parts() -> Parts {
         params,
         table,
         weights,
+        tree: None,
     }
 }
 
@@ -79,7 +90,10 @@ fn bilinear_weight(x: f32, y: f32) -> f32 {
 }
 
 fn encode(p: &Parts) -> Bytes {
-    let sections = sections(&p.info, &p.params, &p.table, &p.weights);
+    let mut sections = sections(&p.info, &p.params, &p.table, &p.weights).to_vec();
+    if let Some((info, nodes, top)) = &p.tree {
+        sections.extend(nuld_core::envmap_tree::sections(info, nodes, top));
+    }
     let meta = [0u8, 0, 0];
     let len = encoded_len(&meta, &sections);
     let mut buf = std::vec![0u128; len.div_ceil(16)];
@@ -171,86 +185,250 @@ fn corners_reproduce_the_stored_points_exactly() {
     }
 }
 
+/// A tree of 4 levels over a light brighter towards `+x` and `+z`, top weights
+/// on 3 x 3 normals.
+fn test_tree() -> TreeParts {
+    let levels = 4;
+    let side = 1usize << levels;
+    let leaves: Vec<[f64; 4]> = (0..side * side)
+        .map(|k| {
+            let p = [
+                ((k % side) as f64 + 0.5) / side as f64,
+                ((k / side) as f64 + 0.5) / side as f64,
+            ];
+            let d = nuld_core::sphere::square_to_sphere_real(p);
+            let light = 0.1 + d[0].max(0.0) + 3.0 * d[2].max(0.0).powi(4);
+            [light, light * d[0], light * d[1], light * d[2]]
+        })
+        .collect();
+    let mut nodes = std::vec![NodeRecord::zeroed(); node_count(levels)];
+    build(levels, &leaves, &mut nodes).unwrap();
+    let grid = 3;
+    let mut top = std::vec![0.0; top_len(grid)];
+    for (r, row) in top.chunks_mut(84).enumerate() {
+        top_row(
+            levels,
+            &nodes,
+            top_normal(grid, [r as u32 % grid, r as u32 / grid]),
+            row,
+        );
+    }
+    let info = TreeInfo {
+        levels,
+        grid,
+        reserved: [0; 2],
+    };
+    (info, nodes, top)
+}
+
 /// An environment sampler's parts: `parts()` on the sphere, conditions the
-/// octahedral square.
+/// octahedral square, the tree prior.
 fn envmap_parts() -> Parts {
     let mut p = parts();
     p.info.domain = Domain::Sphere as u32;
     p.info.target = ConditionalTarget::EnvmapNormal as u32;
     p.info.cond_min = [0.0; 2];
     p.info.cond_max = [1.0; 2];
+    p.info.warp = PointWarp::EnvmapTree as u32;
+    p.tree = Some(test_tree());
     p
 }
 
-/// Table mode of an environment sampler: at a node the stored point's
-/// direction (nlerp of one corner), between nodes the normalized bilinear
-/// blend of the corners' directions (not of their square points), and
-/// `EnvmapSampler::sample` reads a normal as its octahedral square point.
+/// Table mode of an environment sampler: the corners' stored primary points
+/// interpolated bilinearly in the square (at a node the stored point), then the
+/// tree's warp at the normal of the condition, whose pdf the sample carries;
+/// `pdf` answers the same for the direction; the unbiased mode warps the point
+/// shifted on the torus; `EnvmapSampler` reads a normal as its octahedral square
+/// point.
 #[test]
-fn envmap_tables_interpolate_directions() {
+fn envmap_tables_interpolate_primary_points_and_warp_them_through_the_tree() {
     let p = envmap_parts();
     let bytes = encode(&p);
     let cs = Blob::parse(bytes.get()).unwrap().conditional().unwrap();
     assert_eq!(cs.target(), ConditionalTarget::EnvmapNormal);
+    let (ti, nodes, top) = p.tree.clone().unwrap();
+    let tree = EnvmapTree::new(ti.levels, &nodes, ti.grid, &top).unwrap();
     let info = p.info;
     let stored = |node: u32, k: u32, i: u32| {
         let q = unpack_point(p.table[info.point_table_index(node as usize, k, i)]);
-        Domain::Sphere.to_direction_real([unorm16_decode(q[0]), unorm16_decode(q[1])])
+        [unorm16_decode(q[0]), unorm16_decode(q[1])]
     };
     for j1 in 0..info.grid[1] {
         for j0 in 0..info.grid[0] {
             let c = info.grid_condition([j0, j1]).map(|x| x as f32);
             let node = j1 * info.grid[0] + j0;
-            let got = cs.sample(Vec2::from(c), 2, 4).direction.to_array();
-            let want = stored(node, 2, 4);
-            for a in 0..3 {
-                assert!(
-                    (got[a] - want[a]).abs() < 1e-6,
-                    "{j0} {j1}: {got:?} {want:?}"
-                );
-            }
+            let (want, pdf) = tree.sample_square(c, stored(node, 2, 4));
+            let got = cs.sample(Vec2::from(c), 2, 4);
+            assert_eq!(got.direction.to_array(), want, "{j0} {j1}");
+            assert_eq!(got.pdf, pdf);
+            assert!(pdf > 0.0);
+            assert_eq!(
+                cs.pdf(Vec2::from(c), got.direction),
+                tree.pdf_square(c, want)
+            );
+            // The normal's own square point lights the tree as the normal does.
+            let normal = nuld_core::sphere::square_to_sphere_real(c);
+            let by_normal = tree.pdf(normal, want);
+            assert!(
+                (by_normal - pdf).abs() <= 1e-3 * pdf,
+                "{by_normal} vs {pdf}"
+            );
         }
     }
-    // Between nodes (0,0), (1,0), (0,1), (1,1) of the 5 x 3 grid.
+    // Between nodes (0,0), (1,0), (0,1), (1,1) of the 5 x 3 grid: the square
+    // points blend, not the directions.
     let u = [0.1f32, 0.3];
-    let (t0, t1) = (u[0] * 4.0, u[1] * 2.0);
+    let cell = GridCell::locate(u, info.grid);
     let corners = [
         stored(0, 1, 3),
         stored(1, 1, 3),
         stored(5, 1, 3),
         stored(6, 1, 3),
     ];
-    let want: [f32; 3] = core::array::from_fn(|a| {
-        let lo = corners[0][a] + (corners[1][a] - corners[0][a]) * t0;
-        let hi = corners[2][a] + (corners[3][a] - corners[2][a]) * t0;
-        lo + (hi - lo) * t1
+    let point: [f32; 2] = core::array::from_fn(|a| {
+        cell.lerp(corners[0][a], corners[1][a], corners[2][a], corners[3][a])
     });
-    let len = want.iter().map(|x| x * x).sum::<f32>().sqrt();
     let got = cs.sample(Vec2::from(u), 1, 3);
-    let want = Vec3::from_array(want) / len;
-    assert!((got.direction - want).length() < 1e-6, "{got:?} {want}");
+    let (want, pdf) = tree.sample_square(u, point);
+    assert_eq!((got.direction.to_array(), got.pdf), (want, pdf));
     assert!((got.direction.length() - 1.0).abs() < 1e-6);
     assert_eq!(got.weight, cs.weight(Vec2::from(u)));
+    // The unbiased mode: the same point shifted on the torus, then warped.
+    let shifted = torus_shift(point, randomization_shift(77));
+    let r = cs.sample_randomized(Vec2::from(u), 1, 3, 77);
+    assert_eq!(
+        (r.direction.to_array(), r.pdf),
+        tree.sample_square(u, shifted)
+    );
+    assert_ne!(r.direction, got.direction);
+    let net = cs.network().sample_randomized(Vec2::from(u), 1, 3, 77);
+    assert!((cs.pdf(Vec2::from(u), net.direction) - net.pdf).abs() <= 1e-5 * net.pdf);
     // A normal is read through the octahedral map, at any length; degenerate
     // normals read as +z.
     let n = Vec3::new(0.2, -0.7, 0.4);
     let c = nuld_core::sphere::sphere_to_square_real(n.normalize().to_array());
+    let env = EnvmapSampler(cs);
+    assert_eq!(env.sample(n * 3.0, 7, 2), cs.sample(Vec2::from(c), 7, 2));
     assert_eq!(
-        EnvmapSampler(cs).sample(n * 3.0, 7, 2),
-        cs.sample(Vec2::from(c), 7, 2)
+        env.sample_randomized(n, 7, 2, 5),
+        cs.sample_randomized(Vec2::from(c), 7, 2, 5)
     );
+    let d = env.sample(n, 7, 2).direction;
+    assert_eq!(env.pdf(n, d), cs.pdf(Vec2::from(c), d));
     assert_eq!(
-        EnvmapSampler(cs).network().sample(n, 9, 1),
+        env.network().sample(n, 9, 1),
         cs.network().sample(Vec2::from(c), 9, 1)
     );
+    assert_eq!(env.network().pdf(n, d), env.pdf(n, d));
     for bad in [Vec3::ZERO, Vec3::NAN, Vec3::new(f32::INFINITY, 0.0, 1.0)] {
-        assert_eq!(
-            EnvmapSampler(cs).sample(bad, 0, 0),
-            EnvmapSampler(cs).sample(Vec3::Z, 0, 0)
-        );
+        assert_eq!(env.sample(bad, 0, 0), env.sample(Vec3::Z, 0, 0));
+        assert!(env.pdf(bad, Vec3::NAN) >= 0.0);
     }
     let d = cs.network().sample(Vec2::new(0.7, 0.2), 5, 4).direction;
     assert!((d.length() - 1.0).abs() < 1e-5);
+}
+
+/// Over many seeds of the unbiased mode at one normal, the mean of `g / pdf` is
+/// `∫ g` (here `g = 1` on the sphere's lit part, whose integral the tree's own pdf
+/// and an independent midpoint quadrature give), whatever the table holds.
+#[test]
+fn the_unbiased_mode_estimates_integrals_without_bias() {
+    let p = envmap_parts();
+    let bytes = encode(&p);
+    let env = Blob::parse(bytes.get()).unwrap().envmap().unwrap();
+    let n = Vec3::new(0.3, 0.5, 0.8).normalize();
+    // g(l) = max(0, n.l)^2: ∫ g over the sphere = 2 pi / 3.
+    let g = |d: Vec3| n.dot(d).max(0.0).powi(2);
+    let exact = 2.0 * core::f64::consts::PI / 3.0;
+    let (mut sum, mut sq, mut count) = (0.0f64, 0.0f64, 0u32);
+    for seed in 0..20_000u32 {
+        for i in 0..env.len() {
+            let s = env.sample_randomized(n, 1, i, seed);
+            let v = if s.pdf > 0.0 {
+                (g(s.direction) / s.pdf) as f64
+            } else {
+                0.0
+            };
+            sum += v;
+            sq += v * v;
+            count += 1;
+        }
+    }
+    let mean = sum / count as f64;
+    let se = ((sq / count as f64 - mean * mean) / count as f64).sqrt();
+    assert!(
+        (mean - exact).abs() < 4.0 * se + 1e-4,
+        "{mean} vs {exact} (se {se})"
+    );
+}
+
+/// An environment blob of the earlier format (the equal-area output, no tree) is
+/// refused with the error that says to bake it again; tree sections that disagree
+/// with their info are refused by their own errors.
+#[test]
+fn environment_blobs_without_a_sound_prior_are_refused() {
+    let parse = |p: &Parts| Blob::parse(encode(p).get()).map(|_| ());
+    let mut old = envmap_parts();
+    old.info.warp = PointWarp::EqualArea as u32;
+    old.tree = None;
+    let err = parse(&old).unwrap_err();
+    assert_eq!(
+        err,
+        BlobError::Conditional(ConditionalError::EnvmapWithoutPrior)
+    );
+    assert!(std::format!("{err}").contains("bake it again with `build-tool bake --envmap`"));
+    let mut missing = envmap_parts();
+    missing.tree = None;
+    assert_eq!(
+        parse(&missing),
+        Err(BlobError::MissingSection(SectionTag::EnvmapTreeInfo))
+    );
+    let mut brdf_tree = parts();
+    brdf_tree.info.warp = PointWarp::EnvmapTree as u32;
+    assert_eq!(
+        parse(&brdf_tree),
+        Err(BlobError::Conditional(ConditionalError::UnknownPointWarp(
+            2
+        )))
+    );
+    let tree_err = |e| Err(BlobError::Conditional(e));
+    type Mutation = fn(&mut TreeParts);
+    let cases: [(Mutation, ConditionalError); 6] = [
+        (
+            |t| t.0.levels = 2,
+            ConditionalError::Tree(QuadtreeError::Levels(2)),
+        ),
+        (|t| t.0.reserved[1] = 1, ConditionalError::TreeReserved),
+        (
+            |t| t.0.grid = 4,
+            ConditionalError::Tree(QuadtreeError::Length {
+                expected: 16 * 84,
+                got: 9 * 84,
+            }),
+        ),
+        (
+            |t| {
+                t.1.pop();
+            },
+            ConditionalError::Tree(QuadtreeError::Length {
+                expected: 340,
+                got: 339,
+            }),
+        ),
+        (
+            |t| t.1[17].spread = -1.0,
+            ConditionalError::Tree(QuadtreeError::BadMass(17)),
+        ),
+        (
+            |t| t.2[30] = f32::NAN,
+            ConditionalError::Tree(QuadtreeError::BadTopWeight(30)),
+        ),
+    ];
+    for (change, want) in cases {
+        let mut p = envmap_parts();
+        change(p.tree.as_mut().unwrap());
+        assert_eq!(parse(&p), tree_err(want));
+    }
 }
 
 #[test]

@@ -5,7 +5,11 @@ use super::{ConditionalSampler, NetworkParams};
 use crate::section::{record, typed_section};
 use nuld_core::blob::{BlobError, ConditionalError, Domain, Layout, SectionTag};
 use nuld_core::conditional::{ConditionalInfo, ConditionalTarget, PointWarp};
+use nuld_core::envmap_tree::{
+    node_count, top_len, EnvmapTree, NodeRecord, TreeInfo, MAX_TREE_LEVELS, TOP_LEVELS,
+};
 use nuld_core::network::Activation;
+use nuld_core::quadtree::QuadtreeError;
 use nuld_core::quantize::f16_is_finite;
 
 impl<'a> ConditionalSampler<'a> {
@@ -51,6 +55,12 @@ impl<'a> ConditionalSampler<'a> {
                 if !(target == ConditionalTarget::GltfBrdf && domain == Domain::Hemisphere) =>
             {
                 return fail(ConditionalError::UnknownPointWarp(info.warp))
+            }
+            Some(PointWarp::EnvmapTree) if target != ConditionalTarget::EnvmapNormal => {
+                return fail(ConditionalError::UnknownPointWarp(info.warp))
+            }
+            Some(w) if target == ConditionalTarget::EnvmapNormal && w != PointWarp::EnvmapTree => {
+                return fail(ConditionalError::EnvmapWithoutPrior)
             }
             Some(w) => w,
             None => return fail(ConditionalError::UnknownPointWarp(info.warp)),
@@ -125,6 +135,10 @@ impl<'a> ConditionalSampler<'a> {
             || Ok(info.weight_table_len().saturating_mul(info.weight_tables())),
             |expected, got| ConditionalError::WeightTableLength { expected, got },
         )?;
+        let tree = match warp {
+            PointWarp::EnvmapTree => Some(tree_view(layout)?),
+            _ => None,
+        };
         Ok(Self {
             info,
             shape,
@@ -134,6 +148,7 @@ impl<'a> ConditionalSampler<'a> {
             params: NetworkParams::F16(params),
             table,
             weights,
+            tree,
         })
     }
 
@@ -157,8 +172,53 @@ impl<'a> ConditionalSampler<'a> {
             let (index, bits) = (index as u64, w.to_bits());
             return fail(ConditionalError::BadWeight { index, bits });
         }
+        if let Some(tree) = &self.tree {
+            tree.check_values().map_err(ConditionalError::Tree)?;
+        }
         Ok(())
     }
+}
+
+/// A tree section of the wrong length.
+fn tree_length(expected: u64, got: u64) -> ConditionalError {
+    ConditionalError::Tree(QuadtreeError::Length { expected, got })
+}
+
+/// The environment prior's three sections, their counts checked against the
+/// info (`O(1)`; [`EnvmapTree::check_values`] reads every value once, in
+/// [`ConditionalSampler::validate`]).
+fn tree_view<'a>(layout: &Layout<'a>) -> Result<EnvmapTree<'a>, BlobError> {
+    let info: TreeInfo = record(layout, SectionTag::EnvmapTreeInfo, |got, expected| {
+        ConditionalError::TreeInfoSize { got, expected }
+    })?;
+    if info.reserved != [0; 2] {
+        return fail(ConditionalError::TreeReserved);
+    }
+    if !(TOP_LEVELS..=MAX_TREE_LEVELS).contains(&info.levels) {
+        return fail(ConditionalError::Tree(QuadtreeError::Levels(info.levels)));
+    }
+    if !(2..=1024).contains(&info.grid) {
+        return fail(ConditionalError::Tree(QuadtreeError::Length {
+            expected: top_len(info.grid.clamp(2, 1024)) as u64,
+            got: 0,
+        }));
+    }
+    let nodes: &[NodeRecord] = typed_section(
+        layout,
+        SectionTag::EnvmapTreeNodes,
+        ConditionalError::TreeNodeElementSize,
+        || Ok(node_count(info.levels) as u64),
+        tree_length,
+    )?;
+    let top: &[f32] = typed_section(
+        layout,
+        SectionTag::EnvmapTreeTop,
+        ConditionalError::TreeTopElementSize,
+        || Ok(top_len(info.grid) as u64),
+        tree_length,
+    )?;
+    EnvmapTree::view(info.levels, nodes, info.grid, top)
+        .map_err(|e| ConditionalError::Tree(e).into())
 }
 
 /// `Err(e)` as a [`BlobError`].

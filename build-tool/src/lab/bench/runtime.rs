@@ -25,7 +25,8 @@ use std::hint::black_box;
 use std::time::Instant;
 
 /// The network shape of [`random_parts`]: `n` points, the given hidden widths (1
-/// to 3) and activation, a residual for [`PointWarp::BrdfMixture`], and
+/// to 3) and activation, a lattice residual for every warp but the equal-area
+/// map ([`PointWarp::lattice_residual`]), and
 /// `instance_slots` instance slots ([`Shape::with_instance_slots`]). Fails if the
 /// counts describe no valid network.
 pub fn random_shape(
@@ -45,7 +46,7 @@ pub fn random_shape(
     let lattice_generator = (n / 3) | 1;
     Shape::new(n, hidden, activation, lattice_generator)
         .ok_or_else(|| anyhow!("n {n}, hidden {hidden:?}: no valid network"))?
-        .with_lattice_residual(warp == PointWarp::BrdfMixture)
+        .with_lattice_residual(warp.lattice_residual())
         .with_instance_slots(instance_slots)
         .ok_or_else(|| anyhow!("{instance_slots} instance slots overflow the embedding"))
 }
@@ -87,6 +88,7 @@ pub fn random_parts(
         params,
         table,
         weights,
+        prior: None,
     })
 }
 
