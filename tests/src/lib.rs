@@ -109,22 +109,11 @@ pub fn fixture_tree() -> std::sync::Arc<nuld_build_tool::sphere::EnvmapTree> {
     std::sync::Arc::clone(tree)
 }
 
-/// `parts` as an environment sampler on its prior: the sphere, conditions the
-/// octahedral square, the tree warp ([`fixture_tree`]); the shape's output a
+/// `parts` as an environment sampler on its prior, [`fixture_tree`]
+/// ([`nuld_build_tool::lab::bench::runtime::envmap_parts`]); the shape's output a
 /// lattice residual (as [`shape`] makes for a non-equal-area warp).
 pub fn as_envmap(
-    mut parts: nuld_build_tool::conditional::blob::ConditionalParts,
+    parts: nuld_build_tool::conditional::blob::ConditionalParts,
 ) -> nuld_build_tool::conditional::blob::ConditionalParts {
-    use nuld_core::conditional::{ConditionalTarget, PointWarp};
-    parts.info.domain = Domain::Sphere as u32;
-    parts.info.target = ConditionalTarget::EnvmapNormal as u32;
-    parts.info.cond_min = [0.0; 2];
-    parts.info.cond_max = [1.0; 2];
-    parts.info.warp = PointWarp::EnvmapTree as u32;
-    // The mixture's lobe probabilities are a BRDF table: one weight table here.
-    parts
-        .weights
-        .truncate(parts.info.weight_table_len() as usize);
-    parts.prior = Some(fixture_tree());
-    parts
+    nuld_build_tool::lab::bench::runtime::envmap_parts(parts, fixture_tree())
 }

@@ -1,16 +1,25 @@
-//! The environment sampler's prior per sample (`build-tool bench --only
-//! envmap-prior`): [`nuld_core::envmap_tree`]'s exact product warp of a map's
-//! light and a normal's cosine, in `f32` as the runtime calls it, against the
-//! incumbent a renderer ships, Owen-scrambled Sobol (`sobol_burley`) through the
-//! map's luminance inverse CDF ([`EnvmapDensity`]'s warp, which ignores the
-//! cosine).
+//! The environment sampler per sample (`build-tool bench --only envmap-prior`):
+//! [`nuld_core::envmap_tree`]'s exact product warp of a map's light and a
+//! normal's cosine, in `f32` as the runtime calls it, and the runtime's
+//! [`nuld_runtime::EnvmapSampler`] on it (table, unbiased and network modes; the
+//! default bake's network, random contents: speed does not depend on them),
+//! against the incumbent a renderer ships, Owen-scrambled Sobol (`sobol_burley`)
+//! through the map's luminance inverse CDF ([`EnvmapDensity`]'s warp, which
+//! ignores the cosine).
 
+use super::runtime::{envmap_parts, random_parts, random_shape};
 use crate::sphere::{DirectionDensity, EnvmapDensity, EnvmapTree};
-use anyhow::Result;
+use anyhow::{anyhow, Result};
 use glam::{DVec2, DVec3};
+use nuld_core::blob::Metadata;
+use nuld_core::conditional::PointWarp;
 use nuld_core::network::hash_u32;
+use nuld_core::network::Activation;
+use nuld_runtime::glam::Vec3;
+use nuld_runtime::Blob;
 use rand::{Rng, SeedableRng};
 use std::hint::black_box;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Normals cycled through: a renderer's shading points each have their own.
@@ -93,6 +102,63 @@ pub fn measure(map: &EnvmapDensity, samples: u32) -> Result<Vec<(String, f64)>> 
         ns_per_sample(samples / 4, |s| {
             let [x, y] = u(s);
             black_box(core.sample(normals[at(s)].to_array(), [x as f64, y as f64]));
+        }),
+    ));
+    // The default bake's sampler: [32, 32] ReLU, 64 slots, 64 instances on 13 x
+    // 13 normals.
+    let defaults = crate::conditional::bake::BakeConfig::default();
+    let shape = random_shape(
+        N,
+        &defaults.train.hidden,
+        Activation::Relu,
+        PointWarp::EnvmapTree,
+        crate::conditional::bake::ENVMAP_INSTANCE_SLOTS,
+    )?;
+    let parts = random_parts(shape, 64, crate::conditional::bake::ENVMAP_GRID, 3)?;
+    let blob = envmap_parts(parts, Arc::new(tree.clone())).to_blob(&Metadata {
+        generator: "bench",
+        target: "envmap",
+        seed: 0,
+    })?;
+    let env = Blob::parse(blob.as_slice())
+        .map_err(|e| anyhow!("{e}"))?
+        .envmap()
+        .map_err(|e| anyhow!("{e}"))?;
+    let normals32: Vec<Vec3> = normals32.iter().map(|&n| Vec3::from(n)).collect();
+    rows.push((
+        "EnvmapSampler::sample (table mode)".to_string(),
+        ns_per_sample(samples, |s| {
+            black_box(env.sample(normals32[at(s)], s / N, s % N));
+        }),
+    ));
+    rows.push((
+        "EnvmapSampler::sample_randomized (unbiased mode)".to_string(),
+        ns_per_sample(samples, |s| {
+            black_box(env.sample_randomized(normals32[at(s)], s / N, s % N, s));
+        }),
+    ));
+    rows.push((
+        "EnvmapSampler::pdf of a direction".to_string(),
+        ns_per_sample(samples, |s| {
+            let [x, y] = u(s);
+            let d = Vec3::from(nuld_core::sphere::square_to_sphere_real([x, y]));
+            black_box(env.pdf(normals32[at(s)], d));
+        }),
+    ));
+    rows.push((
+        "network: zero-copy, EnvmapNetwork::sample".to_string(),
+        ns_per_sample(samples / 10, |s| {
+            black_box(env.network().sample(normals32[at(s)], s / N, s % N));
+        }),
+    ));
+    let mut buf = vec![0.0f32; env.decoded_network_len()];
+    let decoded = env
+        .decode_network(&mut buf)
+        .ok_or_else(|| anyhow!("decode_network refused a buffer of its own length"))?;
+    rows.push((
+        "network: decoded, EnvmapNetwork::sample".to_string(),
+        ns_per_sample(samples / 10, |s| {
+            black_box(decoded.sample(normals32[at(s)], s / N, s % N));
         }),
     ));
     Ok(rows)

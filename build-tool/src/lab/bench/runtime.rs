@@ -10,7 +10,7 @@
 use crate::conditional::blob::ConditionalParts;
 use crate::conditional::distill::info;
 use crate::pointset::AlignedBytes;
-use crate::sphere::{BrdfTarget, DirectionDensity};
+use crate::sphere::{BrdfTarget, DirectionDensity, EnvmapTree};
 use crate::train::target::LoadedTarget;
 use anyhow::{anyhow, ensure, Result};
 use glam::{DVec2, DVec3};
@@ -22,6 +22,7 @@ use nuld_runtime::glam::{Vec2, Vec3};
 use nuld_runtime::Blob;
 use rand::{Rng, SeedableRng};
 use std::hint::black_box;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// The network shape of [`random_parts`]: `n` points, the given hidden widths (1
@@ -90,6 +91,24 @@ pub fn random_parts(
         weights,
         prior: None,
     })
+}
+/// `parts` (of a lattice-residual network) as an environment sampler on the
+/// prior `tree`: the sphere, conditions the normal's octahedral square `[0,1]^2`,
+/// [`PointWarp::EnvmapTree`], one weight table (the mixture's lobe probabilities
+/// dropped) and the tree's sections.
+pub fn envmap_parts(mut parts: ConditionalParts, tree: Arc<EnvmapTree>) -> ConditionalParts {
+    use nuld_core::blob::Domain;
+    use nuld_core::conditional::ConditionalTarget;
+    parts.info.domain = Domain::Sphere as u32;
+    parts.info.target = ConditionalTarget::EnvmapNormal as u32;
+    parts.info.cond_min = [0.0; 2];
+    parts.info.cond_max = [1.0; 2];
+    parts.info.warp = PointWarp::EnvmapTree as u32;
+    parts
+        .weights
+        .truncate(parts.info.weight_table_len() as usize);
+    parts.prior = Some(tree);
+    parts
 }
 
 fn sampler(b: &AlignedBytes) -> Result<nuld_runtime::BrdfSampler<'_>> {
