@@ -162,7 +162,7 @@ impl EnvmapTree {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sphere::envmap::test_support::assert_unbiased_irradiance;
+    use crate::sphere::envmap::test_support::{assert_unbiased_irradiance, sphere_integral};
     use crate::sphere::envmap::tiny_map;
     use nuld_core::blob::Domain;
 
@@ -222,20 +222,7 @@ mod tests {
             }
             light(d) * nuld_core::brdf::BrdfModel::Gltf.cosine_weighted(wo, local(d), 0.3)
         };
-        let exact = |g: &(dyn Fn(DVec3) -> f64 + Sync)| {
-            let m = 2048;
-            let sum: f64 = (0..m * m)
-                .into_par_iter()
-                .map(|k| {
-                    let p = DVec2::new(
-                        ((k % m) as f64 + 0.5) / m as f64,
-                        ((k / m) as f64 + 0.5) / m as f64,
-                    );
-                    g(square_to_sphere(p))
-                })
-                .sum();
-            sum * 4.0 * PI / (m * m) as f64
-        };
+        let exact = |g: &(dyn Fn(DVec3) -> f64 + Sync)| sphere_integral(2048, g);
         let n_points = 64u32;
         let set: Vec<[f32; 2]> = (0..n_points)
             .map(|i| shifted_lattice_point::<f32>(i, n_points, 19, [0.3, 0.7]))

@@ -7,7 +7,7 @@
 //! through the map's luminance inverse CDF ([`EnvmapDensity`]'s warp, which
 //! ignores the cosine).
 
-use super::runtime::{envmap_parts, random_parts, random_shape};
+use super::runtime::{envmap_parts, ns_per_sample, random_parts, random_shape};
 use crate::sphere::{DirectionDensity, EnvmapDensity, EnvmapTree};
 use anyhow::{anyhow, Result};
 use glam::{DVec2, DVec3};
@@ -20,7 +20,6 @@ use nuld_runtime::Blob;
 use rand::{Rng, SeedableRng};
 use std::hint::black_box;
 use std::sync::Arc;
-use std::time::Instant;
 
 /// Normals cycled through: a renderer's shading points each have their own.
 const NORMALS: usize = 64;
@@ -28,26 +27,10 @@ const NORMALS: usize = 64;
 /// Points per set: a set of 64 shares its normal and scramble.
 const N: u32 = 64;
 
-/// Times of each method are the best of this many repeats.
-const REPEATS: usize = 3;
-
 /// Depth and top-weight grid timed: the environment sampler's defaults.
 pub const LEVELS: u32 = 8;
 /// Normals per axis of the top-weight table timed.
 pub const GRID: u32 = 49;
-
-/// Best-of-[`REPEATS`] nanoseconds per call of `f(sample number)`.
-fn ns_per_sample(count: u32, mut f: impl FnMut(u32)) -> f64 {
-    let mut best = f64::INFINITY;
-    for _ in 0..REPEATS {
-        let t = Instant::now();
-        for s in 0..count {
-            f(black_box(s));
-        }
-        best = best.min(t.elapsed().as_secs_f64() * 1e9 / count as f64);
-    }
-    best
-}
 
 /// `(method, ns per sample)` rows, the incumbent first, over `samples` samples
 /// each, one thread: sample `s` has normal `s / N mod 64`, and index `s mod N` of

@@ -138,8 +138,8 @@ const INCUMBENT_RULE_POINTS: usize = 1 << 10;
 const REPEATS: usize = 3;
 
 /// Best-of-[`REPEATS`] nanoseconds per call of `f(sample number)` over `count`
-/// calls.
-fn ns_per_sample(count: u32, mut f: impl FnMut(u32)) -> f64 {
+/// calls (every runtime timing of `bench`).
+pub(crate) fn ns_per_sample(count: u32, mut f: impl FnMut(u32)) -> f64 {
     let mut best = f64::INFINITY;
     for _ in 0..REPEATS {
         let t = Instant::now();

@@ -8,10 +8,9 @@ use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
-/// `∫ L(l) max(0, n.l) dl` of `map` by the midpoint rule on 1024^2 points of the
+/// `∫ g(l) dl` over the sphere by the midpoint rule on `q^2` points of the
 /// sphere's equal-area square (`dl = 4 pi` times the square's area element).
-pub(crate) fn irradiance_by_quadrature(map: &EnvmapDensity, n: DVec3) -> f64 {
-    let q = 1024;
+pub(crate) fn sphere_integral(q: usize, g: impl Fn(DVec3) -> f64 + Sync) -> f64 {
     let sum: f64 = (0..q * q)
         .into_par_iter()
         .map(|k| {
@@ -19,11 +18,15 @@ pub(crate) fn irradiance_by_quadrature(map: &EnvmapDensity, n: DVec3) -> f64 {
                 ((k % q) as f64 + 0.5) / q as f64,
                 ((k / q) as f64 + 0.5) / q as f64,
             );
-            let d = square_to_sphere(p);
-            map.pdf(d) * map.integral() * n.dot(d).max(0.0)
+            g(square_to_sphere(p))
         })
         .sum();
     sum * 4.0 * PI / (q * q) as f64
+}
+
+/// `∫ L(l) max(0, n.l) dl` of `map` by [`sphere_integral`] on 1024^2 points.
+pub(crate) fn irradiance_by_quadrature(map: &EnvmapDensity, n: DVec3) -> f64 {
+    sphere_integral(1024, |d| map.pdf(d) * map.integral() * n.dot(d).max(0.0))
 }
 
 /// The radical inverse of `i` in base `b` (Halton's second coordinate).
