@@ -422,6 +422,14 @@ impl<'a> EnvmapTree<'a> {
         (square_to_sphere_real(p), pdf / (T::of(4.0) * T::PI))
     }
 
+    /// [`Self::sample_square`]'s point of the octahedral square (before the
+    /// sphere map), its pdf per unit area of the square, and the derivatives
+    /// `(dx/du.x, dy/du.y)` of the point ([`quadtree::sample_with_slopes`]).
+    #[inline]
+    pub fn sample_square_with_slopes<T: Real>(&self, q: [T; 2], u: [T; 2]) -> ([T; 2], T, [T; 2]) {
+        quadtree::sample_with_slopes(&self.lit_square(q), u)
+    }
+
     /// [`Self::pdf`] for the normal whose octahedral square point is `q`.
     #[inline]
     pub fn pdf_square<T: Real>(&self, q: [T; 2], d: [T; 3]) -> T {

@@ -280,14 +280,39 @@ fn positive<T: Real>(v: T) -> T {
 /// within each level's split; at a leaf it is uniform. `O(levels)`; never panics.
 #[inline]
 pub fn sample<T: Real>(tree: &impl ChildWeights<T>, u: [T; 2]) -> ([T; 2], T) {
+    let (point, pdf, _) = sample_with_slopes(tree, u);
+    (point, pdf)
+}
+
+/// [`sample`] with the warp's derivatives `(dx/du.x, dy/du.y)` at `u`: within
+/// the piece of the descent that `u` falls in (the same children chosen at every
+/// level) the point's `x` is affine in `u.x` with slope `1 / (2^L ∏ column
+/// shares)` and its `y` affine in `u.y` with slope `1 / (2^L ∏ row shares)`, the
+/// cross derivatives 0. (Across a split the warp jumps; these are the one-sided
+/// derivatives of the piece.) What a trainer chains its gradients through.
+#[inline]
+pub fn sample_with_slopes<T: Real>(tree: &impl ChildWeights<T>, u: [T; 2]) -> ([T; 2], T, [T; 2]) {
     let levels = tree.levels().min(MAX_LEVELS);
     let (mut ux, mut uy) = (clamp_unit(u[0]), clamp_unit(u[1]));
     let (mut x, mut y) = (0u32, 0u32);
     let mut p = T::ONE;
+    let (mut column, mut row) = (T::ONE, T::ONE);
     for l in 0..levels {
         let w = usable(tree.children(l, x, y));
         let step = choose(w, &mut ux, &mut uy);
         p = p * share(w, step);
+        column = column
+            * if step.i == 0 {
+                step.px
+            } else {
+                T::ONE - step.px
+            };
+        row = row
+            * if step.j == 0 {
+                step.py
+            } else {
+                T::ONE - step.py
+            };
         x = 2 * x + step.i as u32;
         y = 2 * y + step.j as u32;
     }
@@ -296,7 +321,8 @@ pub fn sample<T: Real>(tree: &impl ChildWeights<T>, u: [T; 2]) -> ([T; 2], T) {
         ((T::of(x as f64) + ux) / side).min(T::ONE),
         ((T::of(y as f64) + uy) / side).min(T::ONE),
     ];
-    (point, p * side * side)
+    let slopes = [T::ONE / (side * column), T::ONE / (side * row)];
+    (point, p * side * side, slopes)
 }
 
 /// The density at `p` (clamped into the square) of [`sample`]'s points: the

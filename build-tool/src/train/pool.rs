@@ -120,15 +120,25 @@ impl PoolCondition {
     }
 
     /// The direction of the network's point `p` ([`PointWarp::direction`]) and its
-    /// derivatives along `p.x` and `p.y`: for the mixture warp and the
-    /// environment tree by central differences of step `1e-6`, zeroed where they
-    /// straddle a lobe boundary or a split of the tree (a jump that no gradient
-    /// can follow); for the equal-area maps exact.
+    /// derivatives along `p.x` and `p.y`: for the mixture warp by central
+    /// differences of step `1e-6`, zeroed where they straddle the lobe boundary (a
+    /// jump that no gradient can follow); for the environment tree the descent's
+    /// slopes through the sphere map, exact within the piece of the tree the
+    /// point falls in; for the equal-area maps exact.
     pub fn direction(&self, p: DVec2) -> (DVec3, DVec3, DVec3) {
         let tree = match &self.density {
             ConditionDensity::Envmap { env, .. } => Some(env.tree.tree()),
             ConditionDensity::Brdf { .. } => None,
         };
+        if let (PointWarp::EnvmapTree, Some(tree)) = (self.warp, &tree) {
+            // The tree's warp is affine per axis within a piece: the sphere map's
+            // Jacobian times the descent's slopes (zero across nothing, unlike
+            // differences, and one descent instead of five).
+            let (q, _, slopes) = tree.sample_square_with_slopes(self.cond, p.to_array());
+            let q = DVec2::from(q);
+            let (jx, jy) = map_jacobian(Domain::Sphere, q);
+            return (square_to_sphere(q), jx * slopes[0], jy * slopes[1]);
+        }
         let tree = tree.as_ref();
         let warp = |u: DVec2| {
             DVec3::from_array(self.warp.direction(
