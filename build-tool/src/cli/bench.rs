@@ -53,8 +53,10 @@ pub enum BenchPart {
     Directions,
     /// Only the baseline generators (milliseconds per set; not part of `all`).
     Baselines,
-    /// Only the runtime's conditional sampler against the incumbent warp
-    /// (nanoseconds per sample, one thread; not part of `all`).
+    /// Only the runtime's conditional samplers against the incumbent warps
+    /// (nanoseconds per sample, one thread; not part of `all`): the BRDF
+    /// sampler's table, then the environment sampler's (`envmap-prior`) when
+    /// `--envmap` is there.
     Runtime,
     /// Only the environment sampler's prior, the exact product warp of a map's
     /// light and a normal's cosine, against Owen-Sobol through the map's
@@ -117,7 +119,20 @@ pub fn run(a: BenchArgs) -> Result<()> {
         BenchPart::Square => run_square(&a),
         BenchPart::Directions => run_directions(&a),
         BenchPart::Baselines => run_baselines(&a),
-        BenchPart::Runtime => run_runtime(),
+        BenchPart::Runtime => {
+            run_runtime()?;
+            // The environment sampler's table, too, when its map is there.
+            if a.envmap.exists() {
+                println!();
+                run_envmap_prior(&a)?;
+            } else {
+                println!(
+                    "environment sampler skipped: {} not found (--envmap MAP)",
+                    a.envmap.display()
+                );
+            }
+            Ok(())
+        }
         BenchPart::Training => run_training(),
         BenchPart::EnvmapPrior => run_envmap_prior(&a),
     }
