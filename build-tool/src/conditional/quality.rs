@@ -26,7 +26,7 @@ use crate::train::target::{EnvmapTarget, LoadedTarget};
 use anyhow::Result;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
-use nuld_core::conditional::{randomization_shift, ConditionalTarget, PointWarp};
+use nuld_core::conditional::{randomization_shift, torus_shift, ConditionalTarget, PointWarp};
 use nuld_core::envmap_tree::EnvmapTree as CoreTree;
 use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
@@ -145,7 +145,7 @@ fn directions_at(
         .map(|i| {
             let mut s = params.square_point(unit, k, i);
             if randomized {
-                s = std::array::from_fn(|a| (s[a] + shift[a]).rem_euclid(1.0));
+                s = torus_shift(s, shift);
             }
             DVec3::from_array(warp.direction(domain, cond, p_s, tree, s))
         })

@@ -440,17 +440,18 @@ pub fn randomization_shift(seed: u32) -> [f32; 2] {
     [unit(a), unit(b)]
 }
 
-/// `p + shift` on the unit torus, per axis `x - floor(x)` in `f32`, a result
-/// rounded up to 1 read as 0: in `[0, 1)`. NaN reads as 0. Never panics.
+/// `p + shift` on the unit torus, per axis `x - floor(x)` in `T`'s arithmetic
+/// (`f32` in the runtime and shaders, `f64` in the tool's quality check), a
+/// result rounded up to 1 read as 0: in `[0, 1)`. NaN reads as 0. Never panics.
 #[inline]
-pub fn torus_shift(p: [f32; 2], shift: [f32; 2]) -> [f32; 2] {
+pub fn torus_shift<T: Real>(p: [T; 2], shift: [T; 2]) -> [T; 2] {
     core::array::from_fn(|a| {
         let x = p[a] + shift[a];
-        let f = x - libm::floorf(x);
-        if (0.0..1.0).contains(&f) {
+        let f = x - x.floor();
+        if f >= T::ZERO && f < T::ONE {
             f
         } else {
-            0.0
+            T::ZERO
         }
     })
 }

@@ -330,6 +330,7 @@ fn f32_agrees_with_f64() {
     let top = top_table(levels, &nodes);
     let tree = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
     let mut r = Rng(3);
+    let mut agreeing = 0;
     for _ in 0..2000 {
         let u = [r.next(), r.next()];
         let n = [r.next() - 0.5, r.next() - 0.5, r.next() - 0.5];
@@ -341,8 +342,11 @@ fn f32_agrees_with_f64() {
         // A sample on a split's edge may fall on either side in f32.
         if err < 1e-3 {
             assert!(((p32 as f64) - p64).abs() <= 1e-3 * p64, "{p32} vs {p64}");
+            agreeing += 1;
         }
     }
+    // The sides of a split differ for a few samples only: the check is not empty.
+    assert!(agreeing > 1900, "{agreeing}");
 }
 
 #[test]

@@ -329,10 +329,15 @@ impl<'a> ConditionalSampler<'a> {
     #[inline]
     pub fn sample_randomized(&self, cond: Vec2, instance: u32, i: u32, seed: u32) -> Sample {
         let u = self.info.normalize(cond.to_array());
-        let p = torus_shift(
-            self.square_point_at(u, instance, i).to_array(),
-            randomization_shift(seed),
-        );
+        self.randomized(self.square_point_at(u, instance, i), u, seed)
+    }
+
+    /// The unbiased mode's sample of point `p` at the normalized condition `u`:
+    /// `p` shifted on the torus by [`randomization_shift`]`(seed)`, then
+    /// [`Self::mapped`] (both modes').
+    #[inline]
+    pub(crate) fn randomized(&self, p: Vec2, u: [f32; 2], seed: u32) -> Sample {
+        let p = torus_shift(p.to_array(), randomization_shift(seed));
         self.mapped(Vec2::from_array(p), u)
     }
 

@@ -75,11 +75,8 @@ impl<'a> NetworkSampler<'a> {
     #[inline]
     pub fn sample_randomized(&self, cond: Vec2, instance: u32, i: u32, seed: u32) -> Sample {
         let u = self.0.info().normalize(cond.to_array());
-        let p = nuld_core::conditional::torus_shift(
-            self.0.network_square_point_at(u, instance, i).to_array(),
-            nuld_core::conditional::randomization_shift(seed),
-        );
-        self.0.mapped(Vec2::from_array(p), u)
+        self.0
+            .randomized(self.0.network_square_point_at(u, instance, i), u, seed)
     }
 
     /// The prior's pdf at `direction` ([`ConditionalSampler::pdf`]; the same
