@@ -93,7 +93,18 @@ impl DirectionSampler for MixtureSampler<'_> {
             Sample {
                 direction: at.frame.to_world(l),
                 weight: if pdf > 0.0 { f_cos / pdf } else { 0.0 },
+                pdf,
             }
         }));
+    }
+
+    fn pdf(&self, at: &ShadingPoint, l: DVec3) -> Option<f64> {
+        let p_s = self.lobes.lobe_probability(at.roughness, at.theta_o_deg());
+        Some(brdf_mixture_pdf(
+            at.wo,
+            alpha(at.roughness),
+            p_s,
+            at.frame.to_local(l),
+        ))
     }
 }

@@ -22,22 +22,31 @@
 //! piecewise-constant [`Environment::pdf`]; it is positive wherever `L` is (a half
 //! pixel's mass is `∫ L` over it), so `L / pdf` is finite and the estimators are
 //! unbiased, and it varies inside a half pixel where `L` does.
+//!
+//! A third warp samples the product `L(l) max(0, n.l)` at a surface's normal:
+//! the map's tree ([`EnvmapTree`], [`Environment::sample_product`]), built from
+//! the same density with the same settings as the prior of `bake --envmap`
+//! ([`PRIOR_LEVELS`], [`PRIOR_GRID`]), so it is the very warp under ours' learned
+//! points; uniform points through it are the baselines that isolate what the
+//! learning adds.
 
 use crate::baselines::HierarchicalWarp;
 use crate::density::image::{load_luminance, LuminanceImage};
 use crate::density::CellGrid;
+use crate::sphere::envmap_tree::{EnvmapTree, PRIOR_GRID, PRIOR_LEVELS};
 use crate::sphere::{DirectionDensity, EnvmapDensity, FilteredLuminance};
 use anyhow::{Context, Result};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
 use std::path::Path;
 
-/// An environment map: radiance lookup, density and the two warps.
+/// An environment map: radiance lookup, density and the three warps.
 #[derive(Clone, Debug)]
 pub struct Environment {
     radiance: FilteredLuminance,
     density: EnvmapDensity,
     hierarchical: HierarchicalWarp,
+    product: EnvmapTree,
 }
 
 impl Environment {
@@ -75,10 +84,13 @@ impl Environment {
             height: h,
             mass,
         });
+        let product = EnvmapTree::new(&density, PRIOR_LEVELS, PRIOR_GRID)
+            .with_context(|| format!("environment map {name}"))?;
         Ok(Self {
             radiance,
             density,
             hierarchical,
+            product,
         })
     }
 
@@ -124,6 +136,18 @@ impl Environment {
             (y - r as f64).clamp(0.0, 1.0),
         );
         self.density.pixel_direction(c, r, f)
+    }
+
+    /// The direction of `u` in `[0,1)^2` by the product warp at the unit normal
+    /// `n` (module docs), and its solid-angle pdf ([`Self::product_pdf`]).
+    pub fn sample_product(&self, n: DVec3, u: DVec2) -> (DVec3, f64) {
+        EnvmapTree::sample(&self.product.tree(), n, u)
+    }
+
+    /// The solid-angle density of [`Self::sample_product`] at `n` in the unit
+    /// direction `l`: 0 where the normal cannot see `l`.
+    pub fn product_pdf(&self, n: DVec3, l: DVec3) -> f64 {
+        EnvmapTree::pdf(&self.product.tree(), n, l)
     }
 }
 

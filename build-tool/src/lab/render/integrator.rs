@@ -170,11 +170,12 @@ mod tests {
     use crate::lab::render::lineup;
     use crate::lab::render::nuld_sampler::{NuldMode, NuldSampler};
     use crate::lab::render::primary::{Generator, PrimaryPoints};
+    use crate::lab::render::sampler::Technique;
     use crate::lab::render::scene::Sphere;
     use crate::sphere::brdf_albedo::directional_albedo;
     use nuld_core::brdf::BrdfModel;
 
-    /// One sphere of `roughness`, no ground, filling most of a 24 x 24 view.
+    /// One sphere of `roughness`, no ground, filling most of a 48 x 48 view.
     fn furnace_setup(roughness: f64) -> (Scene, Camera) {
         let scene = Scene {
             spheres: vec![Sphere {
@@ -184,13 +185,14 @@ mod tests {
             }],
             ground_roughness: None,
         };
-        let camera = Camera::new(DVec3::new(0.0, -4.0, 0.0), DVec3::ZERO, 32.0, 24, 24);
+        let camera = Camera::new(DVec3::new(0.0, -4.0, 0.0), DVec3::ZERO, 32.0, 48, 48);
         (scene, camera)
     }
 
     /// The white furnace: under a constant unit sky an unoccluded point's pixel is
     /// its directional albedo `A(roughness, θo)` (the independent quadrature of
-    /// `sphere::brdf_albedo`), for every sampler. Mean over the sphere's pixels of
+    /// `sphere::brdf_albedo`), for every sampler of every technique, MIS
+    /// included (a wrong heuristic weight or pdf shows here). Mean over the sphere's pixels of
     /// `value / A - 1` within 4 standard errors (from the pixels' own spread, plus
     /// 0.2% for ours, whose weight is the blob's interpolated albedo table). Ours
     /// for the environment is left out: its estimate is `E f` per sample
@@ -208,12 +210,37 @@ mod tests {
                 env: &env,
             };
             let lobes = LobeTable::new(&[roughness]);
-            let mut weights = Default::default();
-            let samplers =
-                lineup::samplers(blob.as_slice(), None, 16, 5, &lobes, &env, &mut weights).unwrap();
+            // Environment sampling of a glossy lobe has a heavy-tailed weight
+            // `f cos / pdf`: 64 samples per pixel keep the pixels' spread an honest
+            // standard error there.
+            let (mut w16, mut w64) = Default::default();
+            let mut samplers = lineup::samplers(
+                &[Technique::Brdf, Technique::Mis],
+                Some(blob.as_slice()),
+                None,
+                16,
+                5,
+                &lobes,
+                &env,
+                &mut w16,
+            )
+            .unwrap();
+            samplers.extend(
+                lineup::samplers(
+                    &[Technique::Envmap],
+                    None,
+                    None,
+                    64,
+                    5,
+                    &lobes,
+                    &env,
+                    &mut w64,
+                )
+                .unwrap(),
+            );
             // A at each surface pixel's view angle.
-            let albedo: Vec<Option<f64>> = (0..24)
-                .flat_map(|y| (0..24).map(move |x| (x, y)))
+            let albedo: Vec<Option<f64>> = (0..48)
+                .flat_map(|y| (0..48).map(move |x| (x, y)))
                 .map(|(x, y)| match setup.primary(x, y) {
                     Primary::Surface { at, .. } => Some(
                         directional_albedo(BrdfModel::Gltf, roughness, at.theta_o_deg().min(89.0))
@@ -225,9 +252,13 @@ mod tests {
                     }
                 })
                 .collect();
-            assert!(albedo.iter().flatten().count() > 200);
+            assert!(albedo.iter().flatten().count() > 800);
             for s in &samplers {
-                let img = setup.render(s.as_ref(), 16, 9, &|| {});
+                let n = match s.technique() {
+                    Technique::Envmap => 64,
+                    _ => 16,
+                };
+                let img = setup.render(s.as_ref(), n, 9, &|| {});
                 let ratios: Vec<f64> = img
                     .values
                     .iter()

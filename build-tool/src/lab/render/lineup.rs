@@ -3,9 +3,17 @@
 use super::brdf_warp::{LobeTable, MixtureSampler};
 use super::environment::Environment;
 use super::envmap_warp::{EnvWarp, EnvmapSampler};
+use super::frame::Frame;
+use super::mis::MisSampler;
 use super::nuld_sampler::{NuldBlobError, NuldMode, NuldSampler};
 use super::primary::{Generator, PrimaryPoints};
-use super::sampler::DirectionSampler;
+use super::sampler::{DirectionSampler, ShadingPoint, Technique};
+use glam::DVec3;
+use std::sync::Arc;
+
+/// A sampler of the lineup, shared between the techniques that use it (an
+/// environment sampler serves its own rows and the MIS ones).
+pub type Shared<'a> = Arc<dyn DirectionSampler + 'a>;
 
 /// The BRDF sampler names in table order.
 pub const BRDF_SAMPLERS: [&str; 6] = [
@@ -16,60 +24,147 @@ pub const BRDF_SAMPLERS: [&str; 6] = [
     "sot",
     "gbn",
 ];
-/// The environment sampler names in table order.
-pub const ENVMAP_SAMPLERS: [&str; 5] = [
+
+/// The environment sampler names in table order: ours (fixed instances in both
+/// modes, and the unbiased mode), the generators through ours' prior (the
+/// product warp), and the luminance-only warps renderers ship.
+pub const ENVMAP_SAMPLERS: [&str; 11] = [
     "nuld-table",
     "nuld-network",
+    "nuld-unbiased",
+    "owen-sobol-product",
+    "halton-product",
+    "random-product",
+    "sot-product",
+    "gbn-product",
     "owen-sobol",
     "halton",
     "owen-sobol-hierarchical",
 ];
 
-/// Every sampler at `n` samples per pixel, BRDF then environment, named as
-/// [`BRDF_SAMPLERS`] and [`ENVMAP_SAMPLERS`]: ours from the blobs `blob` (BRDF)
-/// and `envmap_blob` (the environment sampler of `env`; without it ours is left
-/// out of the environment samplers), whose `N` should be `n`, in both modes; the
-/// baselines' points from `seed` (SOT and GBN generate their pools now). Our
-/// network mode reads its weights decoded into `network_weights` (BRDF,
-/// environment; [`NuldSampler::decoded`]). An error if a blob is not the sampler
-/// it should be.
+/// The sampler names of multiple importance sampling: each environment sampler
+/// with Owen-Sobol through the BRDF mixture warp ([`super::mis`]).
+pub const MIS_SAMPLERS: [&str; 11] = ENVMAP_SAMPLERS;
+
+/// The names of `technique`'s samplers in table order.
+pub fn names(technique: Technique) -> &'static [&'static str] {
+    match technique {
+        Technique::Brdf => &BRDF_SAMPLERS,
+        Technique::Envmap => &ENVMAP_SAMPLERS,
+        Technique::Mis => &MIS_SAMPLERS,
+    }
+}
+
+/// The samplers of `techniques` at `n` samples per pixel, in the order of
+/// [`Technique::ALL`] and named as [`names`]: ours from the blobs `blob` (BRDF;
+/// without it ours is left out of the BRDF samplers) and `envmap_blob` (the
+/// environment sampler of `env`; without it ours is left out of the environment
+/// and MIS samplers), whose `N` should be `n`; the
+/// baselines' points from `seed` (SOT and GBN generate their pools now, once for
+/// all techniques). Our network mode reads its weights decoded into
+/// `network_weights` (BRDF, environment; [`NuldSampler::decoded`]). An error if
+/// a blob is not the sampler it should be.
+#[allow(clippy::too_many_arguments)]
 pub fn samplers<'a>(
-    blob: &'a [u8],
+    techniques: &[Technique],
+    blob: Option<&'a [u8]>,
     envmap_blob: Option<&'a [u8]>,
     n: u32,
     seed: u64,
     lobes: &'a LobeTable,
     env: &'a Environment,
     network_weights: &'a mut [Vec<f32>; 2],
-) -> Result<Vec<Box<dyn DirectionSampler + 'a>>, NuldBlobError> {
+) -> Result<Vec<Shared<'a>>, NuldBlobError> {
     let [brdf_weights, envmap_weights] = network_weights;
-    let points = |g| PrimaryPoints::new(g, n, seed);
-    let brdf = |g| Box::new(MixtureSampler::new(points(g), lobes));
-    let envmap = |g, warp| Box::new(EnvmapSampler::new(points(g), warp, env));
-    let mut all: Vec<Box<dyn DirectionSampler + 'a>> = vec![
-        Box::new(NuldSampler::new(blob, NuldMode::Table)?),
-        Box::new(NuldSampler::new(blob, NuldMode::Network)?.decoded(brdf_weights)),
-        brdf(Generator::OwenSobol),
-        brdf(Generator::Random),
-        brdf(Generator::Sot),
-        brdf(Generator::Gbn),
+    let mut brdf_weights = Some(brdf_weights);
+    let generators = [
+        Generator::OwenSobol,
+        Generator::Halton,
+        Generator::Random,
+        Generator::Sot,
+        Generator::Gbn,
     ];
+    let wanted = |g: Generator| {
+        let brdf = techniques.contains(&Technique::Brdf) && g != Generator::Halton;
+        brdf || techniques.iter().any(|t| *t != Technique::Brdf)
+    };
+    let pools: Vec<(Generator, PrimaryPoints)> = generators
+        .into_iter()
+        .filter(|g| wanted(*g))
+        .map(|g| (g, PrimaryPoints::new(g, n, seed)))
+        .collect();
+    let points = |g: Generator| {
+        pools
+            .iter()
+            .find(|(h, _)| *h == g)
+            .map(|(_, p)| p.clone())
+            .unwrap_or_else(|| PrimaryPoints::new(g, n, seed))
+    };
+    let brdf = |g| Arc::new(MixtureSampler::new(points(g), lobes)) as Shared<'a>;
+    let envmap = |g, warp| Arc::new(EnvmapSampler::new(points(g), warp, env)) as Shared<'a>;
+
+    let mut envmaps: Vec<Shared<'a>> = Vec::new();
     if let Some(e) = envmap_blob {
-        all.push(Box::new(NuldSampler::envmap(e, NuldMode::Table, env)?));
-        let network = NuldSampler::envmap(e, NuldMode::Network, env)?;
-        all.push(Box::new(network.decoded(envmap_weights)));
+        envmaps.push(Arc::new(NuldSampler::envmap(e, NuldMode::Table)?));
+        let network = NuldSampler::envmap(e, NuldMode::Network)?;
+        envmaps.push(Arc::new(network.decoded(envmap_weights)));
+        envmaps.push(Arc::new(
+            NuldSampler::envmap(e, NuldMode::Table)?.unbiased(),
+        ));
     }
-    all.push(envmap(Generator::OwenSobol, EnvWarp::InverseCdf));
-    all.push(envmap(Generator::Halton, EnvWarp::InverseCdf));
-    all.push(envmap(Generator::OwenSobol, EnvWarp::Hierarchical));
+    let wants_envmaps = techniques
+        .iter()
+        .any(|t| matches!(t, Technique::Envmap | Technique::Mis));
+    if wants_envmaps {
+        for g in generators {
+            envmaps.push(envmap(g, EnvWarp::Product));
+        }
+        envmaps.push(envmap(Generator::OwenSobol, EnvWarp::InverseCdf));
+        envmaps.push(envmap(Generator::Halton, EnvWarp::InverseCdf));
+        envmaps.push(envmap(Generator::OwenSobol, EnvWarp::Hierarchical));
+    }
+
+    let mut all: Vec<Shared<'a>> = Vec::new();
+    for technique in Technique::ALL {
+        if !techniques.contains(&technique) {
+            continue;
+        }
+        match technique {
+            Technique::Brdf => {
+                if let (Some(blob), Some(weights)) = (blob, brdf_weights.take()) {
+                    all.push(Arc::new(NuldSampler::new(blob, NuldMode::Table)?));
+                    let network = NuldSampler::new(blob, NuldMode::Network)?;
+                    all.push(Arc::new(network.decoded(weights)));
+                }
+                for g in [
+                    Generator::OwenSobol,
+                    Generator::Random,
+                    Generator::Sot,
+                    Generator::Gbn,
+                ] {
+                    all.push(brdf(g));
+                }
+            }
+            Technique::Envmap => all.extend(envmaps.iter().cloned()),
+            Technique::Mis => {
+                let probe = ShadingPoint {
+                    frame: Frame::new(DVec3::Z),
+                    wo: DVec3::Z,
+                    roughness: 0.5,
+                };
+                for s in &envmaps {
+                    let mis = MisSampler::new(s.clone(), brdf(Generator::OwenSobol), &probe);
+                    all.extend(mis.map(|m| Arc::new(m) as Shared<'a>));
+                }
+            }
+        }
+    }
     Ok(all)
 }
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::lab::render::blobs::{tiny_blob, tiny_envmap_blob};
-    use crate::lab::render::sampler::Technique;
     use crate::sphere::envmap::tiny_map;
 
     #[test]
@@ -82,7 +177,8 @@ mod tests {
         let lobes = LobeTable::new(&[0.5]);
         let mut weights = Default::default();
         let all = samplers(
-            blob.as_slice(),
+            &Technique::ALL,
+            Some(blob.as_slice()),
             Some(env_blob.as_slice()),
             4,
             0,
@@ -91,17 +187,18 @@ mod tests {
             &mut weights,
         )
         .unwrap();
-        let names = |t| {
-            all.iter()
+        for t in Technique::ALL {
+            let got: Vec<&str> = all
+                .iter()
                 .filter(|s| s.technique() == t)
                 .map(|s| s.name())
-                .collect::<Vec<_>>()
-        };
-        assert_eq!(names(Technique::Brdf), BRDF_SAMPLERS);
-        assert_eq!(names(Technique::Envmap), ENVMAP_SAMPLERS);
+                .collect();
+            assert_eq!(got, names(t), "{}", t.name());
+        }
         let fails = |blob: &[u8], envmap_blob: Option<&[u8]>| {
             samplers(
-                blob,
+                &Technique::ALL,
+                Some(blob),
                 envmap_blob,
                 4,
                 0,
@@ -116,8 +213,34 @@ mod tests {
         assert!(fails(env_blob.as_slice(), Some(blob.as_slice())));
         assert!(fails(blob.as_slice(), Some(blob.as_slice())));
         let mut spare = Default::default();
-        let without = samplers(blob.as_slice(), None, 4, 0, &lobes, &env, &mut spare).unwrap();
-        assert_eq!(without.len(), all.len() - 2);
+        let all_techniques = &Technique::ALL;
+        let without = samplers(
+            all_techniques,
+            Some(blob.as_slice()),
+            None,
+            4,
+            0,
+            &lobes,
+            &env,
+            &mut spare,
+        )
+        .unwrap();
+        // Ours' three environment samplers, alone and in MIS.
+        assert_eq!(without.len(), all.len() - 6);
+        let mut spare = Default::default();
+        let mis = samplers(
+            &[Technique::Mis],
+            None,
+            Some(env_blob.as_slice()),
+            4,
+            0,
+            &lobes,
+            &env,
+            &mut spare,
+        )
+        .unwrap();
+        assert!(mis.iter().all(|s| s.technique() == Technique::Mis));
+        assert_eq!(mis.len(), MIS_SAMPLERS.len());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -9,8 +9,13 @@
 //! * BRDF sampling: ours in table and network mode ([`nuld_sampler`], through
 //!   `nuld-runtime` on the blob bytes only), and Owen-Sobol, random, SOT and GBN
 //!   points ([`primary`]) through the renderer's mixture warp ([`brdf_warp`]);
-//! * environment sampling: Owen-Sobol and Halton points through the map's
-//!   inverse CDF, and Owen-Sobol through hierarchical warping ([`envmap_warp`]).
+//! * environment sampling: ours in table, network and unbiased mode; Owen-Sobol,
+//!   Halton, random, SOT and GBN points through the product warp of `L cos` that
+//!   ours uses as its prior; Owen-Sobol and Halton points through the map's
+//!   inverse CDF and Owen-Sobol through hierarchical warping of its luminance,
+//!   as renderers ship them ([`envmap_warp`]);
+//! * multiple importance sampling of both ([`mis`]): each environment sampler
+//!   with Owen-Sobol through the BRDF mixture warp, power heuristic.
 //!
 //! [`lineup`] lists them in table order. A multiple-importance-sampled reference
 //! ([`mod@reference`]) gives RMSE and bias ([`summary`]); [`run`] writes pictures
@@ -24,6 +29,7 @@ pub mod envmap_warp;
 pub mod frame;
 pub mod integrator;
 pub mod lineup;
+pub mod mis;
 pub mod nuld_sampler;
 pub mod picture;
 pub mod primary;

@@ -12,13 +12,13 @@
 //!   [`BrdfNetwork::sample`] (network mode) at the local view
 //!   direction and the roughness; the weight is the sample's own (the albedo `A`);
 //! * environment sampling: [`EnvmapSampler::sample`] or
-//!   [`EnvmapNetwork::sample`] at the world normal; the sample
-//!   weight is the irradiance `E(n)`, and since the set follows
-//!   `q(l) = L(l) max(0, n.l) / E(n)`, the estimator's weight is
-//!   `f(wo, l) cos / q(l) = f(wo, l) cos E(n) / (L(l) cos)` (0 where `L` or the
-//!   cosine is 0): the per-sample contribution is `E f`.
+//!   [`EnvmapNetwork::sample`] at the world normal, or their unbiased mode
+//!   ([`EnvmapSampler::sample_randomized`], `nuld-unbiased`, the pixel key's low
+//!   32 bits as its random number); the estimator's weight is the usual
+//!   `f(wo, l) cos / pdf(l)` with the sample's exact pdf (0 where `f cos` is),
+//!   and [`DirectionSampler::pdf`] is the runtime's `pdf`, for multiple
+//!   importance sampling.
 
-use super::environment::Environment;
 use super::sampler::{DirectionSampler, PixelKey, Sample, ShadingPoint, Technique};
 use glam::{DVec2, DVec3};
 use nuld_core::sphere::square_to_sphere;
@@ -56,8 +56,8 @@ pub enum NuldBlobError {
 enum Kind<'a> {
     Brdf(BrdfSampler<'a>),
     BrdfNetwork(BrdfNetwork<'a>),
-    Envmap(EnvmapSampler<'a>, &'a Environment),
-    EnvmapNetwork(EnvmapNetwork<'a>, &'a Environment),
+    Envmap(EnvmapSampler<'a>),
+    EnvmapNetwork(EnvmapNetwork<'a>),
 }
 
 /// Ours (see the module docs): a view on the blob's bytes.
@@ -66,6 +66,7 @@ pub struct NuldSampler<'a> {
     sampler: ConditionalSampler<'a>,
     mode: NuldMode,
     kind: Kind<'a>,
+    randomized: bool,
 }
 
 /// The runtime's refusal of a view as the reason a blob cannot serve.
@@ -87,6 +88,7 @@ impl<'a> NuldSampler<'a> {
         Ok(Self {
             sampler: brdf.conditional(),
             mode,
+            randomized: false,
             kind: match mode {
                 NuldMode::Table => Kind::Brdf(brdf),
                 NuldMode::Network => Kind::BrdfNetwork(brdf.network()),
@@ -94,15 +96,11 @@ impl<'a> NuldSampler<'a> {
         })
     }
 
-    /// The environment sampler of the blob `bytes` for the map `env` in `mode`;
-    /// an error unless they hold a conditional environment sampler. That the blob
-    /// was baked for `env` is the reader's check, made once per blob
+    /// The environment sampler of the blob `bytes` in `mode`; an error unless
+    /// they hold a conditional environment sampler. That the blob was baked for
+    /// the scene's map is the reader's check, made once per blob
     /// ([`super::blobs::SamplerBlobs::read_envmap`]).
-    pub fn envmap(
-        bytes: &'a [u8],
-        mode: NuldMode,
-        env: &'a Environment,
-    ) -> Result<Self, NuldBlobError> {
+    pub fn envmap(bytes: &'a [u8], mode: NuldMode) -> Result<Self, NuldBlobError> {
         let blob = Blob::parse(bytes).map_err(NuldBlobError::Parse)?;
         let sampler = blob
             .envmap()
@@ -110,9 +108,10 @@ impl<'a> NuldSampler<'a> {
         Ok(Self {
             sampler: sampler.conditional(),
             mode,
+            randomized: false,
             kind: match mode {
-                NuldMode::Table => Kind::Envmap(sampler, env),
-                NuldMode::Network => Kind::EnvmapNetwork(sampler.network(), env),
+                NuldMode::Table => Kind::Envmap(sampler),
+                NuldMode::Network => Kind::EnvmapNetwork(sampler.network()),
             },
         })
     }
@@ -150,14 +149,21 @@ impl<'a> NuldSampler<'a> {
                 .ok()
                 .and_then(|b| b.decode_network(buf))
                 .map(Kind::BrdfNetwork),
-            Kind::EnvmapNetwork(_, env) => EnvmapSampler::try_from(self.sampler)
+            Kind::EnvmapNetwork(_) => EnvmapSampler::try_from(self.sampler)
                 .ok()
                 .and_then(|e| e.decode_network(buf))
-                .map(|n| Kind::EnvmapNetwork(n, env)),
+                .map(Kind::EnvmapNetwork),
             _ => None,
         };
         // `None` is unreachable: the buffer has the length asked for.
         kind.map_or(self, |kind| Self { kind, ..self })
+    }
+
+    /// The environment sampler in its unbiased mode (a random torus shift per
+    /// pixel, module docs); a BRDF sampler is returned as it is (it has none yet).
+    pub fn unbiased(self) -> Self {
+        let randomized = matches!(self.kind, Kind::Envmap(_) | Kind::EnvmapNetwork(_));
+        Self { randomized, ..self }
     }
 
     /// Points per set `N` of the blob.
@@ -175,14 +181,16 @@ impl DirectionSampler for NuldSampler<'_> {
     fn technique(&self) -> Technique {
         match self.kind {
             Kind::Brdf(_) | Kind::BrdfNetwork(_) => Technique::Brdf,
-            Kind::Envmap(..) | Kind::EnvmapNetwork(..) => Technique::Envmap,
+            Kind::Envmap(_) | Kind::EnvmapNetwork(_) => Technique::Envmap,
         }
     }
 
     fn name(&self) -> &'static str {
-        match self.mode {
-            NuldMode::Table => "nuld-table",
-            NuldMode::Network => "nuld-network",
+        match (self.mode, self.randomized) {
+            (NuldMode::Table, false) => "nuld-table",
+            (NuldMode::Network, false) => "nuld-network",
+            (NuldMode::Table, true) => "nuld-unbiased",
+            (NuldMode::Network, true) => "nuld-network-unbiased",
         }
     }
 
@@ -198,12 +206,29 @@ impl DirectionSampler for NuldSampler<'_> {
             Kind::BrdfNetwork(t) => {
                 out.extend((0..n).map(|i| brdf_sample(at, t.sample(wo, r, k, i))))
             }
-            Kind::Envmap(t, env) => {
-                out.extend((0..n).map(|i| envmap_sample(at, env, t.sample(normal, k, i))))
-            }
-            Kind::EnvmapNetwork(t, env) => {
-                out.extend((0..n).map(|i| envmap_sample(at, env, t.sample(normal, k, i))))
-            }
+            Kind::Envmap(t) => out.extend((0..n).map(|i| {
+                let s = match self.randomized {
+                    false => t.sample(normal, k, i),
+                    true => t.sample_randomized(normal, k, i, key.scramble()),
+                };
+                envmap_sample(at, s)
+            })),
+            Kind::EnvmapNetwork(t) => out.extend((0..n).map(|i| {
+                let s = match self.randomized {
+                    false => t.sample(normal, k, i),
+                    true => t.sample_randomized(normal, k, i, key.scramble()),
+                };
+                envmap_sample(at, s)
+            })),
+        }
+    }
+
+    fn pdf(&self, at: &ShadingPoint, l: DVec3) -> Option<f64> {
+        let normal = at.frame.normal().as_vec3();
+        match self.kind {
+            Kind::Brdf(_) | Kind::BrdfNetwork(_) => None,
+            Kind::Envmap(t) => Some(t.pdf(normal, l.as_vec3()) as f64),
+            Kind::EnvmapNetwork(t) => Some(t.pdf(normal, l.as_vec3()) as f64),
         }
     }
 }
@@ -214,23 +239,24 @@ fn brdf_sample(at: &ShadingPoint, s: nuld_runtime::Sample) -> Sample {
     Sample {
         direction: at.frame.to_world(s.direction.as_dvec3()),
         weight: s.weight as f64,
+        pdf: 0.0,
     }
 }
 
 /// An environment sample (world frame) with the estimator's weight
-/// `f cos / q = f E / L`, `q = L cos / E`: the cosines cancel.
-fn envmap_sample(at: &ShadingPoint, env: &Environment, s: nuld_runtime::Sample) -> Sample {
+/// `f cos / pdf`, the sample's exact pdf.
+fn envmap_sample(at: &ShadingPoint, s: nuld_runtime::Sample) -> Sample {
     let l = s.direction.as_dvec3();
-    let local = at.frame.to_local(l);
-    let radiance = env.radiance(l);
-    let weight = if local.z > 0.0 && radiance > 0.0 {
-        nuld_core::brdf::brdf(at.wo, local, at.roughness) * s.weight as f64 / radiance
-    } else {
-        0.0
-    };
+    let pdf = s.pdf as f64;
+    let f_cos = at.cosine_weighted(l);
     Sample {
         direction: l,
-        weight,
+        weight: if pdf > 0.0 && f_cos > 0.0 {
+            f_cos / pdf
+        } else {
+            0.0
+        },
+        pdf,
     }
 }
 
@@ -301,12 +327,14 @@ mod tests {
         }
     }
 
-    /// Ours for the environment is the runtime's `EnvmapSampler::sample` at the world
-    /// normal, bit for bit, and each sample contributes `weight x L(l) = E(n)
-    /// f(wo, l)` (0 below the surface): the estimator of a set that follows
-    /// `L max(0, n.l) / E`.
+    /// Ours for the environment is the runtime's `EnvmapSampler::sample` (or
+    /// `sample_randomized` with the key's low bits) at the world normal, bit for
+    /// bit, weighted `f cos / pdf` by the runtime's pdf, which `pdf` returns for
+    /// any direction; and that pdf is the product warp's of the map
+    /// (`Environment::product_pdf`, the baselines through ours' prior) to f32
+    /// rounding: the same warp.
     #[test]
-    fn envmap_samples_are_the_runtimes_and_contribute_e_times_f() {
+    fn envmap_samples_are_the_runtimes_weighted_by_their_exact_pdf() {
         use crate::lab::render::blobs::tiny_envmap_blob;
         use crate::lab::render::environment::Environment;
         use crate::sphere::envmap::tiny_map;
@@ -322,37 +350,54 @@ mod tests {
             roughness: 0.3,
         };
         let key = PixelKey(0x0fed_cba9_8765_4321);
-        let mut checked = 0;
+        let (mut checked, mut compared) = (0, 0);
         for mode in [NuldMode::Table, NuldMode::Network] {
-            let mut weights = Vec::new();
-            let ours = NuldSampler::envmap(blob.as_slice(), mode, &env)
-                .unwrap()
-                .decoded(&mut weights);
-            assert_eq!(ours.technique(), Technique::Envmap);
-            let mut out = Vec::new();
-            ours.samples(&at, key, 8, &mut out);
-            for (i, s) in out.iter().enumerate() {
-                let want = match mode {
-                    NuldMode::Table => cs.sample(n.as_vec3(), key.instance(), i as u32),
-                    NuldMode::Network => cs.network().sample(n.as_vec3(), key.instance(), i as u32),
-                };
-                assert_eq!(s.direction, want.direction.as_dvec3());
-                let l = s.direction;
-                let f = nuld_core::brdf::brdf(at.wo, at.frame.to_local(l), at.roughness);
-                let contribution = s.weight * env.radiance(l);
-                if n.dot(l) > 0.0 {
-                    let e = want.weight as f64;
-                    assert!(
-                        (contribution - e * f).abs() <= 1e-9 * e * f,
-                        "{contribution} {e} {f}"
-                    );
-                    checked += 1;
-                } else {
-                    assert_eq!(s.weight, 0.0);
+            for unbiased in [false, true] {
+                let mut weights = Vec::new();
+                let mut ours = NuldSampler::envmap(blob.as_slice(), mode)
+                    .unwrap()
+                    .decoded(&mut weights);
+                if unbiased {
+                    ours = ours.unbiased();
+                }
+                assert_eq!(ours.technique(), Technique::Envmap);
+                let mut out = Vec::new();
+                ours.samples(&at, key, 8, &mut out);
+                for (i, s) in out.iter().enumerate() {
+                    let (k, i) = (key.instance(), i as u32);
+                    let nf = n.as_vec3();
+                    let want = match (mode, unbiased) {
+                        (NuldMode::Table, false) => cs.sample(nf, k, i),
+                        (NuldMode::Network, false) => cs.network().sample(nf, k, i),
+                        (NuldMode::Table, true) => cs.sample_randomized(nf, k, i, key.scramble()),
+                        (NuldMode::Network, true) => {
+                            cs.network().sample_randomized(nf, k, i, key.scramble())
+                        }
+                    };
+                    assert_eq!(s.direction, want.direction.as_dvec3());
+                    assert_eq!(s.pdf, want.pdf as f64);
+                    let l = s.direction;
+                    assert_eq!(ours.pdf(&at, l), Some(cs.pdf(nf, want.direction) as f64));
+                    let f_cos = at.cosine_weighted(l);
+                    if f_cos > 0.0 {
+                        assert_eq!(s.weight, f_cos / s.pdf);
+                        checked += 1;
+                    } else {
+                        assert_eq!(s.weight, 0.0);
+                    }
+                    let product = env.product_pdf(n, l);
+                    if product > 0.0 {
+                        assert!(
+                            (product - s.pdf).abs() <= 1e-4 * product,
+                            "{product} {}",
+                            s.pdf
+                        );
+                        compared += 1;
+                    }
                 }
             }
         }
-        assert!(checked > 0);
+        assert!(checked > 8 && compared > 8, "{checked} {compared}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -1,7 +1,9 @@
 //! The reference image: direct lighting at many samples per pixel, combining BRDF
 //! sampling (the mixture warp of random points) and environment sampling (the
-//! inverse CDF of random points) by multiple importance sampling with the balance
-//! heuristic (Veach 1997, §9.2.2).
+//! product warp of `L cos` at the normal, [`super::environment`], of random
+//! points) by multiple importance sampling with the balance heuristic (Veach
+//! 1997, §9.2.2). The product warp puts the environment's samples where the
+//! cosine lets light in, none below the surface.
 //!
 //! With `m` samples from each technique, `b_j ~ p_b`, `e_j ~ p_e`, and
 //! `g(l) = f cos L V`, the pixel is `(1/m) Σ_j Y_j`,
@@ -129,7 +131,7 @@ fn pixel(setup: &Setup<'_>, lobes: &LobeTable, m: u32, seed: u64, x: u32, y: u32
         if f_cos <= 0.0 {
             return 0.0;
         }
-        let p = brdf_mixture_pdf(at.wo, a, p_s, local) + setup.env.pdf(l);
+        let p = brdf_mixture_pdf(at.wo, a, p_s, local) + setup.env.product_pdf(normal, l);
         if p <= 0.0 {
             return 0.0;
         }
@@ -144,9 +146,9 @@ fn pixel(setup: &Setup<'_>, lobes: &LobeTable, m: u32, seed: u64, x: u32, y: u32
             p_s,
             ub,
         )));
-        let e = setup
+        let (e, _) = setup
             .env
-            .sample_inverse_cdf(glam::DVec2::new(g.random(), g.random()));
+            .sample_product(normal, glam::DVec2::new(g.random(), g.random()));
         let y = term(b) + term(e);
         sum += y;
         sum2 += y * y;

@@ -1,27 +1,28 @@
 //! `build-tool render`: the whole evaluation of paper Fig. 8 into one directory.
 //!
-//! Writes into `DIR`: `render.csv` ([`super::summary::CSV_HEADER`]),
-//! `render-summary.md` (equal-sample-count and equal-time tables),
+//! Writes into `DIR`: `render.csv` ([`super::summary::CSV_HEADER`], one row per
+//! technique, sampler, spp and seed), `render-summary.md` (equal-sample-count
+//! and equal-time tables, means over the seeds with their standard errors),
 //! `reference.png` and the cached `reference-KEY.bin`, `images/T-S-N.png`
-//! (technique `T`, sampler `S`, `N` spp; tone-mapped with the reference's exposure),
-//! `errors/T-S-N.png` (absolute error against the reference, white at twice
-//! Owen-Sobol's RMSE of the same technique and spp), `fig8-brdf.png`,
-//! `fig8-envmap.png` (and `-errors` twins: rows = samplers, columns = spp), and
-//! the baked blobs `brdf-nN/` and `envmap-nN/` it needed. Every file is written
-//! atomically.
+//! (technique `T`, sampler `S`, `N` spp, the first seed; tone-mapped with the
+//! reference's exposure), `errors/T-S-N.png` (absolute error against the
+//! reference, white at twice Owen-Sobol's RMSE of the same technique and spp),
+//! `fig8-T.png` per technique (and `-errors` twins: rows = samplers, columns =
+//! spp), and the baked blobs `brdf-nN/` and `envmap-nN/` it needed. Every file is
+//! written atomically.
 
 use super::blobs::{BrdfBlobs, SamplerBlobs};
 use super::brdf_warp::LobeTable;
 use super::camera::Camera;
 use super::environment::Environment;
 use super::integrator::{Image, Primary, Setup};
-use super::lineup::{self, BRDF_SAMPLERS, ENVMAP_SAMPLERS};
+use super::lineup;
 use super::picture::{error_map, exposure, tone_map, Picture};
 use super::reference::Reference;
 use super::sampler::Technique;
 use super::scene::Scene;
 use super::summary::{csv, errors, markdown, Row};
-use crate::conditional::bake::{BakeConfig, ENVMAP_GRID, ENVMAP_WEIGHT_GRID};
+use crate::conditional::bake::{BakeConfig, ENVMAP_GRID, ENVMAP_STEPS, ENVMAP_WEIGHT_GRID};
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render_composite, Composite, Tile};
 use crate::progress::Progress;
@@ -53,13 +54,20 @@ pub struct RenderConfig {
     /// How missing environment blobs are baked: these settings
     /// [`with_envmap`](BakeConfig::with_envmap) the render's map.
     pub envmap_bake: BakeConfig,
-    /// Fixes every pixel key, pool set and reference sample.
+    /// Fixes the reference; the images are rendered at seeds `seed`,
+    /// `seed + 1`, ..., `seed + seeds - 1` (pixel keys, pool sets).
     pub seed: u64,
+    /// Renders per technique, sampler and spp (at least 1), each at its own seed.
+    pub seeds: u32,
+    /// What to render (BRDF sampling, environment sampling, MIS); a BRDF blob is
+    /// needed only for BRDF sampling, an environment blob for the others.
+    pub techniques: Vec<Technique>,
 }
 
 impl RenderConfig {
-    /// The full evaluation: 320 x 240 pixels, 4/16/64/256 spp, a reference of
-    /// 4096 + 4096 samples per pixel, missing blobs baked with the default bake.
+    /// The full evaluation: 320 x 240 pixels, 4/16/64/256 spp at 4 seeds, every
+    /// technique, a reference of 4096 + 4096 samples per pixel, missing blobs
+    /// baked with the defaults of `bake --brdf` and `bake --envmap`.
     pub fn full(envmap: PathBuf) -> Self {
         Self {
             envmap,
@@ -73,9 +81,15 @@ impl RenderConfig {
             envmap_bake: BakeConfig {
                 grid: ENVMAP_GRID,
                 weight_grid: ENVMAP_WEIGHT_GRID,
+                train: TrainConfig {
+                    steps: ENVMAP_STEPS,
+                    ..TrainConfig::default()
+                },
                 ..BakeConfig::default()
             },
             seed: 0,
+            seeds: 4,
+            techniques: Technique::ALL.to_vec(),
         }
     }
 
@@ -107,6 +121,7 @@ impl RenderConfig {
             width: 32,
             height: 24,
             reference_samples: 256,
+            seeds: 2,
             envmap_bake: bake.clone(),
             bake,
             ..Self::full(envmap)
@@ -138,6 +153,11 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
     if config.width == 0 || config.height == 0 || config.reference_samples < 2 {
         bail!("the image needs at least 1 x 1 pixels and the reference 2 samples");
     }
+    if config.seeds == 0 || config.techniques.is_empty() {
+        bail!("--seeds must be at least 1 and --techniques name at least one of brdf, envmap, mis");
+    }
+    let wants_brdf = config.techniques.contains(&Technique::Brdf);
+    let wants_envmap = config.techniques.iter().any(|t| *t != Technique::Brdf);
     let map_bytes = std::fs::read(&config.envmap)
         .with_context(|| format!("cannot read environment map {}", config.envmap.display()))?;
     let env = Environment::from_file(&config.envmap)?;
@@ -146,10 +166,14 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
     ensure_dir(out)?;
     ensure_dir(&out.join("images"))?;
     ensure_dir(&out.join("errors"))?;
-    blobs.complete(&config.spp, out, &config.bake)?;
-    let map_target = TrainTarget::envmap_with_bytes(&config.envmap, &map_bytes);
-    let envmap_template = config.envmap_bake.clone().with_envmap(map_target);
-    envmap_blobs.complete(&config.spp, out, &envmap_template)?;
+    if wants_brdf {
+        blobs.complete(&config.spp, out, &config.bake)?;
+    }
+    if wants_envmap {
+        let map_target = TrainTarget::envmap_with_bytes(&config.envmap, &map_bytes);
+        let envmap_template = config.envmap_bake.clone().with_envmap(map_target);
+        envmap_blobs.complete(&config.spp, out, &envmap_template)?;
+    }
 
     let scene = Scene::spheres_on_ground();
     let camera = Camera::evaluation(config.width, config.height);
@@ -163,7 +187,7 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
     // The reference, cached by everything it depends on.
     let key = content_hash(
         format!(
-            "reference v2 (bilinear radiance) {:016x} {scene:?} {camera:?} {} {}",
+            "reference v3 (product warp) {:016x} {scene:?} {camera:?} {} {}",
             content_hash(&map_bytes),
             config.reference_samples,
             config.seed
@@ -205,72 +229,96 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
     let exposure = exposure(&reference.image);
     tone_map(&reference.image, exposure).write_png(&out.join("reference.png"))?;
 
-    let per_spp = BRDF_SAMPLERS.len() + ENVMAP_SAMPLERS.len();
+    let per_spp: usize = config
+        .techniques
+        .iter()
+        .map(|t| lineup::names(*t).len())
+        .sum();
     let progress = Progress::stderr(
         "render",
-        (per_spp * config.spp.len()) as u64 * h as u64,
+        (per_spp * config.spp.len() * config.seeds as usize) as u64 * h as u64,
         "row",
     );
-    // Parallel: the row, image and tone-mapped picture of each render.
+    // Every seed's row; the first seed's image and tone-mapped picture.
     let mut rows: Vec<Row> = Vec::new();
+    let mut shown: Vec<Row> = Vec::new();
     let mut images: Vec<Image> = Vec::new();
     let mut pictures: Vec<Picture> = Vec::new();
     for &n in &config.spp {
-        let (blob_path, bytes) = blobs
-            .get(n)
-            .with_context(|| format!("no BRDF blob with N = {n}"))?;
-        let (envmap_path, envmap_bytes) = envmap_blobs
-            .get(n)
-            .with_context(|| format!("no environment blob with N = {n}"))?;
-        // Network mode's weights, decoded once per blob (as a renderer would).
-        let mut weights = Default::default();
-        let samplers = lineup::samplers(
-            bytes,
-            Some(envmap_bytes),
-            n,
-            config.seed,
-            &lobes,
-            &env,
-            &mut weights,
-        )
-        .with_context(|| {
-            format!(
-                "blobs {} and {}",
-                blob_path.display(),
-                envmap_path.display()
+        let brdf = match wants_brdf {
+            true => Some(
+                blobs
+                    .get(n)
+                    .with_context(|| format!("no BRDF blob with N = {n}"))?,
+            ),
+            false => None,
+        };
+        let envmap = match wants_envmap {
+            true => Some(
+                envmap_blobs
+                    .get(n)
+                    .with_context(|| format!("no environment blob with N = {n}"))?,
+            ),
+            false => None,
+        };
+        for k in 0..config.seeds {
+            let seed = config.seed.wrapping_add(k as u64);
+            // Network mode's weights, decoded once per blob (as a renderer would).
+            let mut weights = Default::default();
+            let samplers = lineup::samplers(
+                &config.techniques,
+                brdf.map(|(_, b)| b),
+                envmap.map(|(_, b)| b),
+                n,
+                seed,
+                &lobes,
+                &env,
+                &mut weights,
             )
-        })?;
-        for sampler in &samplers {
-            progress.set_context(format!(
-                "{} {} {n} spp",
-                sampler.technique().name(),
-                sampler.name()
-            ));
-            let t = Instant::now();
-            let image = setup.render(sampler.as_ref(), n, config.seed, &|| progress.inc(1));
-            let seconds = t.elapsed().as_secs_f64();
-            let (rmse, bias) = errors(&image, &reference.image, &mask);
-            let row = Row {
-                technique: sampler.technique().name().to_string(),
-                sampler: sampler.name().to_string(),
-                spp: n,
-                rmse,
-                bias,
-                seconds,
-            };
-            let picture = tone_map(&image, exposure);
-            picture.write_png(&out.join("images").join(file_name(&row)))?;
-            rows.push(row);
-            images.push(image);
-            pictures.push(picture);
+            .with_context(|| {
+                let paths: Vec<String> = [brdf, envmap]
+                    .into_iter()
+                    .flatten()
+                    .map(|(p, _)| p.display().to_string())
+                    .collect();
+                format!("blobs {}", paths.join(" and "))
+            })?;
+            for sampler in &samplers {
+                progress.set_context(format!(
+                    "{} {} {n} spp, seed {seed}",
+                    sampler.technique().name(),
+                    sampler.name()
+                ));
+                let t = Instant::now();
+                let image = setup.render(sampler.as_ref(), n, seed, &|| progress.inc(1));
+                let seconds = t.elapsed().as_secs_f64();
+                let (rmse, bias) = errors(&image, &reference.image, &mask);
+                let row = Row {
+                    technique: sampler.technique().name().to_string(),
+                    sampler: sampler.name().to_string(),
+                    spp: n,
+                    seed,
+                    rmse,
+                    bias,
+                    seconds,
+                };
+                if k == 0 {
+                    let picture = tone_map(&image, exposure);
+                    picture.write_png(&out.join("images").join(file_name(&row)))?;
+                    shown.push(row.clone());
+                    images.push(image);
+                    pictures.push(picture);
+                }
+                rows.push(row);
+            }
         }
     }
     progress.finish();
 
     // Error maps, white at twice Owen-Sobol's RMSE of the same technique and spp.
     let mut errors_of = Vec::new();
-    for (row, image) in rows.iter().zip(&images) {
-        let scale = rows
+    for (row, image) in shown.iter().zip(&images) {
+        let scale = shown
             .iter()
             .find(|r| r.technique == row.technique && r.spp == row.spp && r.sampler == "owen-sobol")
             .map_or(row.rmse, |r| r.rmse);
@@ -278,9 +326,9 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
         pic.write_png(&out.join("errors").join(file_name(row)))?;
         errors_of.push(pic);
     }
-    for technique in [Technique::Brdf, Technique::Envmap] {
+    for &technique in &config.techniques {
         for (suffix, pictures) in [("", &pictures), ("-errors", &errors_of)] {
-            let composite = composite(technique, &config.spp, &rows, pictures, suffix);
+            let composite = composite(technique, &config.spp, &shown, pictures, suffix);
             render_composite(
                 &out.join(format!("fig8-{}{suffix}.png", technique.name())),
                 &composite,
@@ -288,7 +336,25 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
         }
     }
     write_atomic(&out.join("render.csv"), csv(&rows).as_bytes())?;
-    let summary = markdown(&rows);
+    let reference_rms = (reference
+        .stderr
+        .iter()
+        .zip(&mask)
+        .filter(|(_, m)| **m)
+        .map(|(s, _)| s * s)
+        .sum::<f64>()
+        / surface as f64)
+        .sqrt();
+    let summary = format!(
+        "{}\n## The reference\n\n{} + {} samples per pixel (BRDF mixture and product warp, balance heuristic): standard error per pixel {:.3e} mean, {:.3e} root mean square (this much of every RMSE above is the reference's own noise, `RMSE² ≈ error² + {:.3e}²`); the standard error of its image mean, which any bias above shares, is at most {:.3e}.\n",
+        markdown(&rows),
+        config.reference_samples,
+        config.reference_samples,
+        reference_stderr,
+        reference_rms,
+        reference_rms,
+        reference_rms / (surface as f64).sqrt(),
+    );
     write_atomic(&out.join("render-summary.md"), summary.as_bytes())?;
     Ok(RenderReport {
         rows,
@@ -313,10 +379,7 @@ fn composite<'a>(
     pictures: &'a [Picture],
     suffix: &str,
 ) -> Composite<'a> {
-    let names: &[&str] = match technique {
-        Technique::Brdf => &BRDF_SAMPLERS,
-        Technique::Envmap => &ENVMAP_SAMPLERS,
-    };
+    let names = lineup::names(technique);
     let cells = names
         .iter()
         .map(|name| {
@@ -393,30 +456,30 @@ mod tests {
         let csv_text = std::fs::read_to_string(out.join("render.csv")).unwrap();
         let mut lines = csv_text.lines();
         assert_eq!(lines.next(), Some(CSV_HEADER));
-        assert_eq!(CSV_HEADER, "technique,sampler,spp,rmse,bias,seconds");
+        assert_eq!(CSV_HEADER, "technique,sampler,spp,seed,rmse,bias,seconds");
         let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
-        assert_eq!(
-            rows.len(),
-            (BRDF_SAMPLERS.len() + ENVMAP_SAMPLERS.len()) * 2
-        );
-        for (technique, names) in [
-            ("brdf", &BRDF_SAMPLERS[..]),
-            ("envmap", &ENVMAP_SAMPLERS[..]),
-        ] {
-            for name in names {
+        let per_seed: usize = Technique::ALL.iter().map(|t| lineup::names(*t).len()).sum();
+        assert_eq!(rows.len(), per_seed * 2 * config.seeds as usize);
+        for t in Technique::ALL {
+            let technique = t.name();
+            for name in lineup::names(t) {
                 for spp in ["4", "16"] {
-                    let row = rows
-                        .iter()
-                        .find(|r| r[0] == technique && r[1] == *name && r[2] == spp)
-                        .unwrap_or_else(|| panic!("no row {technique},{name},{spp}"));
-                    let nums: Vec<f64> = row[3..].iter().map(|v| v.parse().unwrap()).collect();
-                    assert!(
-                        nums[0] > 0.0
-                            && nums[0].is_finite()
-                            && nums[1].is_finite()
-                            && nums[2] >= 0.0,
-                        "{row:?}"
-                    );
+                    for seed in ["0", "1"] {
+                        let row = rows
+                            .iter()
+                            .find(|r| {
+                                r[0] == technique && r[1] == *name && r[2] == spp && r[3] == seed
+                            })
+                            .unwrap_or_else(|| panic!("no row {technique},{name},{spp},{seed}"));
+                        let nums: Vec<f64> = row[4..].iter().map(|v| v.parse().unwrap()).collect();
+                        assert!(
+                            nums[0] > 0.0
+                                && nums[0].is_finite()
+                                && nums[1].is_finite()
+                                && nums[2] >= 0.0,
+                            "{row:?}"
+                        );
+                    }
                     for sub in ["images", "errors"] {
                         let f = out.join(sub).join(format!("{technique}-{name}-{spp}.png"));
                         assert!(f.is_file(), "{}", f.display());
@@ -429,8 +492,10 @@ mod tests {
             "reference.png",
             "fig8-brdf.png",
             "fig8-envmap.png",
+            "fig8-mis.png",
             "fig8-brdf-errors.png",
             "fig8-envmap-errors.png",
+            "fig8-mis-errors.png",
             "brdf-n4/brdf.nuld",
             "brdf-n16/brdf.nuld",
         ] {
@@ -456,6 +521,19 @@ mod tests {
             );
         }
         std::fs::remove_dir_all(&out).unwrap();
+    }
+
+    /// A blob `render` bakes is the one `bake --envmap` would: every setting equal.
+    #[test]
+    fn missing_environment_blobs_are_baked_with_the_bake_commands_defaults() {
+        let target = TrainTarget::envmap_with_bytes(Path::new("sky.hdr"), b"sky");
+        let config = RenderConfig::full(PathBuf::from("sky.hdr"));
+        let render = config.envmap_bake.with_envmap(target.clone());
+        let bake = BakeConfig::envmap(target);
+        assert_eq!(
+            serde_json::to_value(&render).unwrap(),
+            serde_json::to_value(&bake).unwrap()
+        );
     }
 
     #[test]

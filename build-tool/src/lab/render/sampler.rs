@@ -1,6 +1,6 @@
 //! The one interface every sampler of the evaluation implements: for a shading
-//! point, a pixel's key and a count `n`, the `n` directions of the pixel's set and
-//! their estimator weights.
+//! point, a pixel's key and a count `n`, the directions of the pixel's set, their
+//! estimator weights and their densities.
 //!
 //! Estimator (one per pixel, direct lighting from the environment only): with the
 //! samples `(l_i, w_i)` of a pixel's set,
@@ -8,20 +8,27 @@
 //! visibility. The weight carries what the sampler knows of the rest:
 //! * BRDF sampling: `w = f(wo, l) cos / p(l)` for the renderer's warp, and the
 //!   stored albedo `A(roughness, theta_o)` for ours (`∫ L f cos ≈ (A/n) Σ L(l_i)`);
-//! * environment sampling: `w = f(wo, l) cos / pdf_env(l)`.
+//! * environment sampling: `w = f(wo, l) cos / pdf_env(l)`, ours included (its
+//!   exact pdf);
+//! * multiple importance sampling ([`super::mis`]): `2n` samples, `n` of each
+//!   technique, each weight times its power-heuristic weight.
 
 use super::frame::Frame;
 use crate::seeding::{derive_seed, mix64};
 use glam::DVec3;
 
-/// One sample: a unit world direction and its estimator weight (see the module
-/// docs; finite, `>= 0`).
+/// One sample: a unit world direction, its estimator weight (see the module
+/// docs; finite, `>= 0`) and its density.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sample {
     /// Unit direction in the world frame.
     pub direction: DVec3,
     /// Estimator weight.
     pub weight: f64,
+    /// Solid-angle density of the sampler's warp at `direction` (per steradian),
+    /// what [`DirectionSampler::pdf`] returns there; 0 where the sampler knows
+    /// none (ours for the BRDF).
+    pub pdf: f64,
 }
 
 /// What a sampler may know of the point being shaded.
@@ -55,15 +62,26 @@ pub enum Technique {
     Brdf,
     /// The environment map.
     Envmap,
+    /// Both, by multiple importance sampling with the power heuristic.
+    Mis,
 }
 
 impl Technique {
-    /// `brdf` or `envmap` (the `technique` column of `render.csv`).
+    /// Every technique, in table order.
+    pub const ALL: [Technique; 3] = [Technique::Brdf, Technique::Envmap, Technique::Mis];
+
+    /// `brdf`, `envmap` or `mis` (the `technique` column of `render.csv`).
     pub fn name(self) -> &'static str {
         match self {
             Technique::Brdf => "brdf",
             Technique::Envmap => "envmap",
+            Technique::Mis => "mis",
         }
+    }
+
+    /// The technique named `name` ([`Self::name`]).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|t| t.name() == name)
     }
 }
 
@@ -87,14 +105,24 @@ impl PixelKey {
         (self.0 >> 32) as u32
     }
 
-    /// The key's low 32 bits: an Owen scramble seed.
+    /// The key's low 32 bits: an Owen scramble seed, and the random number of our
+    /// unbiased mode.
     pub fn scramble(self) -> u32 {
         self.0 as u32
     }
+
+    /// An independent key for a second technique at the same pixel (the BRDF
+    /// half of multiple importance sampling).
+    pub fn second(self) -> Self {
+        Self(mix64(self.0 ^ SECOND_STREAM))
+    }
 }
 
+/// What [`PixelKey::second`] mixes in.
+const SECOND_STREAM: u64 = 0x5ec0_4d00_b4df_0001;
+
 /// A sampler of directions for the evaluation (see the module docs).
-pub trait DirectionSampler: Sync {
+pub trait DirectionSampler: Send + Sync {
     /// The integral it importance-samples.
     fn technique(&self) -> Technique;
 
@@ -104,4 +132,10 @@ pub trait DirectionSampler: Sync {
     /// The `n` samples of the set of the pixel with key `key` at `at`, into `out`
     /// (cleared first). Deterministic in `(at, key, n)`.
     fn samples(&self, at: &ShadingPoint, key: PixelKey, n: u32, out: &mut Vec<Sample>);
+
+    /// The solid-angle density with which the sampler's warp at `at` produces the
+    /// world direction `l` (0 where it never does), for multiple importance
+    /// sampling; `None` when the sampler cannot say (ours for the BRDF, whose
+    /// samples carry no pdf).
+    fn pdf(&self, at: &ShadingPoint, l: DVec3) -> Option<f64>;
 }

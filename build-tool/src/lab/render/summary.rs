@@ -6,12 +6,17 @@
 //! sampler and left out), with `e_p` the image minus the reference:
 //! `rmse = sqrt((1/P) Σ e_p^2)`, `bias = (1/P) Σ e_p` (each pixel is its own
 //! instance of the sampler, so this is the mean signed error over instances too).
+//!
+//! A render repeats every image at `K` seeds (other scrambles, instances and
+//! pools); the tables give each figure's mean over the seeds and its standard
+//! error `sd / sqrt(K)` ([`Stat`]), so that a difference can be told from the
+//! seed-to-seed spread.
 
 use super::integrator::Image;
 use std::fmt::Write as _;
 
 /// The header of `render.csv`.
-pub const CSV_HEADER: &str = "technique,sampler,spp,rmse,bias,seconds";
+pub const CSV_HEADER: &str = "technique,sampler,spp,seed,rmse,bias,seconds";
 
 /// One line of `render.csv`.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -22,6 +27,8 @@ pub struct Row {
     pub sampler: String,
     /// Samples per pixel.
     pub spp: u32,
+    /// The render's seed (pixel keys, pools).
+    pub seed: u64,
     /// Root mean squared error against the reference.
     pub rmse: f64,
     /// Mean signed error against the reference.
@@ -54,8 +61,8 @@ pub fn csv(rows: &[Row]) -> String {
     for r in rows {
         let _ = writeln!(
             out,
-            "{},{},{},{:.6e},{:.6e},{:.4}",
-            r.technique, r.sampler, r.spp, r.rmse, r.bias, r.seconds
+            "{},{},{},{},{:.6e},{:.6e},{:.4}",
+            r.technique, r.sampler, r.spp, r.seed, r.rmse, r.bias, r.seconds
         );
     }
     out
@@ -77,9 +84,88 @@ fn axes<'a>(rows: &'a [Row], technique: &str) -> (Vec<&'a str>, Vec<u32>) {
     (samplers, spp)
 }
 
-fn find<'a>(rows: &'a [Row], technique: &str, sampler: &str, spp: u32) -> Option<&'a Row> {
-    rows.iter()
-        .find(|r| r.technique == technique && r.sampler == sampler && r.spp == spp)
+/// The mean of a figure over seeds and its standard error.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stat {
+    /// Mean over the seeds.
+    pub mean: f64,
+    /// `sd / sqrt(K)` (sample standard deviation); 0 for one seed.
+    pub stderr: f64,
+    /// Seeds `K`.
+    pub count: usize,
+}
+
+impl Stat {
+    /// Of `values` (at least one).
+    pub fn of(values: &[f64]) -> Self {
+        let k = values.len().max(1) as f64;
+        let mean = values.iter().sum::<f64>() / k;
+        let var = if values.len() > 1 {
+            values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (k - 1.0)
+        } else {
+            0.0
+        };
+        Self {
+            mean,
+            stderr: (var / k).sqrt(),
+            count: values.len(),
+        }
+    }
+
+    /// `mean ± stderr` in `format` (`e` for `{:.3e}`, `+` for `{:+.2e}`); the mean
+    /// alone for one seed.
+    fn show(&self, signed: bool) -> String {
+        let m = if signed {
+            format!("{:+.2e}", self.mean)
+        } else {
+            format!("{:.4e}", self.mean)
+        };
+        match self.count {
+            0 | 1 => m,
+            _ => format!("{m} ± {:.1e}", self.stderr),
+        }
+    }
+}
+
+/// One figure of `rows` for `(technique, sampler, spp)` over its seeds.
+fn stat(
+    rows: &[Row],
+    technique: &str,
+    sampler: &str,
+    spp: u32,
+    f: fn(&Row) -> f64,
+) -> Option<Stat> {
+    let v: Vec<f64> = rows
+        .iter()
+        .filter(|r| r.technique == technique && r.sampler == sampler && r.spp == spp)
+        .map(f)
+        .collect();
+    (!v.is_empty()).then(|| Stat::of(&v))
+}
+
+/// `rows` averaged over seeds: one row per `(technique, sampler, spp)` with the
+/// means of RMSE, bias and time (seed 0), in first-seen order.
+pub fn means(rows: &[Row]) -> Vec<Row> {
+    let mut out: Vec<Row> = Vec::new();
+    for r in rows {
+        if out
+            .iter()
+            .any(|o| o.technique == r.technique && o.sampler == r.sampler && o.spp == r.spp)
+        {
+            continue;
+        }
+        let m = |f: fn(&Row) -> f64| {
+            stat(rows, &r.technique, &r.sampler, r.spp, f).map_or(0.0, |s| s.mean)
+        };
+        out.push(Row {
+            seed: 0,
+            rmse: m(|r| r.rmse),
+            bias: m(|r| r.bias),
+            seconds: m(|r| r.seconds),
+            ..r.clone()
+        });
+    }
+    out
 }
 
 /// RMSE of `sampler` at `seconds` of render time, interpolated linearly in
@@ -107,21 +193,33 @@ pub fn rmse_at_time(rows: &[Row], technique: &str, sampler: &str, seconds: f64) 
 }
 
 /// `render-summary.md`: per technique, the RMSE table at equal sample counts
-/// (rows = samplers, columns = spp; the lowest of each column in bold), the bias
-/// table, and the RMSE table at equal time (the times of `owen-sobol` at each spp;
-/// `–` where a sampler's measured times do not reach).
+/// (rows = samplers, columns = spp; mean ± standard error over the seeds, the
+/// lowest mean of each column in bold), the bias table likewise, and the RMSE
+/// table at equal time (the mean times of `owen-sobol` at each spp; `–` where a
+/// sampler's measured times do not reach).
 pub fn markdown(rows: &[Row]) -> String {
     let mut out = String::from("# Render summary\n");
-    for technique in ["brdf", "envmap"] {
+    let seeds = {
+        let mut s: Vec<u64> = rows.iter().map(|r| r.seed).collect();
+        s.sort_unstable();
+        s.dedup();
+        s.len()
+    };
+    let _ = writeln!(
+        out,
+        "\nEvery figure is the mean over {seeds} seed(s) ± its standard error."
+    );
+    let mean_rows = means(rows);
+    for technique in ["brdf", "envmap", "mis"] {
         let (samplers, spp) = axes(rows, technique);
         if samplers.is_empty() {
             continue;
         }
-        let at = |s: &str, n: u32| find(rows, technique, s, n);
+        let at = |s: &str, n: u32, f: fn(&Row) -> f64| stat(rows, technique, s, n, f);
         let best = |n: u32| {
             samplers
                 .iter()
-                .filter_map(|s| at(s, n).map(|r| r.rmse))
+                .filter_map(|s| at(s, n, |r| r.rmse).map(|st| st.mean))
                 .fold(f64::INFINITY, f64::min)
         };
         let spp_columns: Vec<String> = spp.iter().map(|n| n.to_string()).collect();
@@ -132,9 +230,9 @@ pub fn markdown(rows: &[Row]) -> String {
             &samplers,
             |s, c| {
                 let n = spp[c];
-                at(s, n).map(|r| match r.rmse == best(n) {
-                    true => format!("**{:.4e}**", r.rmse),
-                    false => format!("{:.4e}", r.rmse),
+                at(s, n, |r| r.rmse).map(|st| match st.mean == best(n) {
+                    true => format!("**{}**", st.show(false)),
+                    false => st.show(false),
                 })
             },
         );
@@ -143,11 +241,11 @@ pub fn markdown(rows: &[Row]) -> String {
             &format!("{technique}: bias (mean signed error) at equal sample count"),
             &spp_columns,
             &samplers,
-            |s, c| at(s, spp[c]).map(|r| format!("{:+.2e}", r.bias)),
+            |s, c| at(s, spp[c], |r| r.bias).map(|st| st.show(true)),
         );
         let budgets: Vec<f64> = spp
             .iter()
-            .filter_map(|&n| at("owen-sobol", n).map(|r| r.seconds))
+            .filter_map(|&n| at("owen-sobol", n, |r| r.seconds).map(|st| st.mean))
             .collect();
         if budgets.len() == spp.len() {
             let columns: Vec<String> = spp
@@ -160,7 +258,9 @@ pub fn markdown(rows: &[Row]) -> String {
                 &format!("{technique}: RMSE at equal time (the render times of owen-sobol)"),
                 &columns,
                 &samplers,
-                |s, c| rmse_at_time(rows, technique, s, budgets[c]).map(|e| format!("{e:.4e}")),
+                |s, c| {
+                    rmse_at_time(&mean_rows, technique, s, budgets[c]).map(|e| format!("{e:.4e}"))
+                },
             );
         }
     }
@@ -206,6 +306,7 @@ mod tests {
             technique: "brdf".into(),
             sampler: sampler.into(),
             spp,
+            seed: 0,
             rmse,
             bias: 0.0,
             seconds,
@@ -235,13 +336,37 @@ mod tests {
         assert!((rmse_at_time(&rows, "brdf", "a", 4.0).unwrap() - 0.5).abs() < 1e-12);
         assert!(rmse_at_time(&rows, "brdf", "a", 32.0).is_none());
         let csv = csv(&rows);
-        assert!(csv.starts_with("technique,sampler,spp,rmse,bias,seconds\nbrdf,a,4,"));
+        assert!(csv.starts_with("technique,sampler,spp,seed,rmse,bias,seconds\nbrdf,a,4,0,"));
         let md = markdown(&[
             row("owen-sobol", 4, 1.0, 1.0),
             row("owen-sobol", 64, 0.5, 2.0),
         ]);
         assert!(
             md.contains("**1.0000e0**") && md.contains("equal time"),
+            "{md}"
+        );
+    }
+
+    #[test]
+    fn seeds_average_into_a_mean_and_its_standard_error() {
+        let st = Stat::of(&[1.0, 2.0, 3.0, 6.0]);
+        // mean 3, sample variance (4 + 1 + 0 + 9) / 3, stderr sqrt(14/3 / 4).
+        assert_eq!(st.mean, 3.0);
+        assert!((st.stderr - (14.0f64 / 12.0).sqrt()).abs() < 1e-15);
+        assert_eq!(Stat::of(&[5.0]).stderr, 0.0);
+        let rows: Vec<Row> = [(0, 1.0), (1, 3.0)]
+            .into_iter()
+            .map(|(seed, e)| Row {
+                seed,
+                ..row("owen-sobol", 4, e, 1.0)
+            })
+            .collect();
+        let m = means(&rows);
+        assert_eq!(m.len(), 1);
+        assert_eq!(m[0].rmse, 2.0);
+        let md = markdown(&rows);
+        assert!(
+            md.contains("**2.0000e0 ± 1.0e0**") && md.contains("2 seed(s)"),
             "{md}"
         );
     }
