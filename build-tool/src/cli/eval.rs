@@ -35,6 +35,12 @@ pub enum FigArg {
     /// --sizes, the hierarchical warp by --levels; their state. Writes
     /// envmap-prior.json and envmap-prior.md.
     EnvmapPrior,
+    /// The tabulated glTF metallic-roughness BRDF warp as a prior: cap L2 at
+    /// held-out (roughness, θo, metallic) of Owen-Sobol and of a shifted lattice
+    /// through it, over Owen-Sobol through each condition's exact inverse CDF, by
+    /// --brdf-grids, --sizes and --spaces, beside the VNDF/cosine mixture; their
+    /// state. Writes brdf-prior.json and brdf-prior.md.
+    BrdfPrior,
 }
 
 /// Arguments of `build-tool eval`.
@@ -103,9 +109,16 @@ pub struct EvalArgs {
     /// normals, and the normals of the tree's exact top-level weights.
     #[arg(long, value_delimiter = ',', default_value = "9,13,17")]
     pub grids: Vec<u32>,
-    /// envmap-prior: table sizes, vertices per axis (each >= 2).
+    /// envmap-prior, brdf-prior: table sizes, vertices per axis (each >= 2).
     #[arg(long, value_delimiter = ',', default_value = "32,64,128")]
     pub sizes: Vec<u32>,
+    /// brdf-prior: condition grids RxTxM (roughness, θo, metallic nodes, each >= 1).
+    #[arg(long, value_delimiter = ',', default_value = "10x12x3", value_parser = condition_grid)]
+    pub brdf_grids: Vec<[u32; 3]>,
+    /// brdf-prior: table spaces, `direction` (the light direction's equal-area
+    /// square) and `half-vector` (the half vector's).
+    #[arg(long, value_delimiter = ',', default_value = "direction,half-vector", value_parser = prior_space)]
+    pub spaces: Vec<crate::sphere::brdf_prior::PriorSpace>,
     /// envmap-prior: depths of the hierarchical product warp (`2^L` leaves per
     /// axis; each 3 to 12).
     #[arg(long, value_delimiter = ',', default_value = "8,9,10")]
@@ -154,6 +167,7 @@ pub fn run(a: EvalArgs) -> Result<()> {
         FigArg::All => Figure::ALL.to_vec(),
         FigArg::Conditional => return run_conditional(&a),
         FigArg::EnvmapPrior => return run_envmap_prior(&a),
+        FigArg::BrdfPrior => return run_brdf_prior(&a),
     };
     let s = a.settings();
     s.validate()?;
@@ -219,6 +233,71 @@ fn run_conditional(a: &EvalArgs) -> Result<()> {
         "conditional: {} conditions, {} file(s) in {:.1} s -> {}",
         rep.conditions.len(),
         files.len(),
+        started.elapsed().as_secs_f64(),
+        a.out.display()
+    );
+    Ok(())
+}
+
+/// `RxTxM`, each in `1..=64`.
+fn condition_grid(s: &str) -> Result<[u32; 3], String> {
+    let bad = || format!("{s:?} is not a grid RxTxM with each in 1..=64");
+    let v: Vec<u32> = s
+        .split('x')
+        .map(|p| {
+            p.trim()
+                .parse::<u32>()
+                .ok()
+                .filter(|n| (1..=64).contains(n))
+        })
+        .collect::<Option<_>>()
+        .ok_or_else(bad)?;
+    v.try_into().map_err(|_| bad())
+}
+
+/// `direction` or `half-vector`.
+fn prior_space(s: &str) -> Result<crate::sphere::brdf_prior::PriorSpace, String> {
+    use crate::sphere::brdf_prior::PriorSpace;
+    [PriorSpace::Direction, PriorSpace::HalfVector]
+        .into_iter()
+        .find(|p| p.name() == s.trim())
+        .ok_or_else(|| format!("{s:?} is not a table space: direction or half-vector"))
+}
+
+/// `build-tool eval brdf-prior`: measures, writes, prints.
+fn run_brdf_prior(a: &EvalArgs) -> Result<()> {
+    use crate::lab::eval::brdf_prior::{evaluate, markdown, BrdfPriorSettings};
+    anyhow::ensure!(
+        a.sizes.iter().all(|&v| v >= 2),
+        "--sizes needs values of at least 2"
+    );
+    let s = BrdfPriorSettings {
+        grids: a.brdf_grids.clone(),
+        sizes: a.sizes.clone(),
+        spaces: a.spaces.clone(),
+        n: u32::try_from(a.n).map_err(|_| anyhow::anyhow!("--n {} is too large", a.n))?,
+        ..BrdfPriorSettings::default()
+    };
+    crate::output::ensure_dir(&a.out)?;
+    let started = Instant::now();
+    let total = (s.conditions + s.spaces.len() * s.grids.len() * s.sizes.len()) as u64;
+    let progress = crate::progress::Progress::stderr("brdf-prior", total, "step");
+    let rows = evaluate(&s, &|what| {
+        progress.set_message(what.to_string());
+        progress.inc(1);
+    })?;
+    progress.finish();
+    let table = markdown(&rows);
+    let json = serde_json::to_string_pretty(&serde_json::json!({
+        "settings": s,
+        "rows": rows,
+    }))?;
+    crate::output::write_atomic(&a.out.join("brdf-prior.json"), json.as_bytes())?;
+    crate::output::write_atomic(&a.out.join("brdf-prior.md"), table.as_bytes())?;
+    print!("{table}");
+    eprintln!(
+        "brdf-prior: {} configurations in {:.1} s -> {}",
+        rows.len(),
         started.elapsed().as_secs_f64(),
         a.out.display()
     );

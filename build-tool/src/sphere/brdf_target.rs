@@ -1,10 +1,13 @@
-//! `brdf:ROUGHNESS,THETA_O_DEG` (and `brdf-burley:ROUGHNESS,THETA_O_DEG`): the
-//! cosine-weighted BRDF of [`nuld_core::brdf`] (glTF 2.0 by default, Burley on
-//! request) as a density of light directions `wi` on the upper hemisphere,
+//! `brdf:ROUGHNESS,THETA_O_DEG[,METALLIC]` (and `brdf-burley:ROUGHNESS,THETA_O_DEG`):
+//! the cosine-weighted BRDF of [`nuld_core::brdf`] (glTF 2.0 by default, with
+//! `metallic` in `[0, 1]`, 0 when left out; Burley on request) as a density of
+//! light directions `wi` on the upper hemisphere,
 //! `q(wi) = f(wo, wi) max(n.wi, 0) / A(wo)`, with `A` the directional albedo.
 //!
-//! * **Normalizer** `A`: [`directional_albedo`], a Gauss–Legendre rule over half
-//!   vectors (error below `1e-10`), split into the diffuse and specular layers.
+//! * **Normalizer** `A`: [`directional_albedo_metallic`] (the dielectric's
+//!   [`directional_albedo`] at `metallic = 0`, bit for bit), a Gauss–Legendre rule
+//!   over half vectors (error below `1e-10`), split into the diffuse and specular
+//!   layers.
 //! * **Baseline warp** ([`BrdfTarget::sample`]): what a renderer does: GGX
 //!   visible-normal sampling (Heitz 2018) with probability `A_spec / A`, else Malley
 //!   cosine sampling; a direction below the horizon (possible for VNDF) is mirrored
@@ -12,7 +15,8 @@
 //! * **Exact samples** ([`BrdfTarget::sample_target`]): rejection from the mixture
 //!   `p = w p_vndf + (1 - w) p_cos`, `p_vndf = G1(wo) D / (4 n.wo)`. The specular layer
 //!   satisfies `f_spec cos <= p_vndf`: for glTF `F D Vis (n.wi) = F D G2 / (4 n.wo)`
-//!   with the height-correlated `G2 = 1/(1 + Λ(wo) + Λ(wi)) <= G1(wo)`, for Burley
+//!   with the height-correlated `G2 = 1/(1 + Λ(wo) + Λ(wi)) <= G1(wo)` (the
+//!   metallic layer `((1 - m) F + m) D Vis` too, its factor being at most 1), for Burley
 //!   `F D G1(wo) G1(wi) / (4 n.wo)` with `G1(wi) <= 1`; and the diffuse layer
 //!   `f_diff cos <= c_d p_cos` with `c_d = 1 - F0` for glTF (`(1 - F)/pi <= (1 - F0)/pi`)
 //!   and, for Burley,
@@ -27,14 +31,15 @@
 //!   rule), checked against exact samples in the tests. Building it takes ~0.1 s.
 //!   [`DirectionDensity::cap_measure_profile`] uses a `2^16`-point rule (coarser).
 
-use super::brdf_albedo::directional_albedo;
+use super::brdf_albedo::{directional_albedo, directional_albedo_metallic};
 use super::cap_table::{profile_of_rule, CapMeasureTable};
 use super::target::{normalize_rule, spec_num, DirectionDensity, DirectionSpecError};
 use crate::seeding::mix64;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
 use nuld_core::brdf::{
-    alpha, view_direction, BrdfModel, F0, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS,
+    alpha, gltf_metallic, view_direction, BrdfModel, F0, MAX_METALLIC, MAX_ROUGHNESS,
+    MAX_THETA_O_DEG, MIN_METALLIC, MIN_ROUGHNESS,
 };
 use nuld_core::warp::{
     brdf_mixture_pdf, brdf_mixture_real, cosine_hemisphere_pdf, ggx_vndf_reflected_pdf,
@@ -56,6 +61,7 @@ pub struct BrdfTarget {
     model: BrdfModel,
     roughness: f64,
     theta_o_deg: f64,
+    metallic: f64,
     wo: DVec3,
     alpha: f64,
     domain: Domain,
@@ -89,8 +95,25 @@ impl BrdfTarget {
     ) -> Result<Self, DirectionSpecError> {
         Self::with_rules(
             model,
-            roughness,
-            theta_o_deg,
+            [roughness, theta_o_deg, 0.0],
+            domain,
+            TABLE_POINTS,
+            PROFILE_POINTS,
+        )
+    }
+
+    /// The glTF 2.0 metallic-roughness target ([`nuld_core::brdf::gltf_metallic`],
+    /// base colour 1) with `metallic` in `[0, 1]`: [`BrdfTarget::new`] at
+    /// `metallic = 0`, a metal without diffuse layer at 1.
+    pub fn metallic(
+        roughness: f64,
+        theta_o_deg: f64,
+        metallic: f64,
+        domain: Domain,
+    ) -> Result<Self, DirectionSpecError> {
+        Self::with_rules(
+            BrdfModel::Gltf,
+            [roughness, theta_o_deg, metallic],
             domain,
             TABLE_POINTS,
             PROFILE_POINTS,
@@ -108,22 +131,22 @@ impl BrdfTarget {
     ) -> Result<Self, DirectionSpecError> {
         Self::with_rules(
             BrdfModel::Gltf,
-            roughness,
-            theta_o_deg,
+            [roughness, theta_o_deg, 0.0],
             Domain::Hemisphere,
             table_points,
             table_points,
         )
     }
 
+    /// The target at `[roughness, theta_o_deg, metallic]` (metallic only for glTF).
     fn with_rules(
         model: BrdfModel,
-        roughness: f64,
-        theta_o_deg: f64,
+        condition: [f64; 3],
         domain: Domain,
         table_points: usize,
         profile_points: usize,
     ) -> Result<Self, DirectionSpecError> {
+        let [roughness, theta_o_deg, metallic] = condition;
         let kind = spec_kind(model);
         if !(MIN_ROUGHNESS..=MAX_ROUGHNESS).contains(&roughness) {
             return Err(DirectionSpecError::OutOfRange {
@@ -141,9 +164,27 @@ impl BrdfTarget {
                 range: "[0, 89]",
             });
         }
+        let metal_range = match model {
+            BrdfModel::Gltf => MIN_METALLIC..=MAX_METALLIC,
+            BrdfModel::Burley => 0.0..=0.0,
+        };
+        if !metal_range.contains(&metallic) {
+            return Err(DirectionSpecError::OutOfRange {
+                kind,
+                param: "METALLIC",
+                value: metallic,
+                range: match model {
+                    BrdfModel::Gltf => "[0, 1]",
+                    BrdfModel::Burley => "[0, 0] (Burley is a dielectric)",
+                },
+            });
+        }
         let wo = view_direction(theta_o_deg);
         let a = alpha(roughness);
-        let parts = directional_albedo(model, roughness, theta_o_deg);
+        let parts = match model {
+            BrdfModel::Gltf => directional_albedo_metallic(roughness, theta_o_deg, metallic),
+            BrdfModel::Burley => directional_albedo(model, roughness, theta_o_deg),
+        };
         let total = parts.total();
         let what = format!("{kind}:{},{}", spec_num(roughness), spec_num(theta_o_deg));
         if !total.is_finite() {
@@ -167,6 +208,7 @@ impl BrdfTarget {
             model,
             roughness,
             theta_o_deg,
+            metallic,
             wo,
             alpha: a,
             domain,
@@ -194,6 +236,26 @@ impl BrdfTarget {
     /// The view angle in degrees.
     pub fn theta_o_deg(&self) -> f64 {
         self.theta_o_deg
+    }
+
+    /// glTF `metallic` in `[0, 1]` (0 for Burley).
+    pub fn metallic_value(&self) -> f64 {
+        self.metallic
+    }
+
+    /// `f(wo, wi) max(n.wi, 0)` of this target's model and condition.
+    pub fn cosine_weighted(&self, wi: DVec3) -> f64 {
+        match self.model {
+            BrdfModel::Gltf => {
+                gltf_metallic(
+                    self.wo.to_array(),
+                    wi.to_array(),
+                    self.roughness,
+                    self.metallic,
+                ) * wi.z.max(0.0)
+            }
+            BrdfModel::Burley => self.model.cosine_weighted(self.wo, wi, self.roughness),
+        }
     }
 
     /// The view direction `wo`.
@@ -252,7 +314,7 @@ impl BrdfTarget {
             if wi.z <= 0.0 {
                 return;
             }
-            let q = self.model.cosine_weighted(self.wo, wi, self.roughness) / a;
+            let q = self.cosine_weighted(wi) / a;
             let p = ns * self.pdf_vndf(wi) + nc * wi.z / PI;
             if q > 0.0 && p > 0.0 {
                 rule.push((wi, q / p));
@@ -287,8 +349,12 @@ impl BrdfTarget {
 
 impl DirectionDensity for BrdfTarget {
     fn spec(&self) -> String {
+        let metallic = match self.metallic {
+            0.0 => String::new(),
+            m => format!(",{}", spec_num(m)),
+        };
         format!(
-            "{}:{},{}",
+            "{}:{},{}{metallic}",
             spec_kind(self.model),
             spec_num(self.roughness),
             spec_num(self.theta_o_deg)
@@ -300,7 +366,7 @@ impl DirectionDensity for BrdfTarget {
     }
 
     fn pdf(&self, w: DVec3) -> f64 {
-        self.model.cosine_weighted(self.wo, w, self.roughness) / self.albedo()
+        self.cosine_weighted(w) / self.albedo()
     }
 
     /// The baseline warp, [`brdf_mixture_real`] with `p_s = A_spec / A`:
@@ -338,7 +404,7 @@ impl DirectionDensity for BrdfTarget {
             if wi.z <= 0.0 {
                 continue;
             }
-            let f = self.model.cosine_weighted(self.wo, wi, self.roughness);
+            let f = self.cosine_weighted(wi);
             let p = self.pdf_proposal(wi);
             if rng.random::<f64>() * self.bound * p <= f {
                 return wi.normalize();
@@ -392,9 +458,32 @@ mod tests {
         // Independent check of the normalizer: a plain equal-area grid over the whole
         // sphere, where it resolves the lobe.
         for (r, t) in [(0.5, 0.0), (0.6, 45.0), (0.8, 80.0), (1.0, 30.0)] {
-            let b = BrdfTarget::new(r, t, Domain::Hemisphere).unwrap();
-            let s = sphere_integral(1500, |w| b.pdf(w));
-            assert!((s - 1.0).abs() < 3e-4, "r={r} t={t}: {s}");
+            for m in [0.0, 0.5, 1.0] {
+                let b = BrdfTarget::metallic(r, t, m, Domain::Hemisphere).unwrap();
+                let s = sphere_integral(1500, |w| b.pdf(w));
+                assert!((s - 1.0).abs() < 3e-4, "r={r} t={t} m={m}: {s}");
+            }
+        }
+    }
+
+    #[test]
+    fn metallic_zero_is_the_dielectric_and_the_spec_names_the_metal() {
+        let d = BrdfTarget::new(0.3, 40.0, Domain::Hemisphere).unwrap();
+        let m0 = BrdfTarget::metallic(0.3, 40.0, 0.0, Domain::Hemisphere).unwrap();
+        let mut g = rng(5, 6);
+        for _ in 0..1000 {
+            let w = random_direction(&mut g);
+            assert_eq!(d.pdf(w).to_bits(), m0.pdf(w).to_bits());
+        }
+        assert_eq!(m0.spec(), "brdf:0.3,40");
+        let metal = BrdfTarget::metallic(0.3, 40.0, 1.0, Domain::Hemisphere).unwrap();
+        assert_eq!(metal.spec(), "brdf:0.3,40,1");
+        // No diffuse layer: the whole albedo is specular, and the mixture warp
+        // picks the GGX lobe always.
+        assert_eq!(metal.albedo_parts().0, 0.0);
+        assert_eq!(metal.lobe_probability(), 1.0);
+        for bad in [-0.1, 1.5, f64::NAN] {
+            assert!(BrdfTarget::metallic(0.3, 40.0, bad, Domain::Hemisphere).is_err());
         }
     }
 
@@ -420,8 +509,14 @@ mod tests {
         // Exact (rejection) samples vs the tabulated cap measure, 3 standard errors:
         // two independent routes to mu(C).
         let mut g = rng(23, 0);
-        for (r, t) in [(0.1, 20.0), (0.35, 60.0), (0.9, 75.0)] {
-            let b = BrdfTarget::new(r, t, Domain::Hemisphere).unwrap();
+        for (r, t, m) in [
+            (0.1, 20.0, 0.0),
+            (0.35, 60.0, 0.0),
+            (0.9, 75.0, 0.0),
+            (0.2, 50.0, 1.0),
+            (0.6, 30.0, 0.5),
+        ] {
+            let b = BrdfTarget::metallic(r, t, m, Domain::Hemisphere).unwrap();
             let n = 200_000;
             let pts: Vec<DVec3> = (0..n).map(|_| b.sample_target(&mut g)).collect();
             assert!(pts

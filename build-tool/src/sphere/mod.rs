@@ -30,6 +30,7 @@
 //! A cap is `C(w, t) = {x : <w, x> >= t}`, `t = cos theta`.
 
 pub mod brdf_albedo;
+pub mod brdf_prior;
 pub mod brdf_target;
 pub mod cap_table;
 pub mod closed_form;

@@ -56,13 +56,16 @@ pub fn parse_direction_spec(
             Ok(Box::new(CosineDirections { hemisphere }))
         }
         "brdf" => {
-            let p = params(
-                "brdf",
-                "brdf:ROUGHNESS,THETA_O_DEG",
-                &["ROUGHNESS", "THETA_O_DEG"],
-                rest,
-            )?;
-            Ok(Box::new(BrdfTarget::new(p[0], p[1], domain)?))
+            // METALLIC is optional: two numbers are the dielectric.
+            let names: &[&'static str] = match rest.map_or(0, |r| r.matches(',').count()) {
+                2 => &["ROUGHNESS", "THETA_O_DEG", "METALLIC"],
+                _ => &["ROUGHNESS", "THETA_O_DEG"],
+            };
+            let p = params("brdf", "brdf:ROUGHNESS,THETA_O_DEG[,METALLIC]", names, rest)?;
+            let metallic = p.get(2).copied().unwrap_or(0.0);
+            Ok(Box::new(BrdfTarget::metallic(
+                p[0], p[1], metallic, domain,
+            )?))
         }
         "brdf-burley" => {
             let p = params(
@@ -140,7 +143,7 @@ mod tests {
             ("uniform:3", "takes 0 parameter"),
             (
                 "brdf:0.5",
-                "takes 2 parameter(s) (brdf:ROUGHNESS,THETA_O_DEG), got 1",
+                "takes 2 parameter(s) (brdf:ROUGHNESS,THETA_O_DEG[,METALLIC]), got 1",
             ),
             ("brdf:x,30", "ROUGHNESS = `x` is not a number"),
             ("brdf:0.09,30", "ROUGHNESS = 0.09 is outside [0.1, 1]"),

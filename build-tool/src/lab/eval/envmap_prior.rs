@@ -13,17 +13,13 @@
 //! the tables' resolution; the lattice shows what structure in primary space
 //! keeps through the warp.
 
-use crate::baselines::{seeded_owen_sobol, warped_owen_sobol_directions};
-use crate::seeding::{derive_seed, rng};
-use crate::sphere::metrics::{CapRadius, MeasuredCaps};
-use crate::sphere::{DirectionDensity, EnvmapDensity, EnvmapPrior, EnvmapTree};
-use crate::train::lattice_generator;
+use super::prior_judge::{score, Judge, JudgeSettings};
+use crate::seeding::rng;
+use crate::sphere::{EnvmapDensity, EnvmapPrior, EnvmapTree};
 use anyhow::Result;
 use glam::{DVec2, DVec3};
-use nuld_core::network::shifted_lattice_point;
 use nuld_core::sphere::square_to_sphere;
 use rand::Rng;
-use rayon::prelude::*;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -82,19 +78,6 @@ pub struct PriorRow {
     pub lattice: (f64, f64),
 }
 
-/// A held-out normal's judge: its caps and the baseline's mean cap L2.
-struct Judge {
-    normal: DVec3,
-    caps: MeasuredCaps,
-    baseline: f64,
-}
-
-impl Judge {
-    fn d(&self, pts: &[DVec3]) -> f64 {
-        self.caps.l2_squared(pts, CapRadius::ThetaUniform).0.sqrt()
-    }
-}
-
 /// The figures of every `(grid, size)` of `s` on `map`, with `progress` told
 /// after each held-out normal's judge and each configuration.
 pub fn evaluate(
@@ -102,33 +85,21 @@ pub fn evaluate(
     s: &PriorSettings,
     progress: &dyn Fn(&str),
 ) -> Result<Vec<PriorRow>> {
-    let n = s.n as usize;
+    let judging = JudgeSettings {
+        n: s.n,
+        instances: s.instances,
+        caps: s.caps,
+        seed: s.seed,
+    };
     let mut r = rng(s.seed, 0x7072_696f);
-    let mut judges = Vec::new();
+    let mut judges: Vec<Judge<DVec3>> = Vec::new();
     for index in 0..s.normals {
         let normal = square_to_sphere(DVec2::new(r.random(), r.random()));
         let (lit, irradiance) = map.cosine_weighted(normal)?;
         if irradiance <= 0.0 {
             continue;
         }
-        let caps = MeasuredCaps::draw(
-            s.caps,
-            derive_seed(s.seed, index as u64),
-            CapRadius::ThetaUniform,
-            |w, t| lit.cap_measure(w, t),
-        );
-        let mut judge = Judge {
-            normal,
-            caps,
-            baseline: 0.0,
-        };
-        judge.baseline = mean(
-            (0..s.instances as u64)
-                .into_par_iter()
-                .map(|k| judge.d(&warped_owen_sobol_directions(&lit, n, s.seed ^ (k + 1))))
-                .collect(),
-        );
-        judges.push(judge);
+        judges.push(Judge::new(normal, &lit, &judging, index as u64));
         progress(&format!("normal {index} judged"));
     }
     anyhow::ensure!(!judges.is_empty(), "no held-out normal receives light");
@@ -139,7 +110,8 @@ pub fn evaluate(
             let prior = EnvmapPrior::new(map, grid, size)?;
             let build_s = t.elapsed().as_secs_f64();
             let warp = prior.warp();
-            let (owen_sobol, lattice) = score(&judges, s, &|n, u| prior.sample(&warp, n, u).0);
+            let (owen_sobol, lattice) =
+                score(&judges, &judging, &|n, u| prior.sample(&warp, *n, u).0);
             rows.push(PriorRow {
                 kind: "table",
                 grid,
@@ -158,8 +130,8 @@ pub fn evaluate(
             let tree = EnvmapTree::new(map, levels, grid)?;
             let build_s = t.elapsed().as_secs_f64();
             let core = tree.tree();
-            let warp = |n, u| EnvmapTree::sample(&core, n, u).0;
-            let (owen_sobol, lattice) = score(&judges, s, &warp);
+            let warp = |n: &DVec3, u| EnvmapTree::sample(&core, *n, u).0;
+            let (owen_sobol, lattice) = score(&judges, &judging, &warp);
             rows.push(PriorRow {
                 kind: "tree",
                 grid,
@@ -175,51 +147,6 @@ pub fn evaluate(
         }
     }
     Ok(rows)
-}
-
-/// `(mean, worst)` over the judges of Owen-Sobol and of shifted-lattice sets
-/// mapped by `warp(normal, primary point)`, each over the judge's baseline.
-fn score(
-    judges: &[Judge],
-    s: &PriorSettings,
-    warp: &(dyn Fn(DVec3, DVec2) -> DVec3 + Sync),
-) -> ((f64, f64), (f64, f64)) {
-    let n = s.n as usize;
-    let g = lattice_generator(s.n);
-    let through = |normal: DVec3, primary: &[DVec2]| -> Vec<DVec3> {
-        primary.iter().map(|&u| warp(normal, u)).collect()
-    };
-    let (mut os, mut lat) = (Vec::new(), Vec::new());
-    for (j, judge) in judges.iter().enumerate() {
-        let owen: Vec<f64> = (0..s.instances as u64)
-            .into_par_iter()
-            .map(|k| {
-                judge.d(&through(
-                    judge.normal,
-                    &seeded_owen_sobol(n, s.seed ^ (k + 1)),
-                ))
-            })
-            .collect();
-        let lattice: Vec<f64> = (0..s.instances as u64)
-            .into_par_iter()
-            .map(|k| {
-                let mut z = rng(s.seed, (j as u64) << 32 | k);
-                let shift = [z.random::<f64>(), z.random::<f64>()];
-                let pts: Vec<DVec2> = (0..s.n)
-                    .map(|i| DVec2::from(shifted_lattice_point(i, s.n, g, shift)))
-                    .collect();
-                judge.d(&through(judge.normal, &pts))
-            })
-            .collect();
-        os.push(mean(owen) / judge.baseline);
-        lat.push(mean(lattice) / judge.baseline);
-    }
-    let summary = |v: &[f64]| (mean(v.to_vec()), v.iter().copied().fold(0.0, f64::max));
-    (summary(&os), summary(&lat))
-}
-
-fn mean(v: Vec<f64>) -> f64 {
-    v.iter().sum::<f64>() / v.len().max(1) as f64
 }
 
 /// The rows as a Markdown table.

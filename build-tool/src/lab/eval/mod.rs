@@ -22,12 +22,14 @@
 //! [`conditional`] is the quality report of a conditional BRDF sampler (paper §4)
 //! on held-out conditions (`build-tool eval conditional`).
 
+pub mod brdf_prior;
 pub mod cache;
 pub mod conditional;
 pub mod envmap_prior;
 pub mod figures;
 pub mod integrands;
 pub mod methods;
+pub mod prior_judge;
 pub mod report;
 pub mod rows;
 pub mod runner;

@@ -1,0 +1,317 @@
+//! A tabulated conditional warp of the glTF metallic-roughness BRDF, the candidate
+//! prior of the BRDF sampler: `f(wo, wi) max(n.wi, 0)` tabulated on a square for
+//! each node of a grid of conditions `(roughness, θo, metallic)`, blended
+//! trilinearly between the nodes and sampled exactly ([`nuld_core::marginal2d`]).
+//!
+//! * **Nodes**: `G_r x G_t x G_m` conditions at the vertices of a regular grid over
+//!   roughness `[0.1, 1]`, `θo` `[0°, 89°]` and metallic `[0, 1]`. Before
+//!   normalization the target is linear in metallic, so two metallic nodes blended
+//!   as the tables are blend the albedo-weighted lobes, not the lobes at the
+//!   query's metallic: the warp still samples the blend exactly.
+//! * **Space** ([`PriorSpace`]): the square of the tables is the hemisphere's
+//!   equal-area square of either the light direction `wi` itself, or of the half
+//!   vector `h`, with `wi = reflect(wo, h) = 2 (wo.h) h - wo`. In half-vector space
+//!   the specular peak sits at `h = n` for every view, so tables of neighbouring
+//!   `θo` agree where the lobe is; the density there is the direction's times
+//!   `|dwi/dh| = 4 |wo.h|` (0 where `wo.h <= 0` or `wi` is below the horizon).
+//! * **Tables**: `S x S` vertices; vertex `(i, j)` holds the mean of the density
+//!   over `k x k` points of its dual cell clipped to the square (`k` from
+//!   [`SUPERSAMPLED_AXIS`]), so a lobe narrower than the vertex spacing still
+//!   lands in the table.
+//! * **Exactness**: whatever the tables approximate, the warp's pdf is the density
+//!   of its samples (`f cos / pdf` is an unbiased estimate); how well the tables
+//!   follow `f cos` decides the variance and how much low discrepancy survives
+//!   the warp (`build-tool eval brdf-prior`).
+
+use glam::{DVec2, DVec3};
+use nuld_core::brdf::{
+    gltf_metallic, view_direction, MAX_METALLIC, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_METALLIC,
+    MIN_ROUGHNESS,
+};
+use nuld_core::marginal2d::{tabulate, Blend, Marginal2D, Marginal2DError, Marginal2DShape};
+use nuld_core::sphere::{hemisphere_to_square, square_to_hemisphere};
+use rayon::prelude::*;
+use std::f64::consts::PI;
+
+/// Points per axis of the supersampling grid over the whole square (the `k` of
+/// the module docs is this over the table's vertices, at least 1).
+pub const SUPERSAMPLED_AXIS: u32 = 1024;
+
+/// Which square the tables live on (module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum PriorSpace {
+    /// The equal-area square of the light direction `wi`.
+    Direction,
+    /// The equal-area square of the half vector `h`.
+    HalfVector,
+}
+
+impl PriorSpace {
+    /// `direction` or `half-vector`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Direction => "direction",
+            Self::HalfVector => "half-vector",
+        }
+    }
+
+    /// The light direction of the square point `p` for the view `wo`, and
+    /// `|dwi/dω_p|`, the solid angle of `wi` per solid angle of the table's own
+    /// direction (1 for [`Self::Direction`]); `None` below the horizon.
+    fn direction(self, wo: DVec3, p: DVec2) -> Option<(DVec3, f64)> {
+        let d = square_to_hemisphere(p);
+        match self {
+            Self::Direction => (d.z > 0.0).then_some((d, 1.0)),
+            Self::HalfVector => {
+                let c = wo.dot(d);
+                let wi = 2.0 * c * d - wo;
+                (c > 0.0 && wi.z > 0.0).then(|| (wi.normalize(), 4.0 * c))
+            }
+        }
+    }
+
+    /// The square point of the light direction `wi` for `wo` and the same
+    /// Jacobian; `None` where no table point maps to `wi`.
+    fn point(self, wo: DVec3, wi: DVec3) -> Option<(DVec2, f64)> {
+        if wi.z <= 0.0 {
+            return None;
+        }
+        match self {
+            Self::Direction => Some((hemisphere_to_square(wi), 1.0)),
+            Self::HalfVector => {
+                let h = (wo + wi).normalize();
+                let c = wo.dot(h);
+                (h.z > 0.0 && c > 0.0).then(|| (hemisphere_to_square(h), 4.0 * c))
+            }
+        }
+    }
+}
+
+/// The tabulated BRDF warp (module docs).
+#[derive(Clone, Debug)]
+pub struct BrdfPrior {
+    /// Nodes per condition axis `[G_r, G_t, G_m]`.
+    pub grid: [u32; 3],
+    /// The square the tables live on.
+    pub space: PriorSpace,
+    /// The tables' shape: `S x S` vertices, `G_r G_t G_m` nodes.
+    pub shape: Marginal2DShape,
+    /// Normalized vertex values, node `r + G_r (t + G_t m)` after node.
+    pub data: Vec<f32>,
+    /// Marginal CDFs.
+    pub marginal: Vec<f32>,
+    /// Conditional CDFs.
+    pub conditional: Vec<f32>,
+}
+
+/// The condition of grid node `i` of `count` along `[lo, hi]`.
+fn node_value(i: u32, count: u32, lo: f64, hi: f64) -> f64 {
+    match count {
+        0 | 1 => lo,
+        c => lo + (hi - lo) * i as f64 / (c - 1) as f64,
+    }
+}
+
+/// `(x - lo) / (hi - lo)`.
+fn unit(x: f64, lo: f64, hi: f64) -> f64 {
+    (x - lo) / (hi - lo)
+}
+
+impl BrdfPrior {
+    /// The prior on `grid` condition nodes and `size x size` table vertices in
+    /// `space`, tables in `f32` (as a blob would store them). `O(nodes R^2)` with
+    /// `R` = [`SUPERSAMPLED_AXIS`], in parallel over the nodes; the same bits for
+    /// any thread count. An error if `size` is below 2, a grid axis is 0, or a
+    /// node's table has no mass.
+    pub fn new(grid: [u32; 3], size: u32, space: PriorSpace) -> Result<Self, Marginal2DError> {
+        if size < 2 || grid.contains(&0) {
+            return Err(Marginal2DError::Shape);
+        }
+        let nodes = grid[0]
+            .checked_mul(grid[1])
+            .and_then(|n| n.checked_mul(grid[2]))
+            .ok_or(Marginal2DError::Shape)?;
+        let shape = Marginal2DShape {
+            size: [size, size],
+            nodes,
+        };
+        let s = size as usize;
+        let k = SUPERSAMPLED_AXIS.div_ceil(size).max(1) as usize;
+        let h = 1.0 / (s - 1) as f64;
+        let tables: Vec<Vec<f32>> = (0..nodes)
+            .into_par_iter()
+            .map(|node| {
+                let [r, t, m] = Self::node_condition(grid, node);
+                let wo = view_direction(t);
+                let mut out = vec![0.0f32; s * s];
+                for j in 0..s {
+                    for i in 0..s {
+                        let mut sum = 0.0;
+                        for b in 0..k {
+                            for a in 0..k {
+                                // The dual cell of vertex (i, j), clipped to the square.
+                                let at = |v: usize, q: usize| {
+                                    ((v as f64 - 0.5 + (q as f64 + 0.5) / k as f64) * h)
+                                        .clamp(0.0, 1.0)
+                                };
+                                let p = DVec2::new(at(i, a), at(j, b));
+                                if let Some((wi, jac)) = space.direction(wo, p) {
+                                    sum += gltf_metallic(wo.to_array(), wi.to_array(), r, m)
+                                        * wi.z
+                                        * jac;
+                                }
+                            }
+                        }
+                        out[j * s + i] = (sum / (k * k) as f64) as f32;
+                    }
+                }
+                out
+            })
+            .collect();
+        let mut data = tables.concat();
+        let mut marginal = vec![0.0; shape.marginal_len().ok_or(Marginal2DError::Shape)?];
+        let mut conditional = vec![0.0; data.len()];
+        tabulate(shape, &mut data, &mut marginal, &mut conditional)?;
+        Ok(Self {
+            grid,
+            space,
+            shape,
+            data,
+            marginal,
+            conditional,
+        })
+    }
+
+    /// `[roughness, θo in degrees, metallic]` of node `node` of `grid`.
+    pub fn node_condition(grid: [u32; 3], node: u32) -> [f64; 3] {
+        let (i, rest) = (node % grid[0], node / grid[0]);
+        let (j, l) = (rest % grid[1], rest / grid[1]);
+        [
+            node_value(i, grid[0], MIN_ROUGHNESS, MAX_ROUGHNESS),
+            node_value(j, grid[1], 0.0, MAX_THETA_O_DEG),
+            node_value(l, grid[2], MIN_METALLIC, MAX_METALLIC),
+        ]
+    }
+
+    /// The warp over the tables.
+    pub fn warp(&self) -> Marginal2D<'_, f32> {
+        Marginal2D::new(self.shape, &self.data, &self.marginal, &self.conditional)
+            .expect("tables written by tabulate")
+    }
+
+    /// The blend of the nodes around `[roughness, θo in degrees, metallic]`.
+    pub fn blend(&self, condition: [f64; 3]) -> Blend<f32> {
+        let [r, t, m] = condition;
+        let params = [
+            unit(r, MIN_ROUGHNESS, MAX_ROUGHNESS) as f32,
+            unit(t, 0.0, MAX_THETA_O_DEG) as f32,
+            unit(m, MIN_METALLIC, MAX_METALLIC) as f32,
+        ];
+        Blend::multilinear(&params, &self.grid)
+    }
+
+    /// The light direction at primary sample `u` for `condition`, and its
+    /// solid-angle pdf (per steradian); `(+z, 0)` for the rare table point whose
+    /// direction lies below the horizon (a vertex of zero value next to a
+    /// positive one).
+    pub fn sample(
+        &self,
+        warp: &Marginal2D<'_, f32>,
+        condition: [f64; 3],
+        u: DVec2,
+    ) -> (DVec3, f64) {
+        let wo = view_direction(condition[1]);
+        let (p, pdf) = warp.sample([u.x as f32, u.y as f32], &self.blend(condition));
+        let p = DVec2::new(p[0] as f64, p[1] as f64);
+        match self.space.direction(wo, p) {
+            Some((wi, jac)) => (wi, pdf as f64 / (2.0 * PI * jac)),
+            None => (DVec3::Z, 0.0),
+        }
+    }
+
+    /// The solid-angle pdf of [`Self::sample`] at the unit direction `wi`.
+    pub fn pdf(&self, warp: &Marginal2D<'_, f32>, condition: [f64; 3], wi: DVec3) -> f64 {
+        let wo = view_direction(condition[1]);
+        match self.space.point(wo, wi) {
+            Some((p, jac)) => {
+                let pdf = warp.pdf([p.x as f32, p.y as f32], &self.blend(condition));
+                pdf as f64 / (2.0 * PI * jac)
+            }
+            None => 0.0,
+        }
+    }
+
+    /// Bytes of the tables as `f32`: data, conditional and marginal CDFs.
+    pub fn state_bytes(&self) -> usize {
+        4 * (self.data.len() + self.conditional.len() + self.marginal.len())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::seeding::rng;
+    use crate::sphere::brdf_albedo::directional_albedo_metallic;
+    use rand::Rng;
+
+    /// `(1/M) Σ f cos / pdf` over the prior's samples is the albedo of the
+    /// independent quadrature (`directional_albedo_metallic`), on and between the
+    /// nodes, in both spaces: the pdf is the samples' density, whatever the
+    /// tables approximate; and `pdf` returns the samples' pdf.
+    #[test]
+    fn the_estimate_with_the_priors_pdf_is_the_albedo() {
+        for space in [PriorSpace::Direction, PriorSpace::HalfVector] {
+            let prior = BrdfPrior::new([3, 4, 2], 32, space).unwrap();
+            assert_eq!(prior.state_bytes(), 4 * 24 * (2 * 32 * 32 + 32));
+            let warp = prior.warp();
+            for (c, condition) in [
+                [0.55, 29.666666666666668, 0.0],
+                [0.4, 50.0, 0.3],
+                [0.8, 75.0, 1.0],
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                let [r, t, m] = condition;
+                let wo = view_direction(t);
+                let want = directional_albedo_metallic(r, t, m).total();
+                let mut g = rng(7, c as u64);
+                let count = 1 << 17;
+                let (mut sum, mut sum2) = (0.0, 0.0);
+                for _ in 0..count {
+                    let u = DVec2::new(g.random(), g.random());
+                    let (wi, pdf) = prior.sample(&warp, condition, u);
+                    if pdf <= 0.0 {
+                        continue;
+                    }
+                    let back = prior.pdf(&warp, condition, wi);
+                    assert!((back - pdf).abs() <= 1e-3 * pdf, "{back} {pdf}");
+                    let y = gltf_metallic(wo.to_array(), wi.to_array(), r, m) * wi.z / pdf;
+                    sum += y;
+                    sum2 += y * y;
+                }
+                let mean = sum / count as f64;
+                let se = ((sum2 / count as f64 - mean * mean) / count as f64).sqrt();
+                assert!(
+                    (mean - want).abs() < 4.0 * se + 1e-4,
+                    "{} at {condition:?}: {mean} vs {want} (se {se})",
+                    space.name()
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn nodes_are_the_grid_and_a_query_at_a_node_reads_its_table_alone() {
+        let grid = [3, 4, 2];
+        assert_eq!(BrdfPrior::node_condition(grid, 0), [0.1, 0.0, 0.0]);
+        assert_eq!(BrdfPrior::node_condition(grid, 23), [1.0, 89.0, 1.0]);
+        let [r, t, m] = BrdfPrior::node_condition(grid, 1 + 3 * (2 + 4));
+        assert!((r - 0.55).abs() < 1e-12 && (t - 178.0 / 3.0).abs() < 1e-12 && m == 1.0);
+        let prior = BrdfPrior::new(grid, 8, PriorSpace::HalfVector).unwrap();
+        let b = prior.blend([r, t, m]);
+        let pairs: Vec<(u32, f32)> = b.pairs().filter(|p| p.1 > 1e-6).collect();
+        assert_eq!(pairs.len(), 1);
+        assert_eq!(pairs[0].0, 1 + 3 * (2 + 4));
+    }
+}
