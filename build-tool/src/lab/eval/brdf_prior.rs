@@ -7,12 +7,16 @@
 use super::prior_judge::{score, Judge, JudgeSettings};
 use crate::seeding::rng;
 use crate::sphere::brdf_prior::{BrdfPrior, PriorSpace};
-use crate::sphere::{BrdfTarget, DirectionDensity};
+use crate::sphere::{BrdfTarget, DirectionDensity, TabulatedWarp};
 use anyhow::Result;
 use nuld_core::blob::Domain;
 use rand::Rng;
 use serde::Serialize;
 use std::time::Instant;
+
+/// Cells per axis of the exact inverse CDF of a held-out condition's target
+/// (2 x 2 midpoints per cell), as `eval conditional`'s.
+const EXACT_TABULATION: usize = 1024;
 
 /// What [`evaluate`] measures.
 #[derive(Clone, Debug, Serialize)]
@@ -101,7 +105,14 @@ pub fn evaluate(s: &BrdfPriorSettings, progress: &dyn Fn(&str)) -> Result<Vec<Br
     let mut judges: Vec<Judge<BrdfTarget>> = Vec::new();
     for (index, c) in held_out(s).into_iter().enumerate() {
         let target = BrdfTarget::metallic(c[0], c[1], c[2], Domain::Hemisphere)?;
-        let judge = Judge::new(target.clone(), &target, &judging, index as u64);
+        let exact = TabulatedWarp::new(&target, EXACT_TABULATION, 2)?;
+        let judge = Judge::new(
+            target.clone(),
+            &target,
+            &|u| exact.warp(u),
+            &judging,
+            index as u64,
+        );
         judges.push(judge);
         progress(&format!("condition {index} judged"));
     }

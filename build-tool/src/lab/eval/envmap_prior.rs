@@ -15,7 +15,7 @@
 
 use super::prior_judge::{score, Judge, JudgeSettings};
 use crate::seeding::rng;
-use crate::sphere::{EnvmapDensity, EnvmapPrior, EnvmapTree};
+use crate::sphere::{DirectionDensity, EnvmapDensity, EnvmapPrior, EnvmapTree};
 use anyhow::Result;
 use glam::{DVec2, DVec3};
 use nuld_core::sphere::square_to_sphere;
@@ -99,7 +99,9 @@ pub fn evaluate(
         if irradiance <= 0.0 {
             continue;
         }
-        judges.push(Judge::new(normal, &lit, &judging, index as u64));
+        // A lit map's own warp is its exact inverse CDF.
+        let exact = |u| lit.sample(u);
+        judges.push(Judge::new(normal, &lit, &exact, &judging, index as u64));
         progress(&format!("normal {index} judged"));
     }
     anyhow::ensure!(!judges.is_empty(), "no held-out normal receives light");

@@ -6,7 +6,7 @@
 //! the bakes' quality checks). Shared by `eval envmap-prior` and
 //! `eval brdf-prior`.
 
-use crate::baselines::{seeded_owen_sobol, warped_owen_sobol_directions};
+use crate::baselines::seeded_owen_sobol;
 use crate::seeding::{derive_seed, rng};
 use crate::sphere::metrics::{CapRadius, MeasuredCaps};
 use crate::sphere::DirectionDensity;
@@ -39,8 +39,15 @@ pub struct Judge<C> {
 
 impl<C: Sync> Judge<C> {
     /// The judge of `target` at `condition`, the `index`-th of its run (the caps'
-    /// seed).
-    pub fn new(condition: C, target: &dyn DirectionDensity, s: &JudgeSettings, index: u64) -> Self {
+    /// seed); `exact` is the target's exact inverse CDF (the baseline's warp of
+    /// Owen-Sobol points).
+    pub fn new(
+        condition: C,
+        target: &dyn DirectionDensity,
+        exact: &(dyn Fn(DVec2) -> DVec3 + Sync),
+        s: &JudgeSettings,
+        index: u64,
+    ) -> Self {
         let caps = MeasuredCaps::draw(
             s.caps,
             derive_seed(s.seed, index),
@@ -56,7 +63,13 @@ impl<C: Sync> Judge<C> {
         judge.baseline = mean(
             (0..s.instances as u64)
                 .into_par_iter()
-                .map(|k| judge.d(&warped_owen_sobol_directions(target, n, s.seed ^ (k + 1))))
+                .map(|k| {
+                    let pts: Vec<DVec3> = seeded_owen_sobol(n, s.seed ^ (k + 1))
+                        .into_iter()
+                        .map(exact)
+                        .collect();
+                    judge.d(&pts)
+                })
                 .collect(),
         );
         judge
