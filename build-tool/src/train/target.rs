@@ -3,7 +3,7 @@
 //! use the same), and [`LoadedTarget`], the data a pool is built from.
 
 use crate::seeding::content_hash;
-use crate::sphere::envmap_tree::{PRIOR_GRID, PRIOR_LEVELS};
+use crate::sphere::envmap_tree::{prior_levels, PRIOR_GRID};
 use crate::sphere::{EnvmapDensity, EnvmapTree};
 use anyhow::{Context, Result};
 use nuld_core::blob::Domain;
@@ -66,7 +66,7 @@ impl TrainTarget {
             Self::Envmap { path, .. } => {
                 let map = EnvmapDensity::from_file_filtered(path, Domain::Sphere)
                     .with_context(|| format!("environment map {}", path.display()))?;
-                let tree = EnvmapTree::new(&map, PRIOR_LEVELS, PRIOR_GRID)
+                let tree = EnvmapTree::new(&map, prior_levels(&map), PRIOR_GRID)
                     .with_context(|| format!("environment map {}", path.display()))?;
                 Ok(LoadedTarget::Envmap(Arc::new(EnvmapTarget { map, tree })))
             }
@@ -90,7 +90,7 @@ pub struct EnvmapTarget {
     /// The map's bilinearly filtered luminance as a density on the sphere
     /// ([`EnvmapDensity::from_luminance_filtered`]).
     pub map: EnvmapDensity,
-    /// The map's tree ([`PRIOR_LEVELS`] levels, top weights on [`PRIOR_GRID`]
+    /// The map's tree ([`prior_levels`] levels, top weights on [`PRIOR_GRID`]
     /// normals): the prior whose primary space the network refines.
     pub tree: EnvmapTree,
 }

@@ -26,14 +26,14 @@
 //! A third warp samples the product `L(l) max(0, n.l)` at a surface's normal:
 //! the map's tree ([`EnvmapTree`], [`Environment::sample_product`]), built from
 //! the same density with the same settings as the prior of `bake --envmap`
-//! ([`PRIOR_LEVELS`], [`PRIOR_GRID`]), so it is the very warp under ours' learned
+//! ([`prior_levels`], [`PRIOR_GRID`]), so it is the very warp under ours' learned
 //! points; uniform points through it are the baselines that isolate what the
 //! learning adds.
 
 use crate::baselines::HierarchicalWarp;
 use crate::density::image::{load_luminance, LuminanceImage};
 use crate::density::CellGrid;
-use crate::sphere::envmap_tree::{EnvmapTree, PRIOR_GRID, PRIOR_LEVELS};
+use crate::sphere::envmap_tree::{prior_levels, EnvmapTree, PRIOR_GRID};
 use crate::sphere::{DirectionDensity, EnvmapDensity, FilteredLuminance};
 use anyhow::{Context, Result};
 use glam::{DVec2, DVec3};
@@ -84,7 +84,7 @@ impl Environment {
             height: h,
             mass,
         });
-        let product = EnvmapTree::new(&density, PRIOR_LEVELS, PRIOR_GRID)
+        let product = EnvmapTree::new(&density, prior_levels(&density), PRIOR_GRID)
             .with_context(|| format!("environment map {name}"))?;
         Ok(Self {
             radiance,
@@ -142,6 +142,11 @@ impl Environment {
     /// `n` (module docs), and its solid-angle pdf ([`Self::product_pdf`]).
     pub fn sample_product(&self, n: DVec3, u: DVec2) -> (DVec3, f64) {
         EnvmapTree::sample(&self.product.tree(), n, u)
+    }
+
+    /// Levels of the product warp's tree.
+    pub fn product_levels(&self) -> u32 {
+        self.product.levels
     }
 
     /// The solid-angle density of [`Self::sample_product`] at `n` in the unit

@@ -27,7 +27,7 @@ use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render_composite, Composite, Tile};
 use crate::progress::Progress;
 use crate::seeding::content_hash;
-use crate::sphere::envmap_tree::{PRIOR_GRID, PRIOR_LEVELS};
+use crate::sphere::envmap_tree::PRIOR_GRID;
 use crate::train::{TrainConfig, TrainTarget};
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -188,7 +188,8 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
     // The reference, cached by everything it depends on.
     let key = content_hash(
         format!(
-            "reference v3 (product warp {PRIOR_LEVELS} levels, {PRIOR_GRID} normals) {:016x} {scene:?} {camera:?} {} {}",
+            "reference v3 (product warp {} levels, {PRIOR_GRID} normals) {:016x} {scene:?} {camera:?} {} {}",
+            env.product_levels(),
             content_hash(&map_bytes),
             config.reference_samples,
             config.seed
