@@ -1,6 +1,6 @@
-//! The C ABI (`runtime/capi`) from C: the freestanding libraries built as the
-//! README says, and `tests/c/capi_test.c` compiled against the static one by the
-//! system C compiler.
+//! The C ABI (`runtime/capi`) from C and C++: the freestanding libraries built as
+//! the README says, `tests/c/capi_test.c` compiled against the static one by the
+//! system C compiler, and the C++ example against both.
 //!
 //! * Through C, every sample of blobs the build tool wrote (2D, sphere and
 //!   hemisphere sets; BRDF and environment samplers in table, network, decoded
@@ -329,6 +329,34 @@ fn each_bad_argument_through_c_gets_its_code() {
         "{failures:#?}\n{out}"
     );
     println!("{last}");
+}
+
+/// The C++ example, linked with the static and with the dynamic library, on an
+/// environment sampler (its PDF agrees with each sample's pdf) and a BRDF sampler.
+#[test]
+fn the_cpp_example_builds_and_samples_both_targets() {
+    let files = Files::new("cpp");
+    let source = workspace_root().join("runtime/capi/examples/sampler.cpp");
+    let env = files.write("env", &envmap_blob(6));
+    let brdf = files.write(
+        "brdf",
+        &brdf_blob(Activation::Relu, PointWarp::BrdfMixture, 64, 7),
+    );
+    for (link, name) in [(Link::Static, "sampler"), (Link::Dynamic, "sampler_so")] {
+        let exe = compile(&source, link, name);
+        let out = run(&exe, &[&env]);
+        println!("{name} on an environment sampler:\n{out}");
+        let last = out.lines().last().unwrap();
+        let error: f64 = last.rsplit(' ').next().unwrap().parse().unwrap();
+        assert!(error < 1e-4, "{out}");
+        assert!(out.contains("Sample(2): wi ("), "{out}");
+        let out = run(&exe, &[&brdf]);
+        println!("{name} on a BRDF sampler:\n{out}");
+        assert!(out.contains("BRDF, N = 64: reflected radiance"), "{out}");
+        let point_set = files.write("set", &sobol_blob(Domain::Square, 4, 1, 1).1);
+        let refused = Command::new(&exe).arg(&point_set).output().unwrap();
+        assert_eq!(refused.status.code(), Some(1));
+    }
 }
 
 /// The checked-in header is cbindgen's output for the crate as it is. After
