@@ -205,14 +205,16 @@ static int cmd_sample(int argc, char **argv) {
   for (uint32_t i = 0; i < info.len; i++) {
     NuldSample s;
     int32_t rc;
+    const NuldVec3 n = {at[0], at[1], at[2]};
+    const NuldVec2 c = {at[0], at[1]};
     if (normal && randomize)
-      rc = nuld_envmap_sample_randomized(&blob, mode, at, instance, i, seed, &s);
+      rc = nuld_envmap_sample_randomized(&blob, mode, n, instance, i, seed, &s);
     else if (normal)
-      rc = nuld_envmap_sample(&blob, mode, at, instance, i, &s);
+      rc = nuld_envmap_sample(&blob, mode, n, instance, i, &s);
     else if (randomize)
-      rc = nuld_conditional_sample_randomized(&blob, mode, at, instance, i, seed, &s);
+      rc = nuld_conditional_sample_randomized(&blob, mode, c, instance, i, seed, &s);
     else
-      rc = nuld_conditional_sample(&blob, mode, at, instance, i, &s);
+      rc = nuld_conditional_sample(&blob, mode, c, instance, i, &s);
     if (rc != NULD_OK) die("sampling", nuld_error_message(rc));
     char t[5][64];
     fmt_f32(s.direction[0], t[0]);
@@ -273,6 +275,11 @@ static uint64_t checksum(const uint8_t *b, size_t len) {
 
 static long bad_outputs;
 
+static NuldVec3 vec3(const float v[3]) {
+  NuldVec3 r = {v[0], v[1], v[2]};
+  return r;
+}
+
 static void expect_sample(int32_t rc, const NuldSample *s) {
   float len = sqrtf(s->direction[0] * s->direction[0] + s->direction[1] * s->direction[1] +
                     s->direction[2] * s->direction[2]);
@@ -306,12 +313,12 @@ static void touch_all(const NuldBlob *blob) {
     }
     return;
   }
-  const float conds[5][2] = {{info.cond_min[0], info.cond_min[1]},
+  const NuldVec2 conds[5] = {{info.cond_min[0], info.cond_min[1]},
                              {info.cond_max[0], info.cond_max[1]},
                              {0.5f * (info.cond_min[0] + info.cond_max[0]), 0.3f},
                              {NAN, INFINITY},
                              {-1e30f, 1e30f}};
-  const float views[4][3] = {{0.3f, 0.4f, 0.8f}, {0, 0, 0}, {NAN, 1, INFINITY}, {1e-30f, 0, -1}};
+  const NuldVec3 views[4] = {{0.3f, 0.4f, 0.8f}, {0, 0, 0}, {NAN, 1, INFINITY}, {1e-30f, 0, -1}};
   float *weights = aligned(info.decoded_network_len * sizeof(float));
   NuldBlob fast;
   int decoded = nuld_decode_network(blob, weights, info.decoded_network_len, &fast) == NULD_OK;
@@ -327,21 +334,21 @@ static void touch_all(const NuldBlob *blob) {
               nuld_conditional_sample_randomized(b, mode, conds[c], instances[k], i, i * 7u, &s),
               &s);
           float pdf = -1;
-          if (nuld_conditional_pdf(b, conds[c], s.direction, &pdf) != NULD_OK || !(pdf >= 0) ||
-              !isfinite(pdf))
+          if (nuld_conditional_pdf(b, conds[c], vec3(s.direction), &pdf) != NULD_OK ||
+              !(pdf >= 0) || !isfinite(pdf))
             bad_outputs++;
         }
         for (int v = 0; v < 4; v++) {
           int32_t rc;
           if (info.target == NULD_TARGET_GLTF_BRDF) {
-            rc = nuld_brdf_sample(b, mode, views[v], conds[v][0], instances[k], i, &s);
+            rc = nuld_brdf_sample(b, mode, views[v], conds[v].x, instances[k], i, &s);
           } else {
             rc = nuld_envmap_sample_randomized(b, mode, views[v], instances[k], i, 99, &s);
             expect_sample(rc, &s);
             rc = nuld_envmap_sample(b, mode, views[v], instances[k], i, &s);
             float pdf = -1;
-            if (nuld_envmap_pdf(b, views[v], s.direction, &pdf) != NULD_OK || !(pdf >= 0) ||
-                !isfinite(pdf))
+            if (nuld_envmap_pdf(b, views[v], vec3(s.direction), &pdf) != NULD_OK ||
+                !(pdf >= 0) || !isfinite(pdf))
               bad_outputs++;
           }
           expect_sample(rc, &s);
@@ -472,6 +479,8 @@ static int cmd_errors(int argc, char **argv) {
   NuldBlob out, zero;
   memset(&zero, 0, sizeof zero);
   float v[4] = {0.3f, 0.4f, 0.8f, 0};
+  const NuldVec3 wo = {0.3f, 0.4f, 0.8f};
+  const NuldVec2 c2 = {0.3f, 40};
   NuldSample s;
   NuldBlobInfo info;
   uint8_t *copy = aligned(b.len + 16);
@@ -516,15 +525,15 @@ static int cmd_errors(int argc, char **argv) {
     CHECK_BLOB("decode", nuld_decode_network(x, v, 4, &out));
     CHECK_BLOB("point_2d", nuld_point_2d(x, 0, 0, v));
     CHECK_BLOB("direction", nuld_direction(x, 0, 0, v));
-    CHECK_BLOB("brdf_sample", nuld_brdf_sample(x, NULD_MODE_TABLE, v, 0.3f, 0, 0, &s));
-    CHECK_BLOB("envmap_sample", nuld_envmap_sample(x, NULD_MODE_TABLE, v, 0, 0, &s));
+    CHECK_BLOB("brdf_sample", nuld_brdf_sample(x, NULD_MODE_TABLE, wo, 0.3f, 0, 0, &s));
+    CHECK_BLOB("envmap_sample", nuld_envmap_sample(x, NULD_MODE_TABLE, wo, 0, 0, &s));
     CHECK_BLOB("envmap_sample_randomized",
-               nuld_envmap_sample_randomized(x, NULD_MODE_TABLE, v, 0, 0, 1, &s));
-    CHECK_BLOB("envmap_pdf", nuld_envmap_pdf(x, v, v, v));
-    CHECK_BLOB("conditional_sample", nuld_conditional_sample(x, NULD_MODE_TABLE, v, 0, 0, &s));
+               nuld_envmap_sample_randomized(x, NULD_MODE_TABLE, wo, 0, 0, 1, &s));
+    CHECK_BLOB("envmap_pdf", nuld_envmap_pdf(x, wo, wo, v));
+    CHECK_BLOB("conditional_sample", nuld_conditional_sample(x, NULD_MODE_TABLE, c2, 0, 0, &s));
     CHECK_BLOB("conditional_sample_randomized",
-               nuld_conditional_sample_randomized(x, NULD_MODE_TABLE, v, 0, 0, 1, &s));
-    CHECK_BLOB("conditional_pdf", nuld_conditional_pdf(x, v, v, v));
+               nuld_conditional_sample_randomized(x, NULD_MODE_TABLE, c2, 0, 0, 1, &s));
+    CHECK_BLOB("conditional_pdf", nuld_conditional_pdf(x, c2, wo, v));
 #undef CHECK_BLOB
   }
 
@@ -536,22 +545,19 @@ static int cmd_errors(int argc, char **argv) {
   check("point_2d: misaligned out", nuld_point_2d(pts, 0, 0, odd), NULD_ERR_MISALIGNED);
   check("direction: null out", nuld_direction(dirs, 0, 0, NULL), NULD_ERR_NULL);
   check("direction: misaligned out", nuld_direction(dirs, 0, 0, odd), NULD_ERR_MISALIGNED);
-  check("brdf_sample: null wo", nuld_brdf_sample(brdf, 0, NULL, 0.3f, 0, 0, &s), NULD_ERR_NULL);
-  check("brdf_sample: misaligned wo", nuld_brdf_sample(brdf, 0, odd, 0.3f, 0, 0, &s),
-        NULD_ERR_MISALIGNED);
-  check("brdf_sample: null out", nuld_brdf_sample(brdf, 0, v, 0.3f, 0, 0, NULL), NULD_ERR_NULL);
+  check("brdf_sample: null out", nuld_brdf_sample(brdf, 0, wo, 0.3f, 0, 0, NULL), NULD_ERR_NULL);
   check("brdf_sample: misaligned out",
-        nuld_brdf_sample(brdf, 0, v, 0.3f, 0, 0, shifted(&s, 2)), NULD_ERR_MISALIGNED);
-  check("envmap_sample: null normal", nuld_envmap_sample(env, 0, NULL, 0, 0, &s), NULD_ERR_NULL);
-  check("envmap_sample: null out", nuld_envmap_sample(env, 0, v, 0, 0, NULL), NULD_ERR_NULL);
-  check("envmap_pdf: null normal", nuld_envmap_pdf(env, NULL, v, v), NULD_ERR_NULL);
-  check("envmap_pdf: null direction", nuld_envmap_pdf(env, v, NULL, v), NULD_ERR_NULL);
-  check("envmap_pdf: misaligned direction", nuld_envmap_pdf(env, v, odd, v),
-        NULD_ERR_MISALIGNED);
-  check("envmap_pdf: null out", nuld_envmap_pdf(env, v, v, NULL), NULD_ERR_NULL);
-  check("conditional_sample: null cond", nuld_conditional_sample(brdf, 0, NULL, 0, 0, &s),
+        nuld_brdf_sample(brdf, 0, wo, 0.3f, 0, 0, shifted(&s, 2)), NULD_ERR_MISALIGNED);
+  check("envmap_sample: null out", nuld_envmap_sample(env, 0, wo, 0, 0, NULL), NULD_ERR_NULL);
+  check("envmap_sample_randomized: misaligned out",
+        nuld_envmap_sample_randomized(env, 0, wo, 0, 0, 1, shifted(&s, 1)), NULD_ERR_MISALIGNED);
+  check("envmap_pdf: null out", nuld_envmap_pdf(env, wo, wo, NULL), NULD_ERR_NULL);
+  check("envmap_pdf: misaligned out", nuld_envmap_pdf(env, wo, wo, odd), NULD_ERR_MISALIGNED);
+  check("conditional_sample: null out", nuld_conditional_sample(brdf, 0, c2, 0, 0, NULL),
         NULD_ERR_NULL);
-  check("conditional_pdf: null out", nuld_conditional_pdf(env, v, v, NULL), NULD_ERR_NULL);
+  check("conditional_sample_randomized: null out",
+        nuld_conditional_sample_randomized(brdf, 0, c2, 0, 0, 1, NULL), NULD_ERR_NULL);
+  check("conditional_pdf: null out", nuld_conditional_pdf(env, c2, wo, NULL), NULD_ERR_NULL);
   check("decode: null buffer", nuld_decode_network(brdf, NULL, 4, &out), NULD_ERR_NULL);
   check("decode: misaligned buffer", nuld_decode_network(brdf, odd, 4, &out),
         NULD_ERR_MISALIGNED);
@@ -560,23 +566,23 @@ static int cmd_errors(int argc, char **argv) {
         NULD_ERR_TOO_LONG);
 
   /* arguments the blob does not serve */
-  check("brdf_sample: mode 2", nuld_brdf_sample(brdf, 2, v, 0.3f, 0, 0, &s),
+  check("brdf_sample: mode 2", nuld_brdf_sample(brdf, 2, wo, 0.3f, 0, 0, &s),
         NULD_ERR_UNKNOWN_MODE);
-  check("envmap_sample: mode UINT32_MAX", nuld_envmap_sample(env, UINT32_MAX, v, 0, 0, &s),
+  check("envmap_sample: mode UINT32_MAX", nuld_envmap_sample(env, UINT32_MAX, wo, 0, 0, &s),
         NULD_ERR_UNKNOWN_MODE);
-  check("conditional_sample: mode 7", nuld_conditional_sample(env, 7, v, 0, 0, &s),
+  check("conditional_sample: mode 7", nuld_conditional_sample(env, 7, c2, 0, 0, &s),
         NULD_ERR_UNKNOWN_MODE);
   check("point_2d: a direction set", nuld_point_2d(dirs, 0, 0, v), NULD_ERR_WRONG_KIND);
   check("point_2d: a sampler", nuld_point_2d(brdf, 0, 0, v), NULD_ERR_WRONG_KIND);
   check("direction: a 2D set", nuld_direction(pts, 0, 0, v), NULD_ERR_WRONG_KIND);
-  check("brdf_sample: a point set", nuld_brdf_sample(pts, 0, v, 0.3f, 0, 0, &s),
+  check("brdf_sample: a point set", nuld_brdf_sample(pts, 0, wo, 0.3f, 0, 0, &s),
         NULD_ERR_WRONG_KIND);
-  check("brdf_sample: an environment sampler", nuld_brdf_sample(env, 0, v, 0.3f, 0, 0, &s),
+  check("brdf_sample: an environment sampler", nuld_brdf_sample(env, 0, wo, 0.3f, 0, 0, &s),
         NULD_ERR_WRONG_TARGET);
-  check("envmap_sample: a BRDF sampler", nuld_envmap_sample(brdf, 0, v, 0, 0, &s),
+  check("envmap_sample: a BRDF sampler", nuld_envmap_sample(brdf, 0, wo, 0, 0, &s),
         NULD_ERR_WRONG_TARGET);
-  check("envmap_pdf: a BRDF sampler", nuld_envmap_pdf(brdf, v, v, v), NULD_ERR_WRONG_TARGET);
-  check("conditional_sample: a direction set", nuld_conditional_sample(dirs, 0, v, 0, 0, &s),
+  check("envmap_pdf: a BRDF sampler", nuld_envmap_pdf(brdf, wo, wo, v), NULD_ERR_WRONG_TARGET);
+  check("conditional_sample: a direction set", nuld_conditional_sample(dirs, 0, c2, 0, 0, &s),
         NULD_ERR_WRONG_KIND);
   check("decode: a point set", nuld_decode_network(pts, v, 4, &out), NULD_ERR_WRONG_KIND);
   size_t need = infos[2].decoded_network_len;
@@ -592,23 +598,23 @@ static int cmd_errors(int argc, char **argv) {
 
   /* results: written on success only; equal through copies and decoding */
   NuldSample sentinel = {{-7, -7, -7}, -7, -7}, t = sentinel;
-  nuld_brdf_sample(brdf, 9, v, 0.3f, 0, 0, &t);
+  nuld_brdf_sample(brdf, 9, wo, 0.3f, 0, 0, &t);
   check_true("a failed call writes no result", !memcmp(&t, &sentinel, sizeof t));
   check("nuld_last_error after a success is the last failure",
-        nuld_brdf_sample(brdf, 0, v, 0.3f, 3, 1, &s), NULD_OK);
+        nuld_brdf_sample(brdf, 0, wo, 0.3f, 3, 1, &s), NULD_OK);
   check_true("nuld_last_error: the last failure", nuld_last_error() == NULD_ERR_UNKNOWN_MODE);
   check("decode: a long enough buffer", nuld_decode_network(brdf, w, need, &out), NULD_OK);
   NuldSample a, c;
-  nuld_brdf_sample(brdf, NULD_MODE_NETWORK, v, 0.3f, 3, 1, &a);
-  nuld_brdf_sample(&out, NULD_MODE_NETWORK, v, 0.3f, 3, 1, &c);
+  nuld_brdf_sample(brdf, NULD_MODE_NETWORK, wo, 0.3f, 3, 1, &a);
+  nuld_brdf_sample(&out, NULD_MODE_NETWORK, wo, 0.3f, 3, 1, &c);
   check_true("decoded network mode: the same bits", !memcmp(&a, &c, sizeof a));
   NuldBlob moved;
   memcpy(&moved, env, sizeof moved);
-  nuld_envmap_sample(env, NULD_MODE_TABLE, v, 5, 2, &a);
-  nuld_envmap_sample(&moved, NULD_MODE_TABLE, v, 5, 2, &c);
+  nuld_envmap_sample(env, NULD_MODE_TABLE, wo, 5, 2, &a);
+  nuld_envmap_sample(&moved, NULD_MODE_TABLE, wo, 5, 2, &c);
   check_true("a NuldBlob copied by memcpy: the same samples", !memcmp(&a, &c, sizeof a));
   float pdf = -1;
-  check("envmap_pdf: at a sample", nuld_envmap_pdf(env, v, a.direction, &pdf), NULD_OK);
+  check("envmap_pdf: at a sample", nuld_envmap_pdf(env, wo, vec3(a.direction), &pdf), NULD_OK);
   check_true("envmap_pdf: the sample's pdf", fabsf(pdf - a.pdf) <= 1e-4f * a.pdf && pdf > 0);
   check_true("brdf sample: pdf 0 (not served yet)", s.pdf == 0);
 
@@ -667,22 +673,22 @@ static int cmd_floats(int argc, char **argv) {
 /* The conditions every method cycles through (tests/examples/capi_bench.rs
  * makes the same ones). */
 #define CONDITIONS 64
-static float bench_views[CONDITIONS][3], bench_normals[CONDITIONS][3],
-    bench_roughness[CONDITIONS];
+static NuldVec3 bench_views[CONDITIONS], bench_normals[CONDITIONS];
+static float bench_roughness[CONDITIONS];
 
 static void bench_conditions(void) {
   for (int c = 0; c < CONDITIONS; c++) {
     float u = ((float)((c * 37) % CONDITIONS) + 0.5f) / CONDITIONS;
     float theta = 89.0f * u * 3.14159265f / 180.0f;
     float phi = 6.28318531f * (float)fmod(c * 0.618034, 1.0);
-    bench_views[c][0] = sinf(theta) * cosf(phi);
-    bench_views[c][1] = sinf(theta) * sinf(phi);
-    bench_views[c][2] = cosf(theta);
+    bench_views[c].x = sinf(theta) * cosf(phi);
+    bench_views[c].y = sinf(theta) * sinf(phi);
+    bench_views[c].z = cosf(theta);
     float z = 1.0f - 2.0f * ((float)c + 0.5f) / CONDITIONS;
     float r = sqrtf(1.0f - z * z);
-    bench_normals[c][0] = r * cosf(phi);
-    bench_normals[c][1] = r * sinf(phi);
-    bench_normals[c][2] = z;
+    bench_normals[c].x = r * cosf(phi);
+    bench_normals[c].y = r * sinf(phi);
+    bench_normals[c].z = z;
     bench_roughness[c] = 0.1f + 0.9f * ((float)((c * 23) % CONDITIONS) + 0.5f) / CONDITIONS;
   }
 }

@@ -33,9 +33,13 @@ fn program() -> &'static Path {
 
 /// Runs `exe` with `args` and returns its standard output; panics with its
 /// standard error if it fails or is killed (a crash is a signal, no exit code).
+/// Without cargo's `LD_LIBRARY_PATH`, which names `<target>/release`, where the
+/// workspace's own (std) `libnuld_capi.so` lies: the dynamic loader would prefer
+/// it to the freestanding one of the program's run path.
 fn run(exe: &Path, args: &[&str]) -> String {
     let out = Command::new(exe)
         .args(args)
+        .env_remove("LD_LIBRARY_PATH")
         .output()
         .expect("the program runs");
     assert!(
@@ -354,7 +358,11 @@ fn the_cpp_example_builds_and_samples_both_targets() {
         println!("{name} on a BRDF sampler:\n{out}");
         assert!(out.contains("BRDF, N = 64: reflected radiance"), "{out}");
         let point_set = files.write("set", &sobol_blob(Domain::Square, 4, 1, 1).1);
-        let refused = Command::new(&exe).arg(&point_set).output().unwrap();
+        let refused = Command::new(&exe)
+            .arg(&point_set)
+            .env_remove("LD_LIBRARY_PATH")
+            .output()
+            .unwrap();
         assert_eq!(refused.status.code(), Some(1));
     }
 }

@@ -65,7 +65,7 @@ class NuldSampler {
         : file_(file), at_(wo_or_n), roughness_(roughness), pixel_(pixel) {}
 
     std::optional<DirectionSample> Sample(uint32_t u) const {
-        const float at[3] = {at_.x, at_.y, at_.z};
+        const NuldVec3 at = {at_.x, at_.y, at_.z};
         NuldSample s;
         int32_t rc = Brdf() ? nuld_brdf_sample(file_.blob(), NULD_MODE_TABLE, at, roughness_,
                                                pixel_, u, &s)
@@ -78,7 +78,7 @@ class NuldSampler {
 
     // The pdf of a sample in direction wi; 0 for a BRDF blob (not served yet).
     float PDF(Vector3f wi) const {
-        const float n[3] = {at_.x, at_.y, at_.z}, d[3] = {wi.x, wi.y, wi.z};
+        const NuldVec3 n = {at_.x, at_.y, at_.z}, d = {wi.x, wi.y, wi.z};
         float pdf = 0;
         if (Brdf() || nuld_envmap_pdf(file_.blob(), n, d, &pdf) != NULD_OK) return 0;
         return pdf;

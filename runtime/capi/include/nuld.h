@@ -250,6 +250,25 @@ typedef struct NuldBlobInfo {
 } NuldBlobInfo;
 
 /**
+ * A vector of three floats, passed by value (in registers, by the C calling
+ * conventions of the usual platforms).
+ */
+typedef struct NuldVec3 {
+  /**
+   * x.
+   */
+  float x;
+  /**
+   * y.
+   */
+  float y;
+  /**
+   * z.
+   */
+  float z;
+} NuldVec3;
+
+/**
  * One sample of a conditional sampler.
  */
 typedef struct NuldSample {
@@ -274,6 +293,20 @@ typedef struct NuldSample {
    */
   float pdf;
 } NuldSample;
+
+/**
+ * A pair of floats, passed by value: a condition in the blob's units.
+ */
+typedef struct NuldVec2 {
+  /**
+   * The first axis.
+   */
+  float x;
+  /**
+   * The second axis.
+   */
+  float y;
+} NuldVec2;
 
 /**
  * Every status, `NULD_OK` first, then the codes from -1 down.
@@ -371,7 +404,7 @@ int32_t nuld_point_2d(const struct NuldBlob *blob, uint32_t set, uint32_t index,
 int32_t nuld_direction(const struct NuldBlob *blob, uint32_t set, uint32_t index, float *out);
 
 /**
- * Sample `index` of instance `instance` of a BRDF sampler for the view `wo[0..3]`
+ * Sample `index` of instance `instance` of a BRDF sampler for the view `wo`
  * (local frame, z = the normal, any length) at `roughness`, in `mode`, written
  * to `*out`. The runtime's `BrdfSampler::sample`: roughness clamps into the
  * blob's range (NaN to its lower end), a view below the horizon reads as grazing
@@ -380,12 +413,12 @@ int32_t nuld_direction(const struct NuldBlob *blob, uint32_t set, uint32_t index
  * yet). `NULD_ERR_WRONG_TARGET` for an environment sampler.
  *
  * # Safety
- * `blob` must point to a `NuldBlob` whose bytes are alive; `wo` must be valid
- * for reading 3 floats; `out` must be valid for writing a `NuldSample`.
+ * `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
+ * for writing a `NuldSample`.
  */
 int32_t nuld_brdf_sample(const struct NuldBlob *blob,
                          uint32_t mode,
-                         const float *wo,
+                         struct NuldVec3 wo,
                          float roughness,
                          uint32_t instance,
                          uint32_t index,
@@ -393,19 +426,19 @@ int32_t nuld_brdf_sample(const struct NuldBlob *blob,
 
 /**
  * Sample `index` of instance `instance` of an environment sampler at the surface
- * normal `normal[0..3]` (the map's world frame, +z up, any length), in `mode`,
+ * normal `normal` (the map's world frame, +z up, any length), in `mode`,
  * written to `*out`: the runtime's `EnvmapSampler::sample`, with the prior's
  * exact pdf. A zero or non-finite normal reads as +z; index wraps modulo N, table
  * mode's instance modulo S. O(1) in table mode. `NULD_ERR_WRONG_TARGET` for a
  * BRDF sampler.
  *
  * # Safety
- * `blob` must point to a `NuldBlob` whose bytes are alive; `normal` must be
- * valid for reading 3 floats; `out` must be valid for writing a `NuldSample`.
+ * `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
+ * for writing a `NuldSample`.
  */
 int32_t nuld_envmap_sample(const struct NuldBlob *blob,
                            uint32_t mode,
-                           const float *normal,
+                           struct NuldVec3 normal,
                            uint32_t instance,
                            uint32_t index,
                            struct NuldSample *out);
@@ -421,7 +454,7 @@ int32_t nuld_envmap_sample(const struct NuldBlob *blob,
  */
 int32_t nuld_envmap_sample_randomized(const struct NuldBlob *blob,
                                       uint32_t mode,
-                                      const float *normal,
+                                      struct NuldVec3 normal,
                                       uint32_t instance,
                                       uint32_t index,
                                       uint32_t seed,
@@ -429,23 +462,23 @@ int32_t nuld_envmap_sample_randomized(const struct NuldBlob *blob,
 
 /**
  * The solid-angle density of an environment sampler's prior at the unit
- * `direction[0..3]` for the normal `normal[0..3]`, written to `*out`: what
+ * `direction` for the normal `normal`, written to `*out`: what
  * `NuldSample::pdf` is for a sample there, for any direction (multiple
  * importance sampling); both modes share it. O(tree levels). The runtime's
  * `EnvmapSampler::pdf`. `NULD_ERR_WRONG_TARGET` for a BRDF sampler.
  *
  * # Safety
- * `blob` must point to a `NuldBlob` whose bytes are alive; `normal` and
- * `direction` must be valid for reading 3 floats each; `out` for writing one.
+ * `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
+ * for writing a float.
  */
 int32_t nuld_envmap_pdf(const struct NuldBlob *blob,
-                        const float *normal,
-                        const float *direction,
+                        struct NuldVec3 normal,
+                        struct NuldVec3 direction,
                         float *out);
 
 /**
  * Sample `index` of instance `instance` of either sampler at the condition
- * `cond[0..2]` in the blob's units (`NuldBlobInfo::cond_min` to `cond_max`;
+ * `cond` in the blob's units (`NuldBlobInfo::cond_min` to `cond_max`;
  * for a BRDF sampler roughness and view angle in degrees, the view in the
  * xz-plane on the +x side; for an environment sampler the normal's octahedral
  * square point), in `mode`, written to `*out`: the runtime's
@@ -454,12 +487,12 @@ int32_t nuld_envmap_pdf(const struct NuldBlob *blob,
  * condition clamps into the range (NaN to its lower end). O(1) in table mode.
  *
  * # Safety
- * `blob` must point to a `NuldBlob` whose bytes are alive; `cond` must be valid
- * for reading 2 floats; `out` must be valid for writing a `NuldSample`.
+ * `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
+ * for writing a `NuldSample`.
  */
 int32_t nuld_conditional_sample(const struct NuldBlob *blob,
                                 uint32_t mode,
-                                const float *cond,
+                                struct NuldVec2 cond,
                                 uint32_t instance,
                                 uint32_t index,
                                 struct NuldSample *out);
@@ -474,24 +507,24 @@ int32_t nuld_conditional_sample(const struct NuldBlob *blob,
  */
 int32_t nuld_conditional_sample_randomized(const struct NuldBlob *blob,
                                            uint32_t mode,
-                                           const float *cond,
+                                           struct NuldVec2 cond,
                                            uint32_t instance,
                                            uint32_t index,
                                            uint32_t seed,
                                            struct NuldSample *out);
 
 /**
- * The prior's pdf at the unit `direction[0..3]` for the condition `cond[0..2]`
- * (blob units) of either sampler, written to `*out`: the runtime's
+ * The prior's pdf at the unit `direction` for the condition `cond` (blob
+ * units) of either sampler, written to `*out`: the runtime's
  * `ConditionalSampler::pdf` (0 for a BRDF sampler).
  *
  * # Safety
- * `blob` must point to a `NuldBlob` whose bytes are alive; `cond` must be valid
- * for reading 2 floats, `direction` 3; `out` for writing one.
+ * `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
+ * for writing a float.
  */
 int32_t nuld_conditional_pdf(const struct NuldBlob *blob,
-                             const float *cond,
-                             const float *direction,
+                             struct NuldVec2 cond,
+                             struct NuldVec3 direction,
                              float *out);
 
 #ifdef __cplusplus

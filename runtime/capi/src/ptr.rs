@@ -1,5 +1,5 @@
-//! Checked reads and writes through the caller's pointers: null and misaligned
-//! pointers are errors, never dereferenced.
+//! Checked writes through the caller's pointers (the results; vectors come in by
+//! value): null and misaligned pointers are errors, never dereferenced.
 
 use crate::error::NuldStatus::{self, NULD_ERR_MISALIGNED, NULD_ERR_NULL};
 
@@ -13,17 +13,6 @@ pub(crate) fn check<T>(p: *const T) -> Result<(), NuldStatus> {
     } else {
         Ok(())
     }
-}
-
-/// The value at `p` (e.g. `[f32; 3]` for a `const float v[3]`).
-///
-/// # Safety
-/// A non-null, aligned `p` must be valid for reading a `T` (the caller's
-/// contract in the header).
-pub(crate) unsafe fn read<T: Copy>(p: *const T) -> Result<T, NuldStatus> {
-    check(p)?;
-    // SAFETY: non-null and aligned (checked), valid by the caller's contract.
-    Ok(unsafe { p.read() })
 }
 
 /// Writes `value` to `p`.

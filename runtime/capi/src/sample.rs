@@ -9,7 +9,7 @@
 use crate::blob::{view, NuldBlob, View};
 use crate::error::status;
 use crate::error::NuldStatus::{self, NULD_ERR_UNKNOWN_MODE};
-use crate::ptr::{read, write};
+use crate::ptr::write;
 use nuld_runtime::glam::{Vec2, Vec3};
 use nuld_runtime::Sample;
 
@@ -19,6 +19,43 @@ pub const NULD_MODE_TABLE: u32 = 0;
 /// `mode`: network mode, the trained network evaluated per sample (reads the
 /// blob's f16 weights, or the floats of `nuld_decode_network`).
 pub const NULD_MODE_NETWORK: u32 = 1;
+
+/// A vector of three floats, passed by value (in registers, by the C calling
+/// conventions of the usual platforms).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NuldVec3 {
+    /// x.
+    pub x: f32,
+    /// y.
+    pub y: f32,
+    /// z.
+    pub z: f32,
+}
+
+/// A pair of floats, passed by value: a condition in the blob's units.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NuldVec2 {
+    /// The first axis.
+    pub x: f32,
+    /// The second axis.
+    pub y: f32,
+}
+
+impl From<NuldVec3> for Vec3 {
+    #[inline(always)]
+    fn from(v: NuldVec3) -> Self {
+        Vec3::new(v.x, v.y, v.z)
+    }
+}
+
+impl From<NuldVec2> for Vec2 {
+    #[inline(always)]
+    fn from(v: NuldVec2) -> Self {
+        Vec2::new(v.x, v.y)
+    }
+}
 
 /// One sample of a conditional sampler.
 #[repr(C)]
@@ -114,7 +151,7 @@ pub unsafe extern "C" fn nuld_direction(
     )
 }
 
-/// Sample `index` of instance `instance` of a BRDF sampler for the view `wo[0..3]`
+/// Sample `index` of instance `instance` of a BRDF sampler for the view `wo`
 /// (local frame, z = the normal, any length) at `roughness`, in `mode`, written
 /// to `*out`. The runtime's `BrdfSampler::sample`: roughness clamps into the
 /// blob's range (NaN to its lower end), a view below the horizon reads as grazing
@@ -123,13 +160,13 @@ pub unsafe extern "C" fn nuld_direction(
 /// yet). `NULD_ERR_WRONG_TARGET` for an environment sampler.
 ///
 /// # Safety
-/// `blob` must point to a `NuldBlob` whose bytes are alive; `wo` must be valid
-/// for reading 3 floats; `out` must be valid for writing a `NuldSample`.
+/// `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
+/// for writing a `NuldSample`.
 #[no_mangle]
 pub unsafe extern "C" fn nuld_brdf_sample(
     blob: *const NuldBlob,
     mode: u32,
-    wo: *const f32,
+    wo: NuldVec3,
     roughness: f32,
     instance: u32,
     index: u32,
@@ -147,15 +184,15 @@ pub unsafe extern "C" fn nuld_brdf_sample(
 unsafe fn brdf_sample(
     blob: *const NuldBlob,
     m: u32,
-    wo: *const f32,
+    wo: NuldVec3,
     roughness: f32,
     instance: u32,
     index: u32,
     out: *mut NuldSample,
 ) -> Result<(), NuldStatus> {
     // SAFETY: by the caller's contract.
-    let (brdf, wo) = unsafe { (view(blob)?.brdf()?, read(wo.cast::<[f32; 3]>())?) };
-    let wo = Vec3::from_array(wo);
+    let brdf = unsafe { view(blob)?.brdf()? };
+    let wo = Vec3::from(wo);
     let s = match mode(m)? {
         Mode::Table => brdf.sample(wo, roughness, instance, index),
         Mode::Network => brdf.network().sample(wo, roughness, instance, index),
@@ -165,20 +202,20 @@ unsafe fn brdf_sample(
 }
 
 /// Sample `index` of instance `instance` of an environment sampler at the surface
-/// normal `normal[0..3]` (the map's world frame, +z up, any length), in `mode`,
+/// normal `normal` (the map's world frame, +z up, any length), in `mode`,
 /// written to `*out`: the runtime's `EnvmapSampler::sample`, with the prior's
 /// exact pdf. A zero or non-finite normal reads as +z; index wraps modulo N, table
 /// mode's instance modulo S. O(1) in table mode. `NULD_ERR_WRONG_TARGET` for a
 /// BRDF sampler.
 ///
 /// # Safety
-/// `blob` must point to a `NuldBlob` whose bytes are alive; `normal` must be
-/// valid for reading 3 floats; `out` must be valid for writing a `NuldSample`.
+/// `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
+/// for writing a `NuldSample`.
 #[no_mangle]
 pub unsafe extern "C" fn nuld_envmap_sample(
     blob: *const NuldBlob,
     mode: u32,
-    normal: *const f32,
+    normal: NuldVec3,
     instance: u32,
     index: u32,
     out: *mut NuldSample,
@@ -198,7 +235,7 @@ pub unsafe extern "C" fn nuld_envmap_sample(
 pub unsafe extern "C" fn nuld_envmap_sample_randomized(
     blob: *const NuldBlob,
     mode: u32,
-    normal: *const f32,
+    normal: NuldVec3,
     instance: u32,
     index: u32,
     seed: u32,
@@ -215,15 +252,15 @@ pub unsafe extern "C" fn nuld_envmap_sample_randomized(
 unsafe fn envmap_sample(
     blob: *const NuldBlob,
     m: u32,
-    normal: *const f32,
+    normal: NuldVec3,
     instance: u32,
     index: u32,
     seed: Option<u32>,
     out: *mut NuldSample,
 ) -> Result<(), NuldStatus> {
     // SAFETY: by the caller's contract.
-    let (env, n) = unsafe { (view(blob)?.envmap()?, read(normal.cast::<[f32; 3]>())?) };
-    let n = Vec3::from_array(n);
+    let env = unsafe { view(blob)?.envmap()? };
+    let n = Vec3::from(normal);
     let s = match (mode(m)?, seed) {
         (Mode::Table, None) => env.sample(n, instance, index),
         (Mode::Table, Some(r)) => env.sample_randomized(n, instance, index, r),
@@ -235,34 +272,35 @@ unsafe fn envmap_sample(
 }
 
 /// The solid-angle density of an environment sampler's prior at the unit
-/// `direction[0..3]` for the normal `normal[0..3]`, written to `*out`: what
+/// `direction` for the normal `normal`, written to `*out`: what
 /// `NuldSample::pdf` is for a sample there, for any direction (multiple
 /// importance sampling); both modes share it. O(tree levels). The runtime's
 /// `EnvmapSampler::pdf`. `NULD_ERR_WRONG_TARGET` for a BRDF sampler.
 ///
 /// # Safety
-/// `blob` must point to a `NuldBlob` whose bytes are alive; `normal` and
-/// `direction` must be valid for reading 3 floats each; `out` for writing one.
+/// `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
+/// for writing a float.
 #[no_mangle]
 pub unsafe extern "C" fn nuld_envmap_pdf(
     blob: *const NuldBlob,
-    normal: *const f32,
-    direction: *const f32,
+    normal: NuldVec3,
+    direction: NuldVec3,
     out: *mut f32,
 ) -> i32 {
     // SAFETY: by the caller's contract.
-    status(unsafe {
-        let env = view(blob).and_then(View::envmap);
-        let (n, d) = (read(normal.cast::<[f32; 3]>()), read(direction.cast()));
-        env.and_then(|env| {
-            let pdf = env.pdf(Vec3::from_array(n?), Vec3::from_array(d?));
-            write(out, pdf)
-        })
-    })
+    status(
+        unsafe { view(blob) }
+            .and_then(View::envmap)
+            .and_then(|env| {
+                let pdf = env.pdf(normal.into(), direction.into());
+                // SAFETY: by the caller's contract.
+                unsafe { write(out, pdf) }
+            }),
+    )
 }
 
 /// Sample `index` of instance `instance` of either sampler at the condition
-/// `cond[0..2]` in the blob's units (`NuldBlobInfo::cond_min` to `cond_max`;
+/// `cond` in the blob's units (`NuldBlobInfo::cond_min` to `cond_max`;
 /// for a BRDF sampler roughness and view angle in degrees, the view in the
 /// xz-plane on the +x side; for an environment sampler the normal's octahedral
 /// square point), in `mode`, written to `*out`: the runtime's
@@ -271,13 +309,13 @@ pub unsafe extern "C" fn nuld_envmap_pdf(
 /// condition clamps into the range (NaN to its lower end). O(1) in table mode.
 ///
 /// # Safety
-/// `blob` must point to a `NuldBlob` whose bytes are alive; `cond` must be valid
-/// for reading 2 floats; `out` must be valid for writing a `NuldSample`.
+/// `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
+/// for writing a `NuldSample`.
 #[no_mangle]
 pub unsafe extern "C" fn nuld_conditional_sample(
     blob: *const NuldBlob,
     mode: u32,
-    cond: *const f32,
+    cond: NuldVec2,
     instance: u32,
     index: u32,
     out: *mut NuldSample,
@@ -296,7 +334,7 @@ pub unsafe extern "C" fn nuld_conditional_sample(
 pub unsafe extern "C" fn nuld_conditional_sample_randomized(
     blob: *const NuldBlob,
     mode: u32,
-    cond: *const f32,
+    cond: NuldVec2,
     instance: u32,
     index: u32,
     seed: u32,
@@ -313,15 +351,15 @@ pub unsafe extern "C" fn nuld_conditional_sample_randomized(
 unsafe fn conditional_sample(
     blob: *const NuldBlob,
     m: u32,
-    cond: *const f32,
+    cond: NuldVec2,
     instance: u32,
     index: u32,
     seed: Option<u32>,
     out: *mut NuldSample,
 ) -> Result<(), NuldStatus> {
     // SAFETY: by the caller's contract.
-    let (cs, c) = unsafe { (view(blob)?.conditional()?, read(cond.cast::<[f32; 2]>())?) };
-    let c = Vec2::from_array(c);
+    let cs = unsafe { view(blob)?.conditional()? };
+    let c = Vec2::from(cond);
     let s = match (mode(m)?, seed) {
         (Mode::Table, None) => cs.sample(c, instance, index),
         (Mode::Table, Some(r)) => cs.sample_randomized(c, instance, index, r),
@@ -332,27 +370,28 @@ unsafe fn conditional_sample(
     unsafe { write(out, s.into()) }
 }
 
-/// The prior's pdf at the unit `direction[0..3]` for the condition `cond[0..2]`
-/// (blob units) of either sampler, written to `*out`: the runtime's
+/// The prior's pdf at the unit `direction` for the condition `cond` (blob
+/// units) of either sampler, written to `*out`: the runtime's
 /// `ConditionalSampler::pdf` (0 for a BRDF sampler).
 ///
 /// # Safety
-/// `blob` must point to a `NuldBlob` whose bytes are alive; `cond` must be valid
-/// for reading 2 floats, `direction` 3; `out` for writing one.
+/// `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
+/// for writing a float.
 #[no_mangle]
 pub unsafe extern "C" fn nuld_conditional_pdf(
     blob: *const NuldBlob,
-    cond: *const f32,
-    direction: *const f32,
+    cond: NuldVec2,
+    direction: NuldVec3,
     out: *mut f32,
 ) -> i32 {
     // SAFETY: by the caller's contract.
-    status(unsafe {
-        let cs = view(blob).and_then(View::conditional);
-        let (c, d) = (read(cond.cast::<[f32; 2]>()), read(direction.cast()));
-        cs.and_then(|cs| {
-            let pdf = cs.pdf(Vec2::from_array(c?), Vec3::from_array(d?));
-            write(out, pdf)
-        })
-    })
+    status(
+        unsafe { view(blob) }
+            .and_then(View::conditional)
+            .and_then(|cs| {
+                let pdf = cs.pdf(cond.into(), direction.into());
+                // SAFETY: by the caller's contract.
+                unsafe { write(out, pdf) }
+            }),
+    )
 }
