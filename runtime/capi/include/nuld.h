@@ -250,8 +250,8 @@ typedef struct NuldBlobInfo {
 } NuldBlobInfo;
 
 /**
- * A vector of three floats, passed by value (in registers, by the C calling
- * conventions of the usual platforms).
+ * A vector of three floats, passed by value (in registers on x86-64 System V
+ * and AArch64: no memory the caller just wrote is read back).
  */
 typedef struct NuldVec3 {
   /**

@@ -20,8 +20,8 @@ pub const NULD_MODE_TABLE: u32 = 0;
 /// blob's f16 weights, or the floats of `nuld_decode_network`).
 pub const NULD_MODE_NETWORK: u32 = 1;
 
-/// A vector of three floats, passed by value (in registers, by the C calling
-/// conventions of the usual platforms).
+/// A vector of three floats, passed by value (in registers on x86-64 System V
+/// and AArch64: no memory the caller just wrote is read back).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct NuldVec3 {
