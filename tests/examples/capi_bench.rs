@@ -42,8 +42,9 @@ fn conditions() -> Conditions {
     let (mut views, mut normals, mut roughness) = (Vec::new(), Vec::new(), Vec::new());
     for c in 0..CONDITIONS {
         let u = (((c * 37) % CONDITIONS) as f32 + 0.5) / n;
-        let theta = 89.0 * u * 3.14159265 / 180.0;
-        let phi = 6.28318531 * (c as f64 * 0.618034).rem_euclid(1.0) as f32;
+        // PI and TAU are the f32s of the C side's literals 3.14159265f, 6.28318531f.
+        let theta = 89.0 * u * std::f32::consts::PI / 180.0;
+        let phi = std::f32::consts::TAU * (c as f64 * 0.618034).rem_euclid(1.0) as f32;
         views.push(Vec3::new(
             theta.sin() * phi.cos(),
             theta.sin() * phi.sin(),

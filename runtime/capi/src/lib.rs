@@ -11,11 +11,11 @@
 //!   bytes start at a 16-byte aligned address and stay alive and unchanged while
 //!   any `NuldBlob` filled from them is used.
 //! * **Calls.** Every function returns `NULD_OK` (0) or a negative `NULD_ERR_*`
-//!   code and writes its results through out pointers, only on success. Null and
-//!   misaligned pointers are errors ([`NULD_ERR_NULL`], [`NULD_ERR_MISALIGNED`]),
-//!   as is a `NuldBlob` no successful parse filled ([`NULD_ERR_NOT_PARSED`]).
-//!   [`nuld_error_message`] names a code; [`nuld_last_error`] is the most recent
-//!   failure of the process.
+//!   code ([`NuldStatus`]) and writes its results through out pointers, only on
+//!   success; vectors come in by value. Null and misaligned pointers are errors
+//!   (`NULD_ERR_NULL`, `NULD_ERR_MISALIGNED`), as is a `NuldBlob` no successful
+//!   parse filled (`NULD_ERR_NOT_PARSED`). [`nuld_error_message`] names a code;
+//!   [`nuld_last_error`] is the most recent failure of the process.
 //! * **Threads.** A parsed `NuldBlob` is read-only: any number of threads may
 //!   sample it at once. Nothing is global but the last-error code.
 //!
