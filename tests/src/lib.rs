@@ -4,6 +4,8 @@
 //!
 //! This library holds the fixtures those tests share.
 
+pub mod capi;
+
 use nuld_build_tool::pointset::{AlignedBytes, PointSets};
 use nuld_core::blob::{Domain, Metadata};
 

@@ -1,7 +1,8 @@
 //! Proof that the runtime links without `std` and without an allocator
 //! (README.md, "no_std proof"): build the `nuld-no-std-check` staticlib, which has its own
 //! `#[panic_handler]`, under the panic=abort `nostd-check` profile, and show that
-//! the same build fails when a leak is planted on purpose.
+//! the same build fails when a leak is planted on purpose; and the same for the C
+//! ABI's freestanding libraries (`nuld-capi`).
 
 use std::path::PathBuf;
 use std::process::{Command, Output};
@@ -49,6 +50,39 @@ fn runtime_links_without_std_or_alloc_and_leaks_are_caught() {
     );
 
     let leak = build_proof(Some("leak-alloc"));
+    let stderr = String::from_utf8_lossy(&leak.stderr);
+    assert!(!leak.status.success(), "an alloc leak went unnoticed");
+    assert!(
+        stderr.contains("no global memory allocator"),
+        "unexpected failure for the alloc leak:\n{stderr}"
+    );
+}
+
+/// The same proof for the C ABI's freestanding libraries (`nuld-capi` built
+/// `--no-default-features` under the panic=abort `capi` profile, as the README
+/// builds them): the crate is a `no_std` staticlib and cdylib with its own panic
+/// handler, so a std in its graph fails with E0152 and an allocator need with
+/// "no global memory allocator". The leaks are planted through the runtime's
+/// own features.
+#[test]
+fn c_libraries_link_without_std_or_alloc_and_leaks_are_caught() {
+    use nuld_tests::capi::build_libraries;
+    let ok = build_libraries(None);
+    let stderr = String::from_utf8_lossy(&ok.stderr);
+    assert!(
+        ok.status.success(),
+        "the freestanding C libraries failed to build:\n{stderr}"
+    );
+
+    let leak = build_libraries(Some("nuld-runtime/std"));
+    let stderr = String::from_utf8_lossy(&leak.stderr);
+    assert!(!leak.status.success(), "a std leak went unnoticed");
+    assert!(
+        stderr.contains("E0152") && stderr.contains("panic_impl"),
+        "unexpected failure for the std leak:\n{stderr}"
+    );
+
+    let leak = build_libraries(Some("nuld-runtime/alloc"));
     let stderr = String::from_utf8_lossy(&leak.stderr);
     assert!(!leak.status.success(), "an alloc leak went unnoticed");
     assert!(
