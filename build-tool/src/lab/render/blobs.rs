@@ -71,7 +71,7 @@ impl<'e> SamplerBlobs<'e> {
         let what = self.what();
         let sampler = match self.env {
             None => NuldSampler::new(buf.as_slice(), NuldMode::Table),
-            Some(_) => NuldSampler::envmap(buf.as_slice(), NuldMode::Table),
+            Some(env) => NuldSampler::envmap(buf.as_slice(), NuldMode::Table, env),
         }
         .map_err(|e| anyhow!("{what} blob {}: {e}", path.display()))?;
         if let Some(env) = self.env {

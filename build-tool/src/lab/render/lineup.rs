@@ -105,11 +105,11 @@ pub fn samplers<'a>(
 
     let mut envmaps: Vec<Shared<'a>> = Vec::new();
     if let Some(e) = envmap_blob {
-        envmaps.push(Arc::new(NuldSampler::envmap(e, NuldMode::Table)?));
-        let network = NuldSampler::envmap(e, NuldMode::Network)?;
+        envmaps.push(Arc::new(NuldSampler::envmap(e, NuldMode::Table, env)?));
+        let network = NuldSampler::envmap(e, NuldMode::Network, env)?;
         envmaps.push(Arc::new(network.decoded(envmap_weights)));
         envmaps.push(Arc::new(
-            NuldSampler::envmap(e, NuldMode::Table)?.unbiased(),
+            NuldSampler::envmap(e, NuldMode::Table, env)?.unbiased(),
         ));
     }
     let wants_envmaps = techniques

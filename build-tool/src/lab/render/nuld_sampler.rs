@@ -14,11 +14,21 @@
 //! * environment sampling: [`EnvmapSampler::sample`] or
 //!   [`EnvmapNetwork::sample`] at the world normal, or their unbiased mode
 //!   ([`EnvmapSampler::sample_randomized`], `nuld-unbiased`, the pixel key's low
-//!   32 bits as its random number); the estimator's weight is the usual
-//!   `f(wo, l) cos / pdf(l)` with the sample's exact pdf (0 where `f cos` is),
-//!   and [`DirectionSampler::pdf`] is the runtime's `pdf`, for multiple
-//!   importance sampling.
+//!   32 bits as its random number). Each mode is weighted by the density its
+//!   samples follow:
+//!   * the unbiased mode's samples are distributed exactly as the runtime's
+//!     pdf (the prior's): the weight is the usual `f(wo, l) cos / pdf(l)`, and
+//!     [`DirectionSampler::pdf`] is the runtime's `pdf`;
+//!   * a fixed instance's set was trained to follow the target
+//!     `q(l) = L(l) max(0, n.l) / E(n)`, not the prior: weighting it by the
+//!     prior's pdf counts the light the prior puts where the target has none
+//!     (across the horizon, the tree's bound) as a surplus of the rest, a bias
+//!     that multiple importance sampling lays bare (docs/results/rendering.md).
+//!     Its density is `q`, with `E(n)` the sample's weight and `L` the map (the
+//!     renderer's own lookup): the weight is `f cos / q = E f / L`, and
+//!     [`DirectionSampler::pdf`] is `q` (0 where `L` or the cosine is 0).
 
+use super::environment::Environment;
 use super::sampler::{DirectionSampler, PixelKey, Sample, ShadingPoint, Technique};
 use glam::{DVec2, DVec3};
 use nuld_core::sphere::square_to_sphere;
@@ -56,8 +66,8 @@ pub enum NuldBlobError {
 enum Kind<'a> {
     Brdf(BrdfSampler<'a>),
     BrdfNetwork(BrdfNetwork<'a>),
-    Envmap(EnvmapSampler<'a>),
-    EnvmapNetwork(EnvmapNetwork<'a>),
+    Envmap(EnvmapSampler<'a>, &'a Environment),
+    EnvmapNetwork(EnvmapNetwork<'a>, &'a Environment),
 }
 
 /// Ours (see the module docs): a view on the blob's bytes.
@@ -96,11 +106,15 @@ impl<'a> NuldSampler<'a> {
         })
     }
 
-    /// The environment sampler of the blob `bytes` in `mode`; an error unless
-    /// they hold a conditional environment sampler. That the blob was baked for
-    /// the scene's map is the reader's check, made once per blob
+    /// The environment sampler of the blob `bytes` for the map `env` in `mode`;
+    /// an error unless they hold a conditional environment sampler. That the
+    /// blob was baked for `env` is the reader's check, made once per blob
     /// ([`super::blobs::SamplerBlobs::read_envmap`]).
-    pub fn envmap(bytes: &'a [u8], mode: NuldMode) -> Result<Self, NuldBlobError> {
+    pub fn envmap(
+        bytes: &'a [u8],
+        mode: NuldMode,
+        env: &'a Environment,
+    ) -> Result<Self, NuldBlobError> {
         let blob = Blob::parse(bytes).map_err(NuldBlobError::Parse)?;
         let sampler = blob
             .envmap()
@@ -110,8 +124,8 @@ impl<'a> NuldSampler<'a> {
             mode,
             randomized: false,
             kind: match mode {
-                NuldMode::Table => Kind::Envmap(sampler),
-                NuldMode::Network => Kind::EnvmapNetwork(sampler.network()),
+                NuldMode::Table => Kind::Envmap(sampler, env),
+                NuldMode::Network => Kind::EnvmapNetwork(sampler.network(), env),
             },
         })
     }
@@ -149,10 +163,10 @@ impl<'a> NuldSampler<'a> {
                 .ok()
                 .and_then(|b| b.decode_network(buf))
                 .map(Kind::BrdfNetwork),
-            Kind::EnvmapNetwork(_) => EnvmapSampler::try_from(self.sampler)
+            Kind::EnvmapNetwork(_, env) => EnvmapSampler::try_from(self.sampler)
                 .ok()
                 .and_then(|e| e.decode_network(buf))
-                .map(Kind::EnvmapNetwork),
+                .map(|n| Kind::EnvmapNetwork(n, env)),
             _ => None,
         };
         // `None` is unreachable: the buffer has the length asked for.
@@ -162,7 +176,7 @@ impl<'a> NuldSampler<'a> {
     /// The environment sampler in its unbiased mode (a random torus shift per
     /// pixel, module docs); a BRDF sampler is returned as it is (it has none yet).
     pub fn unbiased(self) -> Self {
-        let randomized = matches!(self.kind, Kind::Envmap(_) | Kind::EnvmapNetwork(_));
+        let randomized = matches!(self.kind, Kind::Envmap(..) | Kind::EnvmapNetwork(..));
         Self { randomized, ..self }
     }
 
@@ -181,7 +195,7 @@ impl DirectionSampler for NuldSampler<'_> {
     fn technique(&self) -> Technique {
         match self.kind {
             Kind::Brdf(_) | Kind::BrdfNetwork(_) => Technique::Brdf,
-            Kind::Envmap(_) | Kind::EnvmapNetwork(_) => Technique::Envmap,
+            Kind::Envmap(..) | Kind::EnvmapNetwork(..) => Technique::Envmap,
         }
     }
 
@@ -206,31 +220,85 @@ impl DirectionSampler for NuldSampler<'_> {
             Kind::BrdfNetwork(t) => {
                 out.extend((0..n).map(|i| brdf_sample(at, t.sample(wo, r, k, i))))
             }
-            Kind::Envmap(t) => out.extend((0..n).map(|i| {
+            Kind::Envmap(t, env) => out.extend((0..n).map(|i| {
                 let s = match self.randomized {
                     false => t.sample(normal, k, i),
                     true => t.sample_randomized(normal, k, i, key.scramble()),
                 };
-                envmap_sample(at, s)
+                self.envmap_sample(at, env, s)
             })),
-            Kind::EnvmapNetwork(t) => out.extend((0..n).map(|i| {
+            Kind::EnvmapNetwork(t, env) => out.extend((0..n).map(|i| {
                 let s = match self.randomized {
                     false => t.sample(normal, k, i),
                     true => t.sample_randomized(normal, k, i, key.scramble()),
                 };
-                envmap_sample(at, s)
+                self.envmap_sample(at, env, s)
             })),
         }
     }
 
     fn pdf(&self, at: &ShadingPoint, l: DVec3) -> Option<f64> {
         let normal = at.frame.normal().as_vec3();
-        match self.kind {
-            Kind::Brdf(_) | Kind::BrdfNetwork(_) => None,
-            Kind::Envmap(t) => Some(t.pdf(normal, l.as_vec3()) as f64),
-            Kind::EnvmapNetwork(t) => Some(t.pdf(normal, l.as_vec3()) as f64),
+        let prior = match self.kind {
+            Kind::Brdf(_) | Kind::BrdfNetwork(_) => return None,
+            Kind::Envmap(t, env) => (t.pdf(normal, l.as_vec3()), env),
+            Kind::EnvmapNetwork(t, env) => (t.pdf(normal, l.as_vec3()), env),
+        };
+        Some(match self.randomized {
+            true => prior.0 as f64,
+            false => {
+                let e = self.sampler.weight(normal_condition(at.frame.normal())) as f64;
+                target_density(at, prior.1, e, l)
+            }
+        })
+    }
+}
+
+impl NuldSampler<'_> {
+    /// An environment sample (world frame) weighted by the density it follows
+    /// (module docs): the runtime's exact pdf in the unbiased mode, the target
+    /// `q = L cos / E` for a fixed instance.
+    fn envmap_sample(
+        &self,
+        at: &ShadingPoint,
+        env: &Environment,
+        s: nuld_runtime::Sample,
+    ) -> Sample {
+        let l = s.direction.as_dvec3();
+        let pdf = match self.randomized {
+            true => s.pdf as f64,
+            false => target_density(at, env, s.weight as f64, l),
+        };
+        let f_cos = at.cosine_weighted(l);
+        Sample {
+            direction: l,
+            weight: if pdf > 0.0 && f_cos > 0.0 {
+                f_cos / pdf
+            } else {
+                0.0
+            },
+            pdf,
         }
     }
+}
+
+/// The environment sampler's target at the shading point,
+/// `q(l) = L(l) max(0, n.l) / E(n)` per steradian, with `E(n) = e`; 0 where the
+/// normal sees no light.
+fn target_density(at: &ShadingPoint, env: &Environment, e: f64, l: DVec3) -> f64 {
+    let cos = at.frame.normal().dot(l).max(0.0);
+    if e > 0.0 && cos > 0.0 {
+        env.radiance(l) * cos / e
+    } else {
+        0.0
+    }
+}
+
+/// The runtime's condition of a world normal: its equal-area octahedral square
+/// point.
+fn normal_condition(n: DVec3) -> Vec2 {
+    let p = nuld_core::sphere::sphere_to_square_real(n.as_vec3().normalize().to_array());
+    Vec2::from_array(p)
 }
 
 /// A BRDF sample in the world frame with the runtime's weight, the albedo. The
@@ -240,23 +308,6 @@ fn brdf_sample(at: &ShadingPoint, s: nuld_runtime::Sample) -> Sample {
         direction: at.frame.to_world(s.direction.as_dvec3()),
         weight: s.weight as f64,
         pdf: 0.0,
-    }
-}
-
-/// An environment sample (world frame) with the estimator's weight
-/// `f cos / pdf`, the sample's exact pdf.
-fn envmap_sample(at: &ShadingPoint, s: nuld_runtime::Sample) -> Sample {
-    let l = s.direction.as_dvec3();
-    let pdf = s.pdf as f64;
-    let f_cos = at.cosine_weighted(l);
-    Sample {
-        direction: l,
-        weight: if pdf > 0.0 && f_cos > 0.0 {
-            f_cos / pdf
-        } else {
-            0.0
-        },
-        pdf,
     }
 }
 
@@ -329,12 +380,14 @@ mod tests {
 
     /// Ours for the environment is the runtime's `EnvmapSampler::sample` (or
     /// `sample_randomized` with the key's low bits) at the world normal, bit for
-    /// bit, weighted `f cos / pdf` by the runtime's pdf, which `pdf` returns for
-    /// any direction; and that pdf is the product warp's of the map
-    /// (`Environment::product_pdf`, the baselines through ours' prior) to f32
-    /// rounding: the same warp.
+    /// bit. The unbiased mode is weighted `f cos / pdf` by the runtime's pdf,
+    /// which `pdf` returns for any direction, and that pdf is the product warp's
+    /// of the map (`Environment::product_pdf`, the baselines through ours' prior)
+    /// to f32 rounding: the same warp. A fixed instance is weighted by the
+    /// target `q = L cos / E` (each sample contributes `E f`), which `pdf`
+    /// returns.
     #[test]
-    fn envmap_samples_are_the_runtimes_weighted_by_their_exact_pdf() {
+    fn envmap_samples_are_the_runtimes_weighted_by_the_density_they_follow() {
         use crate::lab::render::blobs::tiny_envmap_blob;
         use crate::lab::render::environment::Environment;
         use crate::sphere::envmap::tiny_map;
@@ -354,7 +407,7 @@ mod tests {
         for mode in [NuldMode::Table, NuldMode::Network] {
             for unbiased in [false, true] {
                 let mut weights = Vec::new();
-                let mut ours = NuldSampler::envmap(blob.as_slice(), mode)
+                let mut ours = NuldSampler::envmap(blob.as_slice(), mode, &env)
                     .unwrap()
                     .decoded(&mut weights);
                 if unbiased {
@@ -375,24 +428,38 @@ mod tests {
                         }
                     };
                     assert_eq!(s.direction, want.direction.as_dvec3());
-                    assert_eq!(s.pdf, want.pdf as f64);
                     let l = s.direction;
-                    assert_eq!(ours.pdf(&at, l), Some(cs.pdf(nf, want.direction) as f64));
                     let f_cos = at.cosine_weighted(l);
+                    if unbiased {
+                        assert_eq!(s.pdf, want.pdf as f64);
+                        assert_eq!(ours.pdf(&at, l), Some(cs.pdf(nf, want.direction) as f64));
+                        let product = env.product_pdf(n, l);
+                        if product > 0.0 {
+                            assert!(
+                                (product - s.pdf).abs() <= 1e-4 * product,
+                                "{product} {}",
+                                s.pdf
+                            );
+                            compared += 1;
+                        }
+                    } else {
+                        // q = L cos / E, E the runtime's weight; f cos / q = E f / L.
+                        let e = want.weight as f64;
+                        let q = env.radiance(l) * n.dot(l).max(0.0) / e;
+                        assert!((s.pdf - q).abs() <= 1e-12 * q, "{} {q}", s.pdf);
+                        let back = ours.pdf(&at, l).unwrap();
+                        assert!((back - q).abs() <= 1e-5 * q, "{back} {q}");
+                        if f_cos > 0.0 {
+                            let f = nuld_core::brdf::brdf(at.wo, at.frame.to_local(l), 0.3);
+                            let contribution = s.weight * env.radiance(l);
+                            assert!((contribution - e * f).abs() <= 1e-9 * e * f);
+                        }
+                    }
                     if f_cos > 0.0 {
-                        assert_eq!(s.weight, f_cos / s.pdf);
+                        assert!((s.weight - f_cos / s.pdf).abs() <= 1e-12 * s.weight);
                         checked += 1;
                     } else {
                         assert_eq!(s.weight, 0.0);
-                    }
-                    let product = env.product_pdf(n, l);
-                    if product > 0.0 {
-                        assert!(
-                            (product - s.pdf).abs() <= 1e-4 * product,
-                            "{product} {}",
-                            s.pdf
-                        );
-                        compared += 1;
                     }
                 }
             }
