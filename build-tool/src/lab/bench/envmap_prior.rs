@@ -8,6 +8,7 @@
 //! ignores the cosine).
 
 use super::runtime::{envmap_parts, ns_per_sample, random_parts, random_shape};
+use crate::sphere::envmap_tree::{prior_levels, PRIOR_GRID};
 use crate::sphere::{DirectionDensity, EnvmapDensity, EnvmapTree};
 use anyhow::{anyhow, Result};
 use glam::{DVec2, DVec3};
@@ -27,16 +28,13 @@ const NORMALS: usize = 64;
 /// Points per set: a set of 64 shares its normal and scramble.
 const N: u32 = 64;
 
-/// Depth and top-weight grid timed: the environment sampler's defaults.
-pub const LEVELS: u32 = 8;
-/// Normals per axis of the top-weight table timed.
-pub const GRID: u32 = 49;
-
 /// `(method, ns per sample)` rows, the incumbent first, over `samples` samples
 /// each, one thread: sample `s` has normal `s / N mod 64`, and index `s mod N` of
 /// the set scrambled by `s / N`.
 pub fn measure(map: &EnvmapDensity, samples: u32) -> Result<Vec<(String, f64)>> {
-    let tree = EnvmapTree::new(map, LEVELS, GRID)?;
+    // The environment sampler's own tree of this map.
+    let (levels, grid) = (prior_levels(map), PRIOR_GRID);
+    let tree = EnvmapTree::new(map, levels, grid)?;
     let core = tree.tree();
     let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(2);
     let normals: Vec<DVec3> = (0..NORMALS)
@@ -67,13 +65,13 @@ pub fn measure(map: &EnvmapDensity, samples: u32) -> Result<Vec<(String, f64)>> 
         }),
     ));
     rows.push((
-        format!("tree L {LEVELS}, top {GRID}: sample + pdf (f32)"),
+        format!("tree L {levels}, top {grid}: sample + pdf (f32)"),
         ns_per_sample(samples, |s| {
             black_box(core.sample(normals32[at(s)], u(s)));
         }),
     ));
     rows.push((
-        format!("tree L {LEVELS}, top {GRID}: pdf of a direction (f32)"),
+        format!("tree L {levels}, top {grid}: pdf of a direction (f32)"),
         ns_per_sample(samples, |s| {
             let [x, y] = u(s);
             let d = nuld_core::sphere::square_to_sphere_real([x, y]);
@@ -81,7 +79,7 @@ pub fn measure(map: &EnvmapDensity, samples: u32) -> Result<Vec<(String, f64)>> 
         }),
     ));
     rows.push((
-        format!("tree L {LEVELS}, top {GRID}: sample + pdf (f64)"),
+        format!("tree L {levels}, top {grid}: sample + pdf (f64)"),
         ns_per_sample(samples / 4, |s| {
             let [x, y] = u(s);
             black_box(core.sample(normals[at(s)].to_array(), [x as f64, y as f64]));
