@@ -287,19 +287,35 @@ fn run_brdf_prior(a: &EvalArgs) -> Result<()> {
         progress.inc(1);
     })?;
     progress.finish();
-    let table = markdown(&rows);
-    let json = serde_json::to_string_pretty(&serde_json::json!({
-        "settings": s,
-        "rows": rows,
-    }))?;
-    crate::output::write_atomic(&a.out.join("brdf-prior.json"), json.as_bytes())?;
-    crate::output::write_atomic(&a.out.join("brdf-prior.md"), table.as_bytes())?;
+    let json = serde_json::json!({ "settings": s, "rows": rows });
+    write_prior_report(
+        &a.out,
+        "brdf-prior",
+        &json,
+        &markdown(&rows),
+        rows.len(),
+        started,
+    )
+}
+
+/// Writes `DIR/STEM.json` and `DIR/STEM.md` (the table, also printed) of a
+/// prior's evaluation, and says how many configurations took how long.
+fn write_prior_report(
+    out: &std::path::Path,
+    stem: &str,
+    json: &serde_json::Value,
+    table: &str,
+    configurations: usize,
+    started: Instant,
+) -> Result<()> {
+    let text = serde_json::to_string_pretty(json)?;
+    crate::output::write_atomic(&out.join(format!("{stem}.json")), text.as_bytes())?;
+    crate::output::write_atomic(&out.join(format!("{stem}.md")), table.as_bytes())?;
     print!("{table}");
     eprintln!(
-        "brdf-prior: {} configurations in {:.1} s -> {}",
-        rows.len(),
+        "{stem}: {configurations} configurations in {:.1} s -> {}",
         started.elapsed().as_secs_f64(),
-        a.out.display()
+        out.display()
     );
     Ok(())
 }
@@ -337,20 +353,17 @@ fn run_envmap_prior(a: &EvalArgs) -> Result<()> {
         progress.inc(1);
     })?;
     progress.finish();
-    let table = markdown(&rows);
-    let json = serde_json::to_string_pretty(&serde_json::json!({
+    let json = serde_json::json!({
         "map": path.display().to_string(),
         "settings": s,
         "rows": rows,
-    }))?;
-    crate::output::write_atomic(&a.out.join("envmap-prior.json"), json.as_bytes())?;
-    crate::output::write_atomic(&a.out.join("envmap-prior.md"), table.as_bytes())?;
-    print!("{table}");
-    eprintln!(
-        "envmap-prior: {} configurations in {:.1} s -> {}",
+    });
+    write_prior_report(
+        &a.out,
+        "envmap-prior",
+        &json,
+        &markdown(&rows),
         rows.len(),
-        started.elapsed().as_secs_f64(),
-        a.out.display()
-    );
-    Ok(())
+        started,
+    )
 }

@@ -23,12 +23,13 @@
 //!   follow `f cos` decides the variance and how much low discrepancy survives
 //!   the warp (`build-tool eval brdf-prior`).
 
+use super::envmap_prior::tabulated;
 use glam::{DVec2, DVec3};
 use nuld_core::brdf::{
     gltf_metallic, view_direction, MAX_METALLIC, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_METALLIC,
     MIN_ROUGHNESS,
 };
-use nuld_core::marginal2d::{tabulate, Blend, Marginal2D, Marginal2DError, Marginal2DShape};
+use nuld_core::marginal2d::{Blend, Marginal2D, Marginal2DError, Marginal2DShape};
 use nuld_core::sphere::{hemisphere_to_square, square_to_hemisphere};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -168,10 +169,7 @@ impl BrdfPrior {
                 out
             })
             .collect();
-        let mut data = tables.concat();
-        let mut marginal = vec![0.0; shape.marginal_len().ok_or(Marginal2DError::Shape)?];
-        let mut conditional = vec![0.0; data.len()];
-        tabulate(shape, &mut data, &mut marginal, &mut conditional)?;
+        let [data, marginal, conditional] = tabulated(shape, &tables)?;
         Ok(Self {
             grid,
             space,

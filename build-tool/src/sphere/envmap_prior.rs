@@ -88,10 +88,7 @@ impl EnvmapPrior {
                 }
             })
             .collect();
-        let mut data = tables.concat();
-        let mut marginal = vec![0.0; shape.marginal_len().ok_or(Marginal2DError::Shape)?];
-        let mut conditional = vec![0.0; data.len()];
-        tabulate(shape, &mut data, &mut marginal, &mut conditional)?;
+        let [data, marginal, conditional] = tabulated(shape, &tables)?;
         Ok(Self {
             grid,
             shape,
@@ -131,6 +128,20 @@ impl EnvmapPrior {
     pub fn state_bytes(&self) -> usize {
         4 * (self.data.len() + self.conditional.len() + self.marginal.len())
     }
+}
+
+/// The node tables `tables` (each `nx ny` vertex values) of a warp of `shape`
+/// normalized, with their cumulative tables: `[data, marginal, conditional]` as
+/// [`Marginal2D::new`] reads them ([`tabulate`]).
+pub(crate) fn tabulated(
+    shape: Marginal2DShape,
+    tables: &[Vec<f32>],
+) -> Result<[Vec<f32>; 3], Marginal2DError> {
+    let mut data = tables.concat();
+    let mut marginal = vec![0.0; shape.marginal_len().ok_or(Marginal2DError::Shape)?];
+    let mut conditional = vec![0.0; data.len()];
+    tabulate(shape, &mut data, &mut marginal, &mut conditional)?;
+    Ok([data, marginal, conditional])
 }
 
 /// Per table vertex, the mean of `value(direction, L)` over its `k x k`
