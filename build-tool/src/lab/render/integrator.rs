@@ -189,6 +189,41 @@ mod tests {
         (scene, camera)
     }
 
+    /// Per pixel of a furnace view, `c A(roughness, θo)` where a surface shows
+    /// (`A` the independent quadrature of `sphere::brdf_albedo`), `None` on the
+    /// background, which must be the sky's `c`.
+    fn furnace_albedo(setup: &Setup<'_>, roughness: f64, c: f64) -> Vec<Option<f64>> {
+        let (w, h) = (setup.camera.width(), setup.camera.height());
+        (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| match setup.primary(x, y) {
+                Primary::Surface { at, .. } => {
+                    let t = at.theta_o_deg().min(89.0);
+                    Some(c * directional_albedo(BrdfModel::Gltf, roughness, t).total())
+                }
+                Primary::Background(l) => {
+                    assert!((l - c).abs() < 1e-9 * c);
+                    None
+                }
+            })
+            .collect()
+    }
+
+    /// The mean of `value / want - 1` over the pixels with a `want`, and its
+    /// standard error from the pixels' spread.
+    fn relative_error(img: &Image, want: &[Option<f64>]) -> (f64, f64) {
+        let ratios: Vec<f64> = img
+            .values
+            .iter()
+            .zip(want)
+            .filter_map(|(v, a)| a.map(|a| v / a - 1.0))
+            .collect();
+        let k = ratios.len() as f64;
+        let mean = ratios.iter().sum::<f64>() / k;
+        let var = ratios.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / (k - 1.0);
+        (mean, (var / k).sqrt())
+    }
+
     /// The white furnace: under a constant unit sky an unoccluded point's pixel is
     /// its directional albedo `A(roughness, θo)` (the independent quadrature of
     /// `sphere::brdf_albedo`), for every sampler of every technique, MIS
@@ -239,19 +274,7 @@ mod tests {
                 .unwrap(),
             );
             // A at each surface pixel's view angle.
-            let albedo: Vec<Option<f64>> = (0..48)
-                .flat_map(|y| (0..48).map(move |x| (x, y)))
-                .map(|(x, y)| match setup.primary(x, y) {
-                    Primary::Surface { at, .. } => Some(
-                        directional_albedo(BrdfModel::Gltf, roughness, at.theta_o_deg().min(89.0))
-                            .total(),
-                    ),
-                    Primary::Background(l) => {
-                        assert!((l - 1.0).abs() < 1e-12);
-                        None
-                    }
-                })
-                .collect();
+            let albedo = furnace_albedo(&setup, roughness, 1.0);
             assert!(albedo.iter().flatten().count() > 800);
             for s in &samplers {
                 let n = match s.technique() {
@@ -259,26 +282,17 @@ mod tests {
                     _ => 16,
                 };
                 let img = setup.render(s.as_ref(), n, 9, &|| {});
-                let ratios: Vec<f64> = img
-                    .values
-                    .iter()
-                    .zip(&albedo)
-                    .filter_map(|(v, a)| a.map(|a| v / a - 1.0))
-                    .collect();
-                let k = ratios.len() as f64;
-                let mean = ratios.iter().sum::<f64>() / k;
-                let var = ratios.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / (k - 1.0);
+                let (mean, se) = relative_error(&img, &albedo);
                 let slack = if s.name().starts_with("nuld") {
                     2e-3
                 } else {
                     0.0
                 };
                 assert!(
-                    mean.abs() <= 4.0 * (var / k).sqrt() + slack + 1e-12,
-                    "{} {} at roughness {roughness}: mean relative error {mean:.3e}, stderr {:.3e}",
+                    mean.abs() <= 4.0 * se + slack + 1e-12,
+                    "{} {} at roughness {roughness}: mean relative error {mean:.3e}, stderr {se:.3e}",
                     s.technique().name(),
                     s.name(),
-                    (var / k).sqrt()
                 );
             }
         }
@@ -324,23 +338,9 @@ mod tests {
         let mut checked = 0;
         for s in samplers.iter().filter(|s| s.name() == "nuld-unbiased") {
             let img = setup.render(s.as_ref(), 16, 9, &|| {});
-            let ratios: Vec<f64> = (0..48)
-                .flat_map(|y| (0..48).map(move |x| (x, y)))
-                .zip(&img.values)
-                .filter_map(|((x, y), v)| match setup.primary(x, y) {
-                    Primary::Surface { at, .. } => {
-                        let t = at.theta_o_deg().min(89.0);
-                        let a = directional_albedo(BrdfModel::Gltf, roughness, t).total();
-                        Some(v / (c * a) - 1.0)
-                    }
-                    Primary::Background(_) => None,
-                })
-                .collect();
-            let k = ratios.len() as f64;
-            assert!(k > 800.0);
-            let mean = ratios.iter().sum::<f64>() / k;
-            let var = ratios.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / (k - 1.0);
-            let se = (var / k).sqrt();
+            let albedo = furnace_albedo(&setup, roughness, c);
+            assert!(albedo.iter().flatten().count() > 800);
+            let (mean, se) = relative_error(&img, &albedo);
             assert!(
                 mean.abs() <= 4.0 * se,
                 "{}: mean relative error {mean:.3e}, stderr {se:.3e}",

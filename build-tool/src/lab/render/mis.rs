@@ -21,6 +21,11 @@ use super::sampler::{DirectionSampler, PixelKey, Sample, ShadingPoint, Technique
 use glam::DVec3;
 use std::sync::Arc;
 
+thread_local! {
+    /// The BRDF samples of the pixel being shaded on this thread.
+    static BRDF_SCRATCH: std::cell::RefCell<Vec<Sample>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
 /// The power heuristic's weight of a technique of density `p` against the other
 /// technique's `q`: `p² / (p² + q²)` (0 when both are 0).
 pub fn power_heuristic(p: f64, q: f64) -> f64 {
@@ -73,15 +78,18 @@ impl DirectionSampler for MisSampler<'_> {
             let other = self.brdf.pdf(at, s.direction).unwrap_or(0.0);
             s.weight *= power_heuristic(s.pdf, other);
         }
-        let mut brdf = Vec::with_capacity(n as usize);
-        self.brdf.samples(at, key.second(), n, &mut brdf);
-        out.extend(brdf.into_iter().filter(|s| s.weight > 0.0).map(|s| {
-            let other = self.envmap.pdf(at, s.direction).unwrap_or(0.0);
-            Sample {
-                weight: s.weight * power_heuristic(s.pdf, other),
-                ..s
-            }
-        }));
+        // The BRDF half in a scratch buffer of the thread's, reused from pixel to
+        // pixel (no allocation per pixel).
+        BRDF_SCRATCH.with_borrow_mut(|brdf| {
+            self.brdf.samples(at, key.second(), n, brdf);
+            out.extend(brdf.iter().filter(|s| s.weight > 0.0).map(|s| {
+                let other = self.envmap.pdf(at, s.direction).unwrap_or(0.0);
+                Sample {
+                    weight: s.weight * power_heuristic(s.pdf, other),
+                    ..*s
+                }
+            }));
+        });
     }
 
     /// `None`: the combination has no single warp.

@@ -247,8 +247,9 @@ impl DirectionSampler for NuldSampler<'_> {
         Some(match self.randomized {
             true => prior.0 as f64,
             false => {
-                let e = self.sampler.weight(normal_condition(at.frame.normal())) as f64;
-                target_density(at, prior.1, e, l)
+                // The runtime's E(n), the weight its samples carry here.
+                let e = EnvmapSampler::try_from(self.sampler).map_or(0.0, |t| t.weight(normal));
+                target_density(at, prior.1, e as f64, l)
             }
         })
     }
@@ -292,13 +293,6 @@ fn target_density(at: &ShadingPoint, env: &Environment, e: f64, l: DVec3) -> f64
     } else {
         0.0
     }
-}
-
-/// The runtime's condition of a world normal: its equal-area octahedral square
-/// point.
-fn normal_condition(n: DVec3) -> Vec2 {
-    let p = nuld_core::sphere::sphere_to_square_real(n.as_vec3().normalize().to_array());
-    Vec2::from_array(p)
 }
 
 /// A BRDF sample in the world frame with the runtime's weight, the albedo. The
