@@ -583,7 +583,7 @@ fn sample_prints_what_the_runtime_serves_and_rejects_bad_input() {
         (&file, "0.5"),
         (&file, "abc,30"),
         (&file, "0.5,inf"),
-        (&file, "0.5,30,2"),
+        (&file, "0.5,30,0,1"),
     ] {
         let out = build_tool()
             .arg("sample")

@@ -8,6 +8,8 @@
 //!   hemisphere), with their inverses and the edge wrapping used by optimizers;
 //! * [`brdf`]: the glTF 2.0 BRDF of `brdf:` targets and conditional samplers, over
 //!   [`real::Real`] so that `f32` and `f64` share one formula;
+//! * [`brdf_prior`]: the BRDF sampler's prior, the metallic-roughness BRDF times the
+//!   cosine tabulated in the half vector's square over (roughness, θo, metallic);
 //! * [`warp`]: the warps baselines sample with (concentric disk, cosine hemisphere,
 //!   GGX visible normals), each beside its density and its inverse;
 //! * [`domain`]: where a set's points live and the map from square to direction;
@@ -41,6 +43,7 @@
 
 pub mod blob;
 pub mod brdf;
+pub mod brdf_prior;
 pub mod conditional;
 pub mod domain;
 pub mod envmap_tree;

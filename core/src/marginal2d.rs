@@ -98,7 +98,7 @@ pub enum Marginal2DError {
 
 impl core::fmt::Display for Marginal2DError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        const SLICES: [&str; 3] = ["data", "marginal CDF", "conditional CDF"];
+        const SLICES: [&str; 4] = ["data", "marginal CDF", "conditional CDF", "masses"];
         let name = |s: u8| SLICES.get(s as usize).copied().unwrap_or("table");
         match *self {
             Self::Shape => write!(f, "a warp table needs at least 2 x 2 vertices and 1 node"),
@@ -359,6 +359,27 @@ impl<'a, T: Real> Marginal2D<'a, T> {
         Ok(Self {
             nx,
             ny,
+            nodes: shape.nodes as usize,
+            data,
+            marginal,
+            conditional,
+        })
+    }
+
+    /// The warp over tables whose values [`Self::new`] has checked before (a
+    /// blob's, validated once at parse): checks the shape and the three lengths
+    /// only, `O(1)`. Never panics on any values; the pdf is as exact as the
+    /// tables are consistent.
+    pub fn view(
+        shape: Marginal2DShape,
+        data: &'a [T],
+        marginal: &'a [T],
+        conditional: &'a [T],
+    ) -> Result<Self, Marginal2DError> {
+        check_lengths(shape, data.len(), marginal.len(), conditional.len())?;
+        Ok(Self {
+            nx: shape.size[0] as usize,
+            ny: shape.size[1] as usize,
             nodes: shape.nodes as usize,
             data,
             marginal,

@@ -191,6 +191,35 @@ pub fn hemisphere_to_square(d: DVec3) -> DVec2 {
     concentric_polar_inverse(r, libm::atan2(d.y, d.x))
 }
 
+/// [`hemisphere_to_square`] in any [`Real`] precision, without `atan2` (the
+/// runtime's `f32` twin; a shader follows the same order of operations): the disk
+/// point `r (x, y) / |(x, y)|` with `r = sqrt(1 - |z|)` is inverted per wedge of
+/// the concentric map, `a = ±r, b = a atan(y / x) / (pi/4)` where `|x| >= |y|`,
+/// else `b = ±r, a = b atan(x / y) / (pi/4)` (the signs of `x` and `y`). The
+/// pole and NaN read as the centre.
+pub fn hemisphere_to_square_real<T: Real>(d: [T; 3]) -> [T; 2] {
+    let r = safe_sqrt(T::ONE - d[2].abs()).min(T::ONE);
+    let (x, y) = (d[0], d[1]);
+    let half = T::of(0.5);
+    let planar = x != T::ZERO || y != T::ZERO;
+    if r.partial_cmp(&T::ZERO) != Some(core::cmp::Ordering::Greater)
+        || !planar
+        || x.is_nan()
+        || y.is_nan()
+    {
+        return [half, half];
+    }
+    let inv_quarter_pi = T::of(4.0 / core::f64::consts::PI);
+    let (a, b) = if x.abs() >= y.abs() {
+        let a = r.copysign(x);
+        (a, a * (y / x).atan() * inv_quarter_pi)
+    } else {
+        let b = r.copysign(y);
+        (b * (x / y).atan() * inv_quarter_pi, b)
+    };
+    [half * (a + T::ONE), half * (b + T::ONE)]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -19,13 +19,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let brdf = blob.brdf()?;
 
     let wo = Vec3::new(0.5, 0.2, 0.8); // the view, local frame, any length
-    let roughness = 0.3;
+    let (roughness, metallic) = (0.3, 0.0); // glTF's material parameters
     let instance = 17; // decorrelates pixels: e.g. a hash of the pixel
     let n = brdf.len();
-    // Table mode: O(1) per sample, no allocation; weight = directional albedo.
+    // Table mode: O(1) per sample, no allocation; weight = f cos / pdf.
     let mut table = 0.0;
     for i in 0..n {
-        let s = brdf.sample(wo, roughness, instance, i);
+        let s = brdf.sample(wo, roughness, metallic, instance, i);
         table += s.weight * incoming(s.direction) / n as f32;
     }
     // Network mode evaluates the trained network per sample; decoding its f16
@@ -37,7 +37,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .ok_or("buffer too short")?;
     let mut net = 0.0;
     for i in 0..n {
-        let s = network.sample(wo, roughness, instance, i);
+        let s = network.sample(wo, roughness, metallic, instance, i);
         net += s.weight * incoming(s.direction) / n as f32;
     }
     println!("{path}: N = {n}; reflected radiance: table {table:.5}, network {net:.5}");

@@ -1,6 +1,22 @@
 //! The BRDF sampler's typed views (blobs of `build-tool bake --brdf`): a view
-//! direction and a roughness in, a direction of the set for that view out, in table
-//! mode ([`BrdfSampler`]) or network mode ([`BrdfNetwork`]).
+//! direction, a roughness and a metallic in, a direction of the set for that view
+//! out, in table mode ([`BrdfSampler`]) or network mode ([`BrdfNetwork`]), with
+//! the exact pdf of the sampler's prior and an unbiased mode.
+//!
+//! **The prior.** Every set is the exact tabulated warp of the glTF
+//! metallic-roughness BRDF times the cosine ([`nuld_core::brdf_prior`]) applied
+//! to learned points of its primary sample space. [`Sample::pdf`] is that warp's
+//! solid-angle density at the direction, [`BrdfSampler::pdf`] answers it for any
+//! direction (multiple importance sampling with a light sampler), and
+//! [`Sample::weight`] is `f cos / pdf` of the direction, so that
+//! `(1/N) Σ L(direction_i) weight_i` estimates `∫ L f cos`: exact in expectation
+//! in the **unbiased mode** ([`BrdfSampler::sample_randomized`]); in the
+//! fixed-instance modes the learned points follow the pdf only approximately,
+//! a small bias that shrinks with the set's discrepancy; there the estimator
+//! `(A / N) Σ L(direction_i)` with the albedo [`BrdfSampler::albedo`] treats the
+//! sets as following the target `f cos / A` they were trained for instead. Blobs of the earlier
+//! VNDF/cosine mixture prior still load: their samples carry `pdf = 0` and the
+//! albedo as the weight, and ignore the metallic.
 
 use crate::conditional::{scaled_to_largest, ConditionalSampler, NetworkSampler, Sample};
 use glam::{Vec2, Vec3};
@@ -11,30 +27,31 @@ use nuld_core::conditional::ConditionalTarget;
 const DEGREES_PER_RADIAN: f32 = 180.0 / core::f32::consts::PI;
 
 /// A glTF 2.0 BRDF sampler in **table mode**: for a view `wo` (local frame, `z` =
-/// normal) and a roughness, the directions of a low-discrepancy set for
-/// `f(l) max(0, n.l)` and the estimator weight, the directional albedo `A`, so that
-/// `∫ L f cos ≈ (A / N) Σ L(direction_i)`.
+/// normal), a roughness and a metallic, the directions of a low-discrepancy set for
+/// `f(l) max(0, n.l)` with their pdf and the estimator weight `f cos / pdf`, so
+/// that `∫ L f cos ≈ (1 / N) Σ L(direction_i) weight_i` (module docs).
 ///
 /// Obtained from [`crate::Blob::brdf`], which refuses any other blob; a copyable
 /// view on the blob's bytes. Every method is `O(1)`, allocates nothing and never
-/// panics: roughness clamps into the blob's range (NaN reads as the lower end),
-/// indices wrap modulo [`Self::len`], instances modulo [`Self::instances`].
+/// panics: roughness clamps into the blob's range, metallic into `[0, 1]` (NaN
+/// reads as the lower end), indices wrap modulo [`Self::len`], instances modulo
+/// [`Self::instances`].
 ///
 /// ```
 /// # let bytes = nuld_runtime::doc_example_conditional_blob();
 /// use nuld_runtime::glam::Vec3;
 /// let brdf = nuld_runtime::Blob::parse(&bytes.0)?.brdf()?;
 /// let wo = Vec3::new(0.3, 0.4, 0.866); // the view, any length
-/// let (roughness, instance) = (0.4, 17); // instance: e.g. a hash of the pixel
+/// let (roughness, metallic, instance) = (0.4, 0.0, 17); // instance: e.g. a pixel hash
 /// let mut estimate = 0.0;
 /// for i in 0..brdf.len() {
-///     let s = brdf.sample(wo, roughness, instance, i);
+///     let s = brdf.sample(wo, roughness, metallic, instance, i);
 ///     assert!((s.direction.length() - 1.0).abs() < 1e-5 && s.direction.z >= 0.0);
 ///     let radiance = 1.0; // L(s.direction) in a renderer
 ///     estimate += s.weight * radiance / brdf.len() as f32;
 /// }
 /// // Network mode: the same model evaluated per sample.
-/// let s = brdf.network().sample(wo, roughness, instance, 0);
+/// let s = brdf.network().sample(wo, roughness, metallic, instance, 0);
 /// assert!(estimate > 0.0 && s.weight > 0.0);
 /// # Ok::<(), nuld_runtime::BlobError>(())
 /// ```
@@ -83,16 +100,29 @@ impl<'a> BrdfSampler<'a> {
         self.0.instances()
     }
 
-    /// The estimator weight (directional albedo `A`) at view `wo` and `roughness`.
+    /// The directional albedo `A` of the dielectric (metallic 0) at view `wo` and
+    /// `roughness`, interpolated on the blob's weight grid ([`Self::albedo`] at
+    /// metallic 0).
     #[inline]
     pub fn weight(&self, wo: Vec3, roughness: f32) -> f32 {
         self.0.weight(view_condition(wo, roughness).0)
     }
 
+    /// The directional albedo `A = ∫ f cos` at view `wo`, `roughness` and
+    /// `metallic` ([`ConditionalSampler::albedo`]): what the weights of the
+    /// unbiased mode average to, and the weight of the fixed-instance modes'
+    /// second estimator, `(A / N) Σ L(direction_i)`, which treats the set as
+    /// following the target `f cos / A` it was trained for (exact in a white
+    /// furnace; module docs). O(1), never panics.
+    #[inline]
+    pub fn albedo(&self, wo: Vec3, roughness: f32, metallic: f32) -> f32 {
+        self.0.albedo(view_condition(wo, roughness).0, metallic)
+    }
+
     /// The direction of index `i` of instance `instance` for the view `wo` (local
-    /// frame, `z` = normal, any length) at `roughness`, and the weight. The set is
-    /// made for the view in the xz-plane on the `+x` side; this samples it at
-    /// `(roughness, theta_o)` and rotates the direction about `z` by the view's
+    /// frame, `z` = normal, any length) at `roughness` and `metallic`, its pdf and
+    /// weight. The set is made for the view in the xz-plane on the `+x` side; this
+    /// samples it at `(roughness, theta_o, metallic)` and rotates the direction about `z` by the view's
     /// azimuth `phi = atan2(wo.y, wo.x)` (the target is isotropic), so the set
     /// follows the caller's view.
     ///
@@ -108,16 +138,67 @@ impl<'a> BrdfSampler<'a> {
     /// let brdf = nuld_runtime::Blob::parse(&bytes.0)?.brdf()?;
     /// // A view at 60° in the yz-plane: the xz-plane set turned by 90° about z.
     /// let wo = Vec3::new(0.0, 3f32.sqrt() / 2.0, 0.5);
-    /// let s = brdf.sample(wo, 0.3, 7, 2);
-    /// let t = brdf.conditional().sample(Vec2::new(0.3, 60.0), 7, 2);
+    /// let s = brdf.sample(wo, 0.3, 0.5, 7, 2);
+    /// let t = brdf.conditional().sample_metallic(Vec2::new(0.3, 60.0), 0.5, 7, 2);
     /// let turned = Vec3::new(-t.direction.y, t.direction.x, t.direction.z);
     /// assert!((s.direction - turned).length() < 1e-5);
     /// # Ok::<(), nuld_runtime::BlobError>(())
     /// ```
     #[inline]
-    pub fn sample(&self, wo: Vec3, roughness: f32, instance: u32, i: u32) -> Sample {
+    pub fn sample(&self, wo: Vec3, roughness: f32, metallic: f32, instance: u32, i: u32) -> Sample {
         let (cond, azimuth) = view_condition(wo, roughness);
-        rotate(self.0.sample(cond, instance, i), azimuth)
+        rotate(self.0.sample_metallic(cond, metallic, instance, i), azimuth)
+    }
+
+    /// The unbiased mode: [`Self::sample`] with the primary point shifted on the
+    /// torus by a random vector drawn from `seed` (the pixel's random number,
+    /// [`nuld_core::conditional::randomization_shift`]), so that each sample is
+    /// distributed exactly as its [`Sample::pdf`] and `L weight` is unbiased
+    /// whatever the table learned. O(1), never panics.
+    ///
+    /// ```
+    /// # let bytes = nuld_runtime::doc_example_brdf_blob();
+    /// use nuld_runtime::glam::Vec3;
+    /// let brdf = nuld_runtime::Blob::parse(&bytes.0)?.brdf()?;
+    /// let wo = Vec3::new(0.5, -0.2, 0.8);
+    /// for i in 0..brdf.len() {
+    ///     // A metal of roughness 0.3; the pixel's random number 0xdead_beef.
+    ///     let s = brdf.sample_randomized(wo, 0.3, 1.0, 0, i, 0xdead_beef);
+    ///     // pdf 0 (and weight 0) only where a coarse table leaks below the horizon.
+    ///     if s.pdf > 0.0 {
+    ///         let pdf = brdf.pdf(wo, 0.3, 1.0, s.direction);
+    ///         assert!((pdf - s.pdf).abs() <= 1e-3 * s.pdf && s.weight.is_finite());
+    ///     }
+    /// }
+    /// # Ok::<(), nuld_runtime::BlobError>(())
+    /// ```
+    #[inline]
+    pub fn sample_randomized(
+        &self,
+        wo: Vec3,
+        roughness: f32,
+        metallic: f32,
+        instance: u32,
+        i: u32,
+        seed: u32,
+    ) -> Sample {
+        let (cond, azimuth) = view_condition(wo, roughness);
+        let s = self
+            .0
+            .sample_randomized_metallic(cond, metallic, instance, i, seed);
+        rotate(s, azimuth)
+    }
+
+    /// The solid-angle density of the sampler's prior at the unit `direction`
+    /// (local frame) for the view `wo`, `roughness` and `metallic`:
+    /// [`Sample::pdf`] of a sample there, for any direction (multiple importance
+    /// sampling); 0 below the horizon, and for blobs of the mixture prior.
+    /// `O(log size)`, never panics.
+    #[inline]
+    pub fn pdf(&self, wo: Vec3, roughness: f32, metallic: f32, direction: Vec3) -> f32 {
+        let (cond, azimuth) = view_condition(wo, roughness);
+        self.0
+            .pdf_metallic(cond, metallic, unrotate(direction, azimuth))
     }
 
     /// The same model in network mode, reading the blob's f16 weights (zero-copy).
@@ -169,9 +250,35 @@ impl<'a> BrdfNetwork<'a> {
     /// As [`BrdfSampler::sample`], the network evaluated per sample.
     /// `O(multiply_adds)`, never panics.
     #[inline]
-    pub fn sample(&self, wo: Vec3, roughness: f32, instance: u32, i: u32) -> Sample {
+    pub fn sample(&self, wo: Vec3, roughness: f32, metallic: f32, instance: u32, i: u32) -> Sample {
         let (cond, azimuth) = view_condition(wo, roughness);
-        rotate(self.0.sample(cond, instance, i), azimuth)
+        rotate(self.0.sample_metallic(cond, metallic, instance, i), azimuth)
+    }
+
+    /// The unbiased mode in network mode ([`BrdfSampler::sample_randomized`]).
+    #[inline]
+    pub fn sample_randomized(
+        &self,
+        wo: Vec3,
+        roughness: f32,
+        metallic: f32,
+        instance: u32,
+        i: u32,
+        seed: u32,
+    ) -> Sample {
+        let (cond, azimuth) = view_condition(wo, roughness);
+        let s = self
+            .0
+            .sample_randomized_metallic(cond, metallic, instance, i, seed);
+        rotate(s, azimuth)
+    }
+
+    /// The prior's pdf ([`BrdfSampler::pdf`]; both modes share the prior).
+    #[inline]
+    pub fn pdf(&self, wo: Vec3, roughness: f32, metallic: f32, direction: Vec3) -> f32 {
+        let (cond, azimuth) = view_condition(wo, roughness);
+        self.0
+            .pdf_metallic(cond, metallic, unrotate(direction, azimuth))
     }
 
     /// The target-agnostic network view, conditions in the blob's units.
@@ -196,6 +303,14 @@ fn view_condition(wo: Vec3, roughness: f32) -> (Vec2, Vec2) {
         Vec2::X
     };
     (Vec2::new(roughness, theta), azimuth)
+}
+
+/// `d` turned about `z` by minus the azimuth `(cos phi, sin phi)`: a local
+/// direction in the frame of the xz-plane view.
+#[inline]
+fn unrotate(d: Vec3, azimuth: Vec2) -> Vec3 {
+    let (c, sn) = (azimuth.x, azimuth.y);
+    Vec3::new(c * d.x + sn * d.y, -sn * d.x + c * d.y, d.z)
 }
 
 /// The sample turned about `z` by the azimuth `(cos phi, sin phi)`.

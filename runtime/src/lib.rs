@@ -38,8 +38,8 @@
 //! let blob = Blob::parse(bytes)?;
 //! let brdf = blob.brdf()?; // a blob of `build-tool bake --brdf`
 //! let wo = Vec3::new(0.3, 0.4, 0.866); // view, local frame (z = normal)
-//! let s = brdf.sample(wo, 0.4, 17, 0); // table mode: roughness 0.4, instance 17, index 0
-//! let t = brdf.network().sample(wo, 0.4, 17, 0); // network mode
+//! let s = brdf.sample(wo, 0.4, 0.0, 17, 0); // table mode: roughness 0.4, metallic 0, instance 17, index 0
+//! let t = brdf.network().sample(wo, 0.4, 0.0, 17, 0); // network mode
 //! assert!(s.weight > 0.0 && t.weight > 0.0);
 //! assert!(matches!(blob.envmap(), Err(BlobError::WrongTarget { .. })));
 //! # Ok::<(), BlobError>(())
@@ -302,6 +302,71 @@ pub fn doc_example_conditional_blob() -> Aligned<[u8; 400]> {
     doc_example_sampler(ConditionalTarget::GltfBrdf, [0.1, 0.0], [1.0, 89.0])
 }
 
+/// [`doc_example_conditional_blob`] as a BRDF sampler on the tabulated prior
+/// ([`nuld_core::conditional::PointWarp::BrdfTable`]): its network and point
+/// table, the dielectric's and the metal's albedo as weights, and a prior of 2 x
+/// 2 x 2 conditions on 4 x 4 half-vector vertices (`f cos |dwi/dh|` at each
+/// vertex), so that its samples carry an exact pdf.
+#[doc(hidden)]
+pub fn doc_example_brdf_blob() -> Aligned<[u8; 1776]> {
+    use nuld_core::brdf::{gltf_metallic, view_direction_real};
+    use nuld_core::brdf_prior::{half_vector_direction, node_condition, BrdfPriorInfo};
+    use nuld_core::marginal2d::tabulate;
+    let (info, params, table, _) =
+        doc_example_parts(ConditionalTarget::GltfBrdf, [0.1, 0.0], [1.0, 89.0]);
+    let info = ConditionalInfo {
+        warp: nuld_core::conditional::PointWarp::BrdfTable as u32,
+        ..info
+    };
+    let weights: [f32; 8] = [0.97, 0.97, 0.93, 0.94, 0.99, 0.91, 0.31, 0.78];
+    let prior = BrdfPriorInfo {
+        grid: [2, 2, 2],
+        size: 4,
+    };
+    let mut data = [0.0f32; 128];
+    for (node, table) in data.chunks_mut(16).enumerate() {
+        let [r, t, m] = node_condition(prior.grid, node as u32).map(|x| x as f32);
+        let wo = view_direction_real(t);
+        for (v, value) in table.iter_mut().enumerate() {
+            let p = [(v % 4) as f32 / 3.0, (v / 4) as f32 / 3.0];
+            if let Some((wi, jac)) = half_vector_direction(wo, p) {
+                *value = gltf_metallic(wo, wi, r, m) * wi[2] * jac;
+            }
+        }
+    }
+    // Each node's trapezoid mass, which `tabulate` divides by.
+    let mut masses = [0.0f32; 8];
+    for (mass, table) in masses.iter_mut().zip(data.chunks(16)) {
+        let w = |i: usize| if i == 0 || i == 3 { 0.5 } else { 1.0 };
+        *mass = (0..16).map(|v| w(v % 4) * w(v / 4) * table[v]).sum::<f32>() / 9.0;
+    }
+    let (mut marginal, mut conditional) = ([0.0f32; 32], [0.0f32; 128]);
+    let shape = prior
+        .shape()
+        .unwrap_or(nuld_core::marginal2d::Marginal2DShape {
+            size: [4, 4],
+            nodes: 8,
+        });
+    let _ = tabulate(shape, &mut data, &mut marginal, &mut conditional);
+    let meta = [
+        3, b'd', b'o', b'c', 7, b'b', b'r', b'd', b'f', b'-', b'd', b'o', 0,
+    ];
+    let [a, b, c, d] = nuld_core::conditional::sections(&info, &params, &table, &weights);
+    let [e, f, g, h, i] =
+        nuld_core::brdf_prior::sections(&prior, &data, &marginal, &conditional, &masses);
+    // 48 + 9 x 32 + 13 -> 352; info 80 -> 432; params 36 -> 480; table 64 -> 544;
+    // weights 32 -> 576; prior info 16 -> 592; data 512 -> 1104; marginal 128 ->
+    // 1232; conditional 512 -> 1744; masses 32 -> 1776 bytes.
+    let mut out = Aligned([0u8; 1776]);
+    let _ = nuld_core::blob::write(
+        &mut out.0,
+        BlobKind::Conditional,
+        &meta,
+        &[a, b, c, d, e, f, g, h, i],
+    );
+    out
+}
+
 /// [`doc_example_conditional_blob`] as an environment sampler on its prior: conditions
 /// the normal's octahedral square point in `[0, 1]^2`, directions on the sphere, a
 /// tree of 3 levels over a sky brighter towards `+z` with its top weights on 2 x 2
@@ -424,6 +489,15 @@ fn doc_example_sampler(
 #[cfg(test)]
 mod tests {
     use super::*;
+    /// The documentation's BRDF blob parses, on the tabulated prior.
+    #[test]
+    fn the_doc_brdf_blob_parses_with_its_prior() {
+        let bytes = doc_example_brdf_blob();
+        let brdf = Blob::parse(&bytes.0).unwrap().brdf().unwrap();
+        let s = brdf.sample(glam::Vec3::new(0.3, 0.1, 0.9), 0.5, 0.5, 1, 1);
+        assert!(s.pdf > 0.0 && s.weight > 0.0);
+    }
+
     #[test]
     fn point_counts_whose_byte_length_passes_2_pow_64_are_refused_without_overflow() {
         assert!(Blob::parse(&point_set_blob(4, 1).0).is_ok());

@@ -29,9 +29,9 @@ pub(crate) fn record<T: bytemuck::Pod, E: Into<BlobError>>(
 pub(crate) fn typed_section<'a, T: bytemuck::Pod, E: Into<BlobError>>(
     layout: &Layout<'a>,
     tag: SectionTag,
-    bad_size: fn(u32) -> E,
+    bad_size: impl FnOnce(u32) -> E,
     expected: impl FnOnce() -> Result<u64, E>,
-    bad_length: fn(u64, u64) -> E,
+    bad_length: impl FnOnce(u64, u64) -> E,
 ) -> Result<&'a [T], BlobError> {
     let (entry, bytes) = layout.section(tag)?;
     let size = core::mem::size_of::<T>();

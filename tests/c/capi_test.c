@@ -162,7 +162,7 @@ static void parse_floats(const char *text, float *out, int count, const char *fl
 }
 
 static int cmd_sample(int argc, char **argv) {
-  if (argc < 1) die("usage", "sample FILE (--cond A,B | --normal X,Y,Z) [options]");
+  if (argc < 1) die("usage", "sample FILE (--cond A,B[,M] | --normal X,Y,Z) [options]");
   float at[3] = {0};
   int normal = -1, decoded = 0, randomize = 0;
   uint32_t instance = 0, mode = NULD_MODE_TABLE, seed = 0;
@@ -175,7 +175,10 @@ static int cmd_sample(int argc, char **argv) {
     if (!v) die("missing value of", a);
     k++;
     if (!strcmp(a, "--cond")) {
-      parse_floats(v, at, 2, a);
+      // A,B or A,B,METALLIC (the metallic 0 unless given).
+      int commas = 0;
+      for (const char *q = v; *q; q++) commas += *q == ',';
+      parse_floats(v, at, commas == 2 ? 3 : 2, a);
       normal = 0;
     } else if (!strcmp(a, "--normal")) {
       parse_floats(v, at, 3, a);
@@ -212,9 +215,9 @@ static int cmd_sample(int argc, char **argv) {
     else if (normal)
       rc = nuld_envmap_sample(&blob, mode, n, instance, i, &s);
     else if (randomize)
-      rc = nuld_conditional_sample_randomized(&blob, mode, c, instance, i, seed, &s);
+      rc = nuld_conditional_sample_randomized(&blob, mode, c, at[2], instance, i, seed, &s);
     else
-      rc = nuld_conditional_sample(&blob, mode, c, instance, i, &s);
+      rc = nuld_conditional_sample(&blob, mode, c, at[2], instance, i, &s);
     if (rc != NULD_OK) die("sampling", nuld_error_message(rc));
     char t[5][64];
     fmt_f32(s.direction[0], t[0]);
@@ -319,6 +322,7 @@ static void touch_all(const NuldBlob *blob) {
                              {NAN, INFINITY},
                              {-1e30f, 1e30f}};
   const NuldVec3 views[4] = {{0.3f, 0.4f, 0.8f}, {0, 0, 0}, {NAN, 1, INFINITY}, {1e-30f, 0, -1}};
+  const float metals[5] = {0.0f, 1.0f, 0.4f, NAN, -3.0f};
   float *weights = aligned(info.decoded_network_len * sizeof(float));
   NuldBlob fast;
   int decoded = nuld_decode_network(blob, weights, info.decoded_network_len, &fast) == NULD_OK;
@@ -329,19 +333,27 @@ static void touch_all(const NuldBlob *blob) {
         const NuldBlob *b = mode && decoded ? &fast : blob;
         NuldSample s;
         for (int c = 0; c < 5; c++) {
-          expect_sample(nuld_conditional_sample(b, mode, conds[c], instances[k], i, &s), &s);
+          expect_sample(nuld_conditional_sample(b, mode, conds[c], metals[c], instances[k], i, &s), &s);
           expect_sample(
-              nuld_conditional_sample_randomized(b, mode, conds[c], instances[k], i, i * 7u, &s),
+              nuld_conditional_sample_randomized(b, mode, conds[c], metals[c], instances[k], i, i * 7u, &s),
               &s);
           float pdf = -1;
-          if (nuld_conditional_pdf(b, conds[c], vec3(s.direction), &pdf) != NULD_OK ||
+          if (nuld_conditional_pdf(b, conds[c], metals[c], vec3(s.direction), &pdf) != NULD_OK ||
               !(pdf >= 0) || !isfinite(pdf))
             bad_outputs++;
         }
         for (int v = 0; v < 4; v++) {
           int32_t rc;
           if (info.target == NULD_TARGET_GLTF_BRDF) {
-            rc = nuld_brdf_sample(b, mode, views[v], conds[v].x, instances[k], i, &s);
+            rc = nuld_brdf_sample_randomized(b, mode, views[v], conds[v].x, metals[v],
+                                             instances[k], i, 99, &s);
+            expect_sample(rc, &s);
+            float pdf = -1;
+            if (nuld_brdf_pdf(b, views[v], conds[v].x, metals[v], vec3(s.direction), &pdf) !=
+                    NULD_OK ||
+                !(pdf >= 0) || !isfinite(pdf))
+              bad_outputs++;
+            rc = nuld_brdf_sample(b, mode, views[v], conds[v].x, metals[v], instances[k], i, &s);
           } else {
             rc = nuld_envmap_sample_randomized(b, mode, views[v], instances[k], i, 99, &s);
             expect_sample(rc, &s);
@@ -525,15 +537,18 @@ static int cmd_errors(int argc, char **argv) {
     CHECK_BLOB("decode", nuld_decode_network(x, v, 4, &out));
     CHECK_BLOB("point_2d", nuld_point_2d(x, 0, 0, v));
     CHECK_BLOB("direction", nuld_direction(x, 0, 0, v));
-    CHECK_BLOB("brdf_sample", nuld_brdf_sample(x, NULD_MODE_TABLE, wo, 0.3f, 0, 0, &s));
+    CHECK_BLOB("brdf_sample", nuld_brdf_sample(x, NULD_MODE_TABLE, wo, 0.3f, 0.0f, 0, 0, &s));
+    CHECK_BLOB("brdf_sample_randomized",
+               nuld_brdf_sample_randomized(x, NULD_MODE_TABLE, wo, 0.3f, 0.0f, 0, 0, 1, &s));
+    CHECK_BLOB("brdf_pdf", nuld_brdf_pdf(x, wo, 0.3f, 0.0f, wo, v));
     CHECK_BLOB("envmap_sample", nuld_envmap_sample(x, NULD_MODE_TABLE, wo, 0, 0, &s));
     CHECK_BLOB("envmap_sample_randomized",
                nuld_envmap_sample_randomized(x, NULD_MODE_TABLE, wo, 0, 0, 1, &s));
     CHECK_BLOB("envmap_pdf", nuld_envmap_pdf(x, wo, wo, v));
-    CHECK_BLOB("conditional_sample", nuld_conditional_sample(x, NULD_MODE_TABLE, c2, 0, 0, &s));
+    CHECK_BLOB("conditional_sample", nuld_conditional_sample(x, NULD_MODE_TABLE, c2, 0.0f, 0, 0, &s));
     CHECK_BLOB("conditional_sample_randomized",
-               nuld_conditional_sample_randomized(x, NULD_MODE_TABLE, c2, 0, 0, 1, &s));
-    CHECK_BLOB("conditional_pdf", nuld_conditional_pdf(x, c2, wo, v));
+               nuld_conditional_sample_randomized(x, NULD_MODE_TABLE, c2, 0.0f, 0, 0, 1, &s));
+    CHECK_BLOB("conditional_pdf", nuld_conditional_pdf(x, c2, 0.0f, wo, v));
 #undef CHECK_BLOB
   }
 
@@ -545,19 +560,26 @@ static int cmd_errors(int argc, char **argv) {
   check("point_2d: misaligned out", nuld_point_2d(pts, 0, 0, odd), NULD_ERR_MISALIGNED);
   check("direction: null out", nuld_direction(dirs, 0, 0, NULL), NULD_ERR_NULL);
   check("direction: misaligned out", nuld_direction(dirs, 0, 0, odd), NULD_ERR_MISALIGNED);
-  check("brdf_sample: null out", nuld_brdf_sample(brdf, 0, wo, 0.3f, 0, 0, NULL), NULD_ERR_NULL);
+  check("brdf_sample: null out", nuld_brdf_sample(brdf, 0, wo, 0.3f, 0.0f, 0, 0, NULL), NULD_ERR_NULL);
+  check("brdf_sample_randomized: null out",
+        nuld_brdf_sample_randomized(brdf, 0, wo, 0.3f, 1.0f, 0, 0, 5, NULL), NULD_ERR_NULL);
+  check("brdf_pdf: null out", nuld_brdf_pdf(brdf, wo, 0.3f, 1.0f, wo, NULL), NULD_ERR_NULL);
+  check("brdf_pdf: misaligned out", nuld_brdf_pdf(brdf, wo, 0.3f, 1.0f, wo, odd),
+        NULD_ERR_MISALIGNED);
+  check("brdf_pdf: an environment sampler", nuld_brdf_pdf(env, wo, 0.3f, 1.0f, wo, v),
+        NULD_ERR_WRONG_TARGET);
   check("brdf_sample: misaligned out",
-        nuld_brdf_sample(brdf, 0, wo, 0.3f, 0, 0, shifted(&s, 2)), NULD_ERR_MISALIGNED);
+        nuld_brdf_sample(brdf, 0, wo, 0.3f, 0.0f, 0, 0, shifted(&s, 2)), NULD_ERR_MISALIGNED);
   check("envmap_sample: null out", nuld_envmap_sample(env, 0, wo, 0, 0, NULL), NULD_ERR_NULL);
   check("envmap_sample_randomized: misaligned out",
         nuld_envmap_sample_randomized(env, 0, wo, 0, 0, 1, shifted(&s, 1)), NULD_ERR_MISALIGNED);
   check("envmap_pdf: null out", nuld_envmap_pdf(env, wo, wo, NULL), NULD_ERR_NULL);
   check("envmap_pdf: misaligned out", nuld_envmap_pdf(env, wo, wo, odd), NULD_ERR_MISALIGNED);
-  check("conditional_sample: null out", nuld_conditional_sample(brdf, 0, c2, 0, 0, NULL),
+  check("conditional_sample: null out", nuld_conditional_sample(brdf, 0, c2, 0.0f, 0, 0, NULL),
         NULD_ERR_NULL);
   check("conditional_sample_randomized: null out",
-        nuld_conditional_sample_randomized(brdf, 0, c2, 0, 0, 1, NULL), NULD_ERR_NULL);
-  check("conditional_pdf: null out", nuld_conditional_pdf(env, c2, wo, NULL), NULD_ERR_NULL);
+        nuld_conditional_sample_randomized(brdf, 0, c2, 0.0f, 0, 0, 1, NULL), NULD_ERR_NULL);
+  check("conditional_pdf: null out", nuld_conditional_pdf(env, c2, 0.0f, wo, NULL), NULD_ERR_NULL);
   check("decode: null buffer", nuld_decode_network(brdf, NULL, 4, &out), NULD_ERR_NULL);
   check("decode: misaligned buffer", nuld_decode_network(brdf, odd, 4, &out),
         NULD_ERR_MISALIGNED);
@@ -566,23 +588,23 @@ static int cmd_errors(int argc, char **argv) {
         NULD_ERR_TOO_LONG);
 
   /* arguments the blob does not serve */
-  check("brdf_sample: mode 2", nuld_brdf_sample(brdf, 2, wo, 0.3f, 0, 0, &s),
+  check("brdf_sample: mode 2", nuld_brdf_sample(brdf, 2, wo, 0.3f, 0.0f, 0, 0, &s),
         NULD_ERR_UNKNOWN_MODE);
   check("envmap_sample: mode UINT32_MAX", nuld_envmap_sample(env, UINT32_MAX, wo, 0, 0, &s),
         NULD_ERR_UNKNOWN_MODE);
-  check("conditional_sample: mode 7", nuld_conditional_sample(env, 7, c2, 0, 0, &s),
+  check("conditional_sample: mode 7", nuld_conditional_sample(env, 7, c2, 0.0f, 0, 0, &s),
         NULD_ERR_UNKNOWN_MODE);
   check("point_2d: a direction set", nuld_point_2d(dirs, 0, 0, v), NULD_ERR_WRONG_KIND);
   check("point_2d: a sampler", nuld_point_2d(brdf, 0, 0, v), NULD_ERR_WRONG_KIND);
   check("direction: a 2D set", nuld_direction(pts, 0, 0, v), NULD_ERR_WRONG_KIND);
-  check("brdf_sample: a point set", nuld_brdf_sample(pts, 0, wo, 0.3f, 0, 0, &s),
+  check("brdf_sample: a point set", nuld_brdf_sample(pts, 0, wo, 0.3f, 0.0f, 0, 0, &s),
         NULD_ERR_WRONG_KIND);
-  check("brdf_sample: an environment sampler", nuld_brdf_sample(env, 0, wo, 0.3f, 0, 0, &s),
+  check("brdf_sample: an environment sampler", nuld_brdf_sample(env, 0, wo, 0.3f, 0.0f, 0, 0, &s),
         NULD_ERR_WRONG_TARGET);
   check("envmap_sample: a BRDF sampler", nuld_envmap_sample(brdf, 0, wo, 0, 0, &s),
         NULD_ERR_WRONG_TARGET);
   check("envmap_pdf: a BRDF sampler", nuld_envmap_pdf(brdf, wo, wo, v), NULD_ERR_WRONG_TARGET);
-  check("conditional_sample: a direction set", nuld_conditional_sample(dirs, 0, c2, 0, 0, &s),
+  check("conditional_sample: a direction set", nuld_conditional_sample(dirs, 0, c2, 0.0f, 0, 0, &s),
         NULD_ERR_WRONG_KIND);
   check("decode: a point set", nuld_decode_network(pts, v, 4, &out), NULD_ERR_WRONG_KIND);
   size_t need = infos[2].decoded_network_len;
@@ -598,15 +620,15 @@ static int cmd_errors(int argc, char **argv) {
 
   /* results: written on success only; equal through copies and decoding */
   NuldSample sentinel = {{-7, -7, -7}, -7, -7}, t = sentinel;
-  nuld_brdf_sample(brdf, 9, wo, 0.3f, 0, 0, &t);
+  nuld_brdf_sample(brdf, 9, wo, 0.3f, 0.0f, 0, 0, &t);
   check_true("a failed call writes no result", !memcmp(&t, &sentinel, sizeof t));
   check("nuld_last_error after a success is the last failure",
-        nuld_brdf_sample(brdf, 0, wo, 0.3f, 3, 1, &s), NULD_OK);
+        nuld_brdf_sample(brdf, 0, wo, 0.3f, 0.0f, 3, 1, &s), NULD_OK);
   check_true("nuld_last_error: the last failure", nuld_last_error() == NULD_ERR_UNKNOWN_MODE);
   check("decode: a long enough buffer", nuld_decode_network(brdf, w, need, &out), NULD_OK);
   NuldSample a, c;
-  nuld_brdf_sample(brdf, NULD_MODE_NETWORK, wo, 0.3f, 3, 1, &a);
-  nuld_brdf_sample(&out, NULD_MODE_NETWORK, wo, 0.3f, 3, 1, &c);
+  nuld_brdf_sample(brdf, NULD_MODE_NETWORK, wo, 0.3f, 0.0f, 3, 1, &a);
+  nuld_brdf_sample(&out, NULD_MODE_NETWORK, wo, 0.3f, 0.0f, 3, 1, &c);
   check_true("decoded network mode: the same bits", !memcmp(&a, &c, sizeof a));
   NuldBlob moved;
   memcpy(&moved, env, sizeof moved);
@@ -714,7 +736,7 @@ static double time_calls(const NuldBlob *blob, Method method, uint32_t mode, uin
       float pdf = 0;
       switch (method) {
       case BRDF:
-        nuld_brdf_sample(blob, mode, bench_views[c], bench_roughness[c], k, i, &out);
+        nuld_brdf_sample(blob, mode, bench_views[c], bench_roughness[c], 0.0f, k, i, &out);
         break;
       case ENVMAP:
         nuld_envmap_sample(blob, mode, bench_normals[c], k, i, &out);

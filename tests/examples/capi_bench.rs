@@ -135,13 +135,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let net = SAMPLES / 10;
     let rust: [f64; 7] = [
         time(SAMPLES, n, |c, k, i| {
-            brdf.sample(at.views[c], at.roughness[c], k, i)
+            brdf.sample(at.views[c], at.roughness[c], 0.0, k, i)
         }),
         time(net, n, |c, k, i| {
-            brdf.network().sample(at.views[c], at.roughness[c], k, i)
+            brdf.network()
+                .sample(at.views[c], at.roughness[c], 0.0, k, i)
         }),
         time(net, n, |c, k, i| {
-            brdf_fast.sample(at.views[c], at.roughness[c], k, i)
+            brdf_fast.sample(at.views[c], at.roughness[c], 0.0, k, i)
         }),
         time(SAMPLES, n, |c, k, i| env.sample(at.normals[c], k, i)),
         time(SAMPLES, n, |c, k, i| {

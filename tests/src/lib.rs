@@ -37,26 +37,34 @@ pub fn sobol_blob(domain: Domain, n: usize, sets: usize, seed: u64) -> (PointSet
 /// one ([`nuld_build_tool::lab::bench::runtime::random_parts`]; the benchmark times the
 /// same blobs), of a network [`shape`].
 pub fn conditional_parts(
-    shape: nuld_core::network::Shape,
+    (shape, warp): (nuld_core::network::Shape, nuld_core::conditional::PointWarp),
     instances: u32,
     grid: [u32; 2],
     seed: u64,
 ) -> nuld_build_tool::conditional::blob::ConditionalParts {
-    nuld_build_tool::lab::bench::runtime::random_parts(shape, instances, grid, seed)
+    nuld_build_tool::lab::bench::runtime::random_parts(shape, warp, instances, grid, seed)
         .expect("a valid fixture")
 }
 
 /// The network shape of a [`conditional_parts`] fixture
-/// ([`nuld_build_tool::lab::bench::runtime::random_shape`]).
+/// ([`nuld_build_tool::lab::bench::runtime::random_shape`]) and the warp it is
+/// made for.
 pub fn shape(
     n: u32,
     hidden: &[u32],
     activation: nuld_core::network::Activation,
     warp: nuld_core::conditional::PointWarp,
     instance_slots: u32,
-) -> nuld_core::network::Shape {
-    nuld_build_tool::lab::bench::runtime::random_shape(n, hidden, activation, warp, instance_slots)
-        .expect("a valid fixture shape")
+) -> (nuld_core::network::Shape, nuld_core::conditional::PointWarp) {
+    let shape = nuld_build_tool::lab::bench::runtime::random_shape(
+        n,
+        hidden,
+        activation,
+        warp,
+        instance_slots,
+    )
+    .expect("a valid fixture shape");
+    (shape, warp)
 }
 
 /// A BRDF sampler briefly trained (40 + 40 steps of a 16-point, [16, 16] network:
@@ -118,4 +126,28 @@ pub fn as_envmap(
     parts: nuld_build_tool::conditional::blob::ConditionalParts,
 ) -> nuld_build_tool::conditional::blob::ConditionalParts {
     nuld_build_tool::lab::bench::runtime::envmap_parts(parts, fixture_tree())
+}
+
+/// A small tabulated BRDF prior (3 x 2 x 2 conditions, 5 x 5 half-vector
+/// vertices; built once per test binary): for blobs whose every byte a test
+/// visits.
+pub fn small_brdf_prior() -> std::sync::Arc<nuld_build_tool::sphere::brdf_prior::BrdfPrior> {
+    use nuld_build_tool::sphere::brdf_prior::{BrdfPrior, PriorSpace};
+    static PRIOR: std::sync::OnceLock<std::sync::Arc<BrdfPrior>> = std::sync::OnceLock::new();
+    let prior = PRIOR.get_or_init(|| {
+        std::sync::Arc::new(
+            BrdfPrior::new([3, 2, 2], 5, PriorSpace::HalfVector).expect("a valid prior"),
+        )
+    });
+    std::sync::Arc::clone(prior)
+}
+
+/// `parts` (a [`nuld_core::conditional::PointWarp::BrdfTable`] sampler) with
+/// `prior` as its tabulated prior.
+pub fn with_brdf_prior(
+    mut parts: nuld_build_tool::conditional::blob::ConditionalParts,
+    prior: std::sync::Arc<nuld_build_tool::sphere::brdf_prior::BrdfPrior>,
+) -> nuld_build_tool::conditional::blob::ConditionalParts {
+    parts.prior = Some(nuld_build_tool::conditional::blob::Prior::Brdf(prior));
+    parts
 }

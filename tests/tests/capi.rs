@@ -17,7 +17,9 @@ use nuld_core::blob::Domain;
 use nuld_core::conditional::PointWarp;
 use nuld_core::network::Activation;
 use nuld_tests::capi::{compile, workspace_root, Link};
-use nuld_tests::{as_envmap, conditional_parts, shape, sobol_blob, META};
+use nuld_tests::{
+    as_envmap, conditional_parts, shape, small_brdf_prior, sobol_blob, with_brdf_prior, META,
+};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
@@ -85,6 +87,18 @@ fn brdf_blob(act: Activation, warp: PointWarp, slots: u32, seed: u64) -> Aligned
         .expect("a valid blob")
 }
 
+/// [`brdf_blob`]'s shape on the tabulated BRDF prior, made small
+/// ([`small_brdf_prior`]) so that the file the C program reads stays small.
+fn brdf_table_blob(act: Activation, slots: u32, seed: u64) -> AlignedBytes {
+    let shape = shape(64, &[32, 32], act, PointWarp::BrdfTable, slots);
+    with_brdf_prior(
+        conditional_parts(shape, 16, [10, 9], seed),
+        small_brdf_prior(),
+    )
+    .to_blob(&META)
+    .expect("a valid blob")
+}
+
 /// An environment sampler of the same shape on the fixture prior.
 fn envmap_blob(seed: u64) -> AlignedBytes {
     let parts = conditional_parts(
@@ -124,12 +138,19 @@ impl SampleArgs {
     fn new(text: &str, instance: u32, mode: SampleMode, randomize: Option<u32>) -> Self {
         // Both sides read the same decimal text: Rust's `parse` and C's `strtof`
         // both round it correctly.
-        let v: Vec<f32> = text.split(',').map(|x| x.parse().unwrap()).collect();
-        let (flag, at) = match v[..] {
-            [a, b] => ("--cond", At::Condition(Condition([a, b]))),
-            [x, y, z] => ("--normal", At::Normal(Normal([x, y, z]))),
+        let v: Vec<f32> = text
+            .trim_start_matches("n:")
+            .split(',')
+            .map(|x| x.parse().unwrap())
+            .collect();
+        // `--cond A,B[,M]` for a conditional, `--normal X,Y,Z` (a `n:` prefix).
+        let (flag, at) = match (text.strip_prefix("n:"), &v[..]) {
+            (None, [a, b]) => ("--cond", At::Condition(Condition([*a, *b, 0.0]))),
+            (None, [a, b, m]) => ("--cond", At::Condition(Condition([*a, *b, *m]))),
+            (Some(_), [x, y, z]) => ("--normal", At::Normal(Normal([*x, *y, *z]))),
             _ => panic!("{text}"),
         };
+        let text = text.trim_start_matches("n:");
         Self {
             at,
             at_flag: [flag.to_string(), text.to_string()],
@@ -165,15 +186,19 @@ fn samples_through_c_equal_build_tool_sample_byte_for_byte() {
     let brdf = [
         brdf_blob(Activation::Relu, PointWarp::BrdfMixture, 64, 3),
         brdf_blob(Activation::Silu, PointWarp::EqualArea, 7, 4),
+        brdf_table_blob(Activation::Relu, 64, 6),
     ];
     let env = envmap_blob(5);
-    // Inside and outside the BRDF's range (clamped), every corner of a grid cell.
+    // Inside and outside the BRDF's range (clamped), every corner of a grid cell;
+    // metallic inside and outside [0, 1] on the tabulated prior.
     let brdf_at = ["0.3,60", "0.05,-5", "1,89", "0.55,33.3"];
-    let env_at = ["0.2,0.9,-0.3", "0,0,1", "-1e-3,0.5,-7", "0.25,0.75"];
+    let metal_at = ["0.3,60,1", "0.05,-5,0.5", "1,89,7", "0.55,33.3,0"];
+    let env_at = ["n:0.2,0.9,-0.3", "n:0,0,1", "n:-1e-3,0.5,-7", "0.25,0.75"];
     let mut rows = 0;
     for (blob, places) in [
         (&brdf[0], &brdf_at[..]),
         (&brdf[1], &brdf_at[..]),
+        (&brdf[2], &metal_at[..]),
         (&env, &env_at[..]),
     ] {
         let file = files.write(&format!("conditional-{rows}"), blob);
@@ -268,6 +293,15 @@ fn hostile_bytes_through_c_are_refused_without_a_crash() {
         [3, 2],
         6,
     );
+    let small_table = with_brdf_prior(
+        conditional_parts(
+            shape(4, &[3, 2], Activation::Relu, PointWarp::BrdfTable, 2),
+            2,
+            [3, 2],
+            7,
+        ),
+        small_brdf_prior(),
+    );
     let blobs = [
         sobol_blob(Domain::Square, 5, 2, 1).1,
         sobol_blob(Domain::Sphere, 16, 1, 2).1,
@@ -275,6 +309,7 @@ fn hostile_bytes_through_c_are_refused_without_a_crash() {
         sobol_blob(Domain::Square, 200, 1, 4).1,
         small_brdf.to_blob(&META).unwrap(),
         as_envmap(small_env).to_blob(&META).unwrap(),
+        small_table.to_blob(&META).unwrap(),
     ];
     let (mut mutations, mut rechecksummed, mut accepted) = (0, 0, 0);
     for (k, blob) in blobs.iter().enumerate() {
@@ -336,16 +371,14 @@ fn each_bad_argument_through_c_gets_its_code() {
 }
 
 /// The C++ example, linked with the static and with the dynamic library, on an
-/// environment sampler (its PDF agrees with each sample's pdf) and a BRDF sampler.
+/// environment sampler and a BRDF sampler on the tabulated prior (a metal): its
+/// PDF agrees with each sample's pdf.
 #[test]
 fn the_cpp_example_builds_and_samples_both_targets() {
     let files = Files::new("cpp");
     let source = workspace_root().join("runtime/capi/examples/sampler.cpp");
     let env = files.write("env", &envmap_blob(6));
-    let brdf = files.write(
-        "brdf",
-        &brdf_blob(Activation::Relu, PointWarp::BrdfMixture, 64, 7),
-    );
+    let brdf = files.write("brdf", &brdf_table_blob(Activation::Relu, 64, 7));
     for (link, name) in [(Link::Static, "sampler"), (Link::Dynamic, "sampler_so")] {
         let exe = compile(&source, link, name);
         let out = run(&exe, &[&env]);
@@ -356,7 +389,13 @@ fn the_cpp_example_builds_and_samples_both_targets() {
         assert!(out.contains("Sample(2): wi ("), "{out}");
         let out = run(&exe, &[&brdf]);
         println!("{name} on a BRDF sampler:\n{out}");
-        assert!(out.contains("BRDF, N = 64: reflected radiance"), "{out}");
+        assert!(
+            out.contains("metal BRDF, N = 64: reflected radiance"),
+            "{out}"
+        );
+        let last = out.lines().last().unwrap();
+        let error: f64 = last.rsplit(' ').next().unwrap().parse().unwrap();
+        assert!(error < 1e-3, "{out}");
         let point_set = files.write("set", &sobol_blob(Domain::Square, 4, 1, 1).1);
         let refused = Command::new(&exe)
             .arg(&point_set)

@@ -4,7 +4,7 @@
 
 use glam::Vec2;
 use nuld_build_tool::pointset::AlignedBytes;
-use nuld_build_tool::sphere::brdf_albedo::directional_albedo;
+use nuld_build_tool::sphere::brdf_albedo::{directional_albedo, directional_albedo_metallic};
 use nuld_core::brdf::BrdfModel;
 use nuld_core::quantize::UNORM16_MAX_ERROR;
 use nuld_runtime::{Blob, ConditionalSampler};
@@ -98,7 +98,8 @@ fn table_mode_follows_network_mode_within_a_measured_bound() {
 
 /// The weights at the weight-grid nodes equal the glTF directional albedo of the
 /// Gauss-Legendre quadrature (itself checked against published reference values)
-/// within 1e-4, in both modes.
+/// within 1e-4, and the albedo at metallic 0, 1 and 0.5 the dielectric's, the
+/// metal's and their mean.
 #[test]
 fn weights_equal_the_albedo_at_the_weight_grid_nodes() {
     let cs = distilled();
@@ -106,9 +107,13 @@ fn weights_equal_the_albedo_at_the_weight_grid_nodes() {
         for j0 in 0..WEIGHT_GRID[0] {
             let c = node(cs.info().weight_grid_condition([j0, j1]));
             let want = directional_albedo(BrdfModel::Gltf, c.x as f64, c.y as f64).total();
-            for got in [
-                cs.sample(c, 0, 0).weight,
-                cs.network().sample(c, 5, 1).weight,
+            let metal = directional_albedo_metallic(c.x as f64, c.y as f64, 1.0).total();
+            let half = 0.5 * (want + metal);
+            for (got, want) in [
+                (cs.weight(c), want),
+                (cs.albedo(c, 0.0), want),
+                (cs.albedo(c, 1.0), metal),
+                (cs.albedo(c, 0.5), half),
             ] {
                 assert!(
                     (got as f64 - want).abs() < 1e-4,

@@ -12,7 +12,9 @@ use nuld_core::network::Activation;
 use nuld_core::quantize::f16_decode;
 use nuld_runtime::glam::{Vec2, Vec3};
 use nuld_runtime::{Blob, BlobKind};
-use nuld_tests::{as_envmap, conditional_parts, shape, sobol_blob, META};
+use nuld_tests::{
+    as_envmap, conditional_parts, shape, small_brdf_prior, sobol_blob, with_brdf_prior, META,
+};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -61,8 +63,14 @@ fn parse_and_touch(bytes: &[u8]) -> Result<(), BlobError> {
                 for k in [0, u32::MAX] {
                     check_sample(cs.network().sample(c, k, i));
                     if let Some(b) = brdf {
-                        check_sample(b.sample(wo, c.x, k, i));
-                        check_sample(b.network().sample(wo, c.x, k, i));
+                        for m in [0.0, 0.6, f32::NAN, 7.0] {
+                            check_sample(b.sample(wo, c.x, m, k, i));
+                            check_sample(b.network().sample(wo, c.x, m, k, i));
+                            let s = b.sample_randomized(wo, c.x, m, k, i, k ^ i);
+                            check_sample(s);
+                            let pdf = b.pdf(wo, c.x, m, s.direction);
+                            assert!(pdf.is_finite() && pdf >= 0.0);
+                        }
                     }
                     if let Some(e) = envmap {
                         check_sample(e.sample(wo, k, i));
@@ -105,6 +113,16 @@ fn envmap_blob() -> AlignedBytes {
         .unwrap()
 }
 
+/// [`conditional_blob`]'s shape as a BRDF sampler on the tabulated prior, with
+/// a small prior (3 x 2 x 2 conditions, 5 x 5 vertices: [`small_brdf_prior`]) so
+/// that every truncation stays cheap.
+fn brdf_table_blob() -> AlignedBytes {
+    let shape = shape(4, &[3, 2], Activation::Relu, PointWarp::BrdfTable, 2);
+    with_brdf_prior(conditional_parts(shape, 2, [3, 2], 7), small_brdf_prior())
+        .to_blob(&META)
+        .unwrap()
+}
+
 fn valid_blobs() -> Vec<AlignedBytes> {
     vec![
         sobol_blob(Domain::Square, 5, 2, 1).1,
@@ -113,6 +131,7 @@ fn valid_blobs() -> Vec<AlignedBytes> {
         sobol_blob(Domain::Square, 200, 1, 4).1,
         conditional_blob(),
         envmap_blob(),
+        brdf_table_blob(),
     ]
 }
 
@@ -584,9 +603,11 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
         && ranges_ok
         && info.activation <= 1
         && widths_ok
-        // Warps 0 and 1 (the BRDF mixture, on the hemisphere only) are the glTF
-        // BRDF's; warp 2 (the environment tree) is a map's, which requires it.
-        && ((info.target == 1 && (info.warp == 0 || (info.warp == 1 && info.domain == 2)))
+        // Warps 0, 1 and 3 (the BRDF mixture and the tabulated prior, on the
+        // hemisphere only) are the glTF BRDF's; warp 2 (the environment tree) is
+        // a map's, which requires it.
+        && ((info.target == 1
+            && (info.warp == 0 || ((info.warp == 1 || info.warp == 3) && info.domain == 2)))
             || (info.target == 2 && info.warp == 2))
         && info.reserved == 0)
     {
@@ -607,11 +628,17 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
     expected_params += 2 * (fan_in + 1);
     let table_len =
         info.grid[0] as u128 * info.grid[1] as u128 * info.instances as u128 * info.n as u128;
-    // Warp 1 stores the lobe probabilities after the weights.
+    // Warp 1 stores the lobe probabilities after the weights, warp 3 the metal's
+    // albedo.
     let weight_len = info.weight_grid[0] as u128
         * info.weight_grid[1] as u128
-        * if info.warp == 1 { 2 } else { 1 };
+        * if info.warp == 1 || info.warp == 3 {
+            2
+        } else {
+            1
+        };
     (info.warp != 2 || tree_semantics_hold(&layout))
+        && (info.warp != 3 || brdf_prior_semantics_hold(&layout))
         && pe.elem_size == 2
         && te.elem_size == 4
         && we.elem_size == 4
@@ -625,6 +652,54 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
             let w = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
             w.is_finite() && w >= 0.0
         })
+}
+
+/// The BRDF prior's sections (core/FORMAT.md, tags 10-14), checked from the raw
+/// bytes: a 16-byte info of three grid counts of 2 to 256 and a size `S` of 2 to
+/// 4096; `nodes S^2` data and conditional CDF values and `nodes S` marginal CDF
+/// values, all finite `f32 >= 0`, each row of `S` CDF values non-decreasing,
+/// each node's marginal ending above 0; `nodes` finite masses above 0.
+fn brdf_prior_semantics_hold(layout: &Layout<'_>) -> bool {
+    let section = |tag| layout.section(tag).ok();
+    let Some((_, info)) = section(SectionTag::BrdfPriorInfo) else {
+        return false;
+    };
+    if info.len() != 16 {
+        return false;
+    }
+    let word = |at: usize| u32::from_le_bytes(info[at..at + 4].try_into().unwrap());
+    let (grid, size) = ([word(0), word(4), word(8)], word(12));
+    if !(grid.iter().all(|g| (2..=256).contains(g)) && (2..=4096).contains(&size)) {
+        return false;
+    }
+    let nodes = (grid[0] * grid[1] * grid[2]) as usize;
+    let s = size as usize;
+    let floats = |tag, len: usize| -> Option<Vec<f32>> {
+        let (e, bytes) = section(tag)?;
+        (e.elem_size == 4 && bytes.len() == 4 * len).then(|| {
+            bytes
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect()
+        })
+    };
+    let (Some(data), Some(marginal), Some(conditional), Some(masses)) = (
+        floats(SectionTag::BrdfPriorData, nodes * s * s),
+        floats(SectionTag::BrdfPriorMarginal, nodes * s),
+        floats(SectionTag::BrdfPriorConditional, nodes * s * s),
+        floats(SectionTag::BrdfPriorMasses, nodes),
+    ) else {
+        return false;
+    };
+    let finite = |v: &[f32]| v.iter().all(|x| x.is_finite() && *x >= 0.0);
+    let rising = |v: &[f32]| v.chunks(s).all(|row| row.windows(2).all(|w| w[0] <= w[1]));
+    finite(&data)
+        && finite(&marginal)
+        && finite(&conditional)
+        && rising(&marginal)
+        && rising(&conditional)
+        && marginal.chunks(s).all(|m| m[s - 1] > 0.0)
+        && masses.iter().all(|m| m.is_finite() && *m > 0.0)
 }
 
 /// The environment prior's sections (core/FORMAT.md, tags 7-9), checked from the
@@ -690,6 +765,13 @@ fn conditional_blob_mutations_are_rejected_or_harmless() {
 #[test]
 fn envmap_blob_mutations_are_rejected_or_harmless() {
     mutate(envmap_blob(), 50_000, 17);
+}
+
+/// [`conditional_blob_mutations_are_rejected_or_harmless`] for a BRDF sampler
+/// on the tabulated prior (warp 3 and its five sections), 50k mutations.
+#[test]
+fn brdf_table_blob_mutations_are_rejected_or_harmless() {
+    mutate(brdf_table_blob(), 50_000, 19);
 }
 
 /// `cases` mutations of `blob` from `seed` (see

@@ -321,7 +321,9 @@ fn runtime_sample(cs: &ConditionalSampler, p: &KernelParams, e: u32) -> (Sample,
         KernelMode::BrdfTable => {
             let cond = brdf_cond();
             (
-                BrdfSampler::try_from(*cs).unwrap().sample(wo, c.x, k, i),
+                BrdfSampler::try_from(*cs)
+                    .unwrap()
+                    .sample(wo, c.x, 0.0, k, i),
                 cond,
                 cs.square_point(cond, k, i),
             )
@@ -332,7 +334,7 @@ fn runtime_sample(cs: &ConditionalSampler, p: &KernelParams, e: u32) -> (Sample,
                 BrdfSampler::try_from(*cs)
                     .unwrap()
                     .network()
-                    .sample(wo, c.x, k, i),
+                    .sample(wo, c.x, 0.0, k, i),
                 cond,
                 cs.network().square_point(cond, k, i),
             )
@@ -530,7 +532,9 @@ fn shader_readme_example_gives_the_runtime_samples() {
         // the BRDF sampler's.
         worst = worst.max(gap(
             &(*got, [0.0; 4]),
-            BrdfSampler::try_from(cs).unwrap().sample(wo, 0.4, pixel, i),
+            BrdfSampler::try_from(cs)
+                .unwrap()
+                .sample(wo, 0.4, 0.0, pixel, i),
         ));
     }
     println!("shader README example: max |gpu - cpu| {worst:.2e} (tolerance 1e-5)");

@@ -85,7 +85,10 @@ pub struct EvalArgs {
     #[arg(long = "panel", value_name = "NAME")]
     pub panels: Vec<String>,
     /// conditional: the `.nuld` conditional blob whose table and network modes are
-    /// judged.
+    /// judged. brdf-prior: also judge this baked BRDF sampler (`bake --brdf`) at
+    /// the prior's conditions: table, network and unbiased mode, per metallic,
+    /// the union of 64 instances, and the variance of f cos / pdf at metals
+    /// against the VNDF/cosine mixture (the judge takes the blob's N).
     #[arg(long)]
     pub blob: Option<PathBuf>,
     /// conditional: judge independent Owen-Sobol sets warped by the VNDF/cosine
@@ -266,36 +269,57 @@ fn prior_space(s: &str) -> Result<crate::sphere::brdf_prior::PriorSpace, String>
 
 /// `build-tool eval brdf-prior`: measures, writes, prints.
 fn run_brdf_prior(a: &EvalArgs) -> Result<()> {
-    use crate::lab::eval::brdf_prior::{evaluate, markdown, BrdfPriorSettings};
+    use crate::lab::eval::brdf_prior::{evaluate, judging, markdown, BrdfPriorSettings};
+    use crate::lab::eval::brdf_sampler;
     anyhow::ensure!(
         a.sizes.iter().all(|&v| v >= 2),
         "--sizes needs values of at least 2"
     );
+    let blob = match &a.blob {
+        Some(path) => Some(crate::pointset::AlignedBytes::read(path)?),
+        None => None,
+    };
+    // A blob's judge takes its N.
+    let n = match &blob {
+        Some(bytes) => nuld_runtime::Blob::parse(bytes.as_slice())
+            .and_then(|b| b.brdf())
+            .map_err(|e| anyhow::anyhow!("{}: {e}", a.blob.as_ref().unwrap().display()))?
+            .len(),
+        None => u32::try_from(a.n).map_err(|_| anyhow::anyhow!("--n {} is too large", a.n))?,
+    };
     let s = BrdfPriorSettings {
         grids: a.brdf_grids.clone(),
         sizes: a.sizes.clone(),
         spaces: a.spaces.clone(),
-        n: u32::try_from(a.n).map_err(|_| anyhow::anyhow!("--n {} is too large", a.n))?,
+        n,
         ..BrdfPriorSettings::default()
     };
     crate::output::ensure_dir(&a.out)?;
     let started = Instant::now();
-    let total = (s.conditions + s.spaces.len() * s.grids.len() * s.sizes.len()) as u64;
+    let blob_steps = if blob.is_some() { 5 } else { 0 };
+    let total = (s.conditions + s.spaces.len() * s.grids.len() * s.sizes.len() + blob_steps) as u64;
     let progress = crate::progress::Progress::stderr("brdf-prior", total, "step");
-    let rows = evaluate(&s, &|what| {
+    let tell = |what: &str| {
         progress.set_message(what.to_string());
         progress.inc(1);
-    })?;
+    };
+    let (rows, judges) = evaluate(&s, &tell)?;
+    let sampler = match &blob {
+        Some(bytes) => Some(brdf_sampler::evaluate(
+            bytes.as_slice(),
+            &judges,
+            &judging(&s),
+            &tell,
+        )?),
+        None => None,
+    };
     progress.finish();
-    let json = serde_json::json!({ "settings": s, "rows": rows });
-    write_prior_report(
-        &a.out,
-        "brdf-prior",
-        &json,
-        &markdown(&rows),
-        rows.len(),
-        started,
-    )
+    let mut table = markdown(&rows);
+    if let Some(r) = &sampler {
+        table += &brdf_sampler::markdown(r);
+    }
+    let json = serde_json::json!({ "settings": s, "rows": rows, "blob": sampler });
+    write_prior_report(&a.out, "brdf-prior", &json, &table, rows.len(), started)
 }
 
 /// Writes `DIR/STEM.json` and `DIR/STEM.md` (the table, also printed) of a

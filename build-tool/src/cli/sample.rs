@@ -14,8 +14,9 @@ use std::path::PathBuf;
 pub struct SampleArgs {
     /// The conditional blob.
     pub file: PathBuf,
-    /// The condition in the blob's units, `ROUGHNESS,THETA_O_DEG` for BRDF samplers
-    /// (view in the xz-plane, +x side); values outside the blob's range clamp.
+    /// The condition in the blob's units, `ROUGHNESS,THETA_O_DEG[,METALLIC]` for
+    /// BRDF samplers (view in the xz-plane, +x side; metallic 0 to 1, default 0,
+    /// the dielectric); values outside the blob's range clamp.
     #[arg(long, value_parser = parse_condition, allow_hyphen_values = true,
         required_unless_present = "normal", conflicts_with = "normal")]
     pub cond: Option<Condition>,
@@ -36,9 +37,10 @@ pub struct SampleArgs {
     pub randomize: Option<u32>,
 }
 
-/// A parsed `--cond`: two finite numbers.
+/// A parsed `--cond`: two finite numbers and a third (the metallic) that
+/// defaults to 0.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Condition(pub [f32; 2]);
+pub struct Condition(pub [f32; 3]);
 
 /// A parsed `--normal`: three finite numbers, not all zero.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -63,11 +65,16 @@ pub enum SampleMode {
 }
 
 fn parse_condition(s: &str) -> Result<Condition, String> {
-    let bad = || format!("{s:?} is not ROUGHNESS,THETA_O_DEG (two finite numbers)");
-    let (a, b) = s.split_once(',').ok_or_else(bad)?;
-    let num = |v: &str| v.trim().parse::<f32>().ok().filter(|x| x.is_finite());
-    match (num(a), num(b)) {
-        (Some(x), Some(y)) => Ok(Condition([x, y])),
+    let bad =
+        || format!("{s:?} is not ROUGHNESS,THETA_O_DEG[,METALLIC] (two or three finite numbers)");
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|v| v.trim().parse::<f32>().ok().filter(|x| x.is_finite()))
+        .collect::<Option<_>>()
+        .ok_or_else(bad)?;
+    match v[..] {
+        [x, y] => Ok(Condition([x, y, 0.0])),
+        [x, y, m] => Ok(Condition([x, y, m])),
         _ => Err(bad()),
     }
 }
@@ -113,12 +120,12 @@ pub fn write_csv(
         }
         At::Condition(c) => {
             let cs = blob.conditional().map_err(|e| anyhow!("{e}"))?;
-            View::Condition(cs, Vec2::from(c.0))
+            View::Condition(cs, Vec2::new(c.0[0], c.0[1]), c.0[2])
         }
     };
     let len = match view {
         View::Normal(env, _) => env.len(),
-        View::Condition(cs, _) => cs.len(),
+        View::Condition(cs, ..) => cs.len(),
     };
     writeln!(out, "index,x,y,z,weight,pdf")?;
     for i in 0..len {
@@ -130,13 +137,15 @@ pub fn write_csv(
             (View::Normal(env, n), SampleMode::Network, Some(r)) => {
                 env.network().sample_randomized(n, k, i, r)
             }
-            (View::Condition(cs, c), SampleMode::Table, None) => cs.sample(c, k, i),
-            (View::Condition(cs, c), SampleMode::Table, Some(r)) => {
-                cs.sample_randomized(c, k, i, r)
+            (View::Condition(cs, c, m), SampleMode::Table, None) => cs.sample_metallic(c, m, k, i),
+            (View::Condition(cs, c, m), SampleMode::Table, Some(r)) => {
+                cs.sample_randomized_metallic(c, m, k, i, r)
             }
-            (View::Condition(cs, c), SampleMode::Network, None) => cs.network().sample(c, k, i),
-            (View::Condition(cs, c), SampleMode::Network, Some(r)) => {
-                cs.network().sample_randomized(c, k, i, r)
+            (View::Condition(cs, c, m), SampleMode::Network, None) => {
+                cs.network().sample_metallic(c, m, k, i)
+            }
+            (View::Condition(cs, c, m), SampleMode::Network, Some(r)) => {
+                cs.network().sample_randomized_metallic(c, m, k, i, r)
             }
         };
         let d = s.direction;
@@ -150,7 +159,7 @@ pub fn write_csv(
 #[derive(Clone, Copy)]
 enum View<'a> {
     Normal(EnvmapSampler<'a>, Vec3),
-    Condition(ConditionalSampler<'a>, Vec2),
+    Condition(ConditionalSampler<'a>, Vec2, f32),
 }
 
 /// The one-line warning for a `--cond` outside the blob's condition range, which
@@ -162,7 +171,7 @@ pub fn clamp_warning(bytes: &[u8], at: At) -> Option<String> {
     let cs = Blob::parse(bytes).ok()?.conditional().ok()?;
     let info = cs.info();
     let inside = (0..2).all(|a| (info.cond_min[a]..=info.cond_max[a]).contains(&c[a]));
-    let clamped = info.denormalize(info.normalize(c));
+    let clamped = info.denormalize(info.normalize([c[0], c[1]]));
     (!inside).then(|| {
         format!(
             "warning: --cond {},{} is outside the blob's range [{}, {}] x [{}, {}]; sampling at the clamped {},{}",
@@ -181,7 +190,9 @@ pub fn run(a: SampleArgs) -> Result<()> {
     let at = match (a.cond, a.normal) {
         (Some(c), _) => At::Condition(c),
         (None, Some(n)) => At::Normal(n),
-        (None, None) => bail!("sample needs --cond ROUGHNESS,THETA_O_DEG or --normal X,Y,Z"),
+        (None, None) => {
+            bail!("sample needs --cond ROUGHNESS,THETA_O_DEG[,METALLIC] or --normal X,Y,Z")
+        }
     };
     if let Some(warning) = clamp_warning(bytes.as_slice(), at) {
         eprintln!("{warning}");

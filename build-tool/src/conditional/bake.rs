@@ -284,7 +284,7 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
         (800, 500),
     )?;
     match target {
-        LoadedTarget::GltfBrdf => render_sets(&out.join("sets.png"), &params)?,
+        LoadedTarget::GltfBrdf(_) => render_sets(&out.join("sets.png"), &params)?,
         LoadedTarget::Envmap(env) => render_envmap_sets(&out.join("sets.png"), &params, env)?,
     }
     crate::output::write_atomic(&out.join(config.blob_name()), blob.as_slice())?;
@@ -312,7 +312,7 @@ fn render_sets(path: &Path, params: &crate::network::Params) -> Result<()> {
     // worth building.
     let targets = conds
         .iter()
-        .map(|c| BrdfTarget::coarse(c[0], c[1], 1 << 10))
+        .map(|c| BrdfTarget::coarse(c[0], c[1], 0.0, 1 << 10))
         .collect::<Result<Vec<_>, _>>()?;
     let densities: Vec<Box<dyn Fn(DVec2) -> f64 + '_>> = targets
         .iter()
@@ -429,8 +429,12 @@ mod tests {
         let shape = config.train.shape().unwrap();
         assert_eq!(len(SectionTag::NetworkParams), 2 * shape.param_len());
         assert_eq!(len(SectionTag::PointTable), 4 * 2 * 3 * 3 * 8);
-        // The weights, then the mixture warp's lobe probabilities.
+        // The dielectric's albedo, then the metal's.
         assert_eq!(len(SectionTag::WeightTable), 4 * 8 * 2);
+        // The tabulated prior's five sections.
+        let prior = crate::sphere::brdf_prior::BrdfPrior::shared();
+        assert_eq!(len(SectionTag::BrdfPriorData), 4 * prior.data.len());
+        assert_eq!(len(SectionTag::BrdfPriorMasses), 4 * prior.masses.len());
         for f in ["report.json", "loss.png", "sets.png", "checkpoint.bin"] {
             assert!(dir.join(f).is_file(), "{f}");
         }

@@ -2,6 +2,7 @@
 //! and their encoding through [`nuld_core::blob::write`].
 
 use crate::pointset::AlignedBytes;
+use crate::sphere::brdf_prior::BrdfPrior;
 use crate::sphere::EnvmapTree;
 use anyhow::{bail, Context, Result};
 use nuld_core::blob::{encoded_len, write, BlobKind, Metadata};
@@ -23,9 +24,20 @@ pub struct ConditionalParts {
     /// [`nuld_core::conditional::PointWarp::BrdfMixture`] followed by the lobe
     /// probabilities on the same nodes.
     pub weights: Vec<f32>,
-    /// The environment prior of a [`nuld_core::conditional::PointWarp::EnvmapTree`]
-    /// sampler, written as its three sections after the four above.
-    pub prior: Option<Arc<EnvmapTree>>,
+    /// The prior of a sampler that warps through one, written as its sections
+    /// after the four above.
+    pub prior: Option<Prior>,
+}
+
+/// The tables of a sampler's prior.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Prior {
+    /// An environment sampler's tree
+    /// ([`nuld_core::conditional::PointWarp::EnvmapTree`], three sections).
+    Envmap(Arc<EnvmapTree>),
+    /// A BRDF sampler's tabulated prior
+    /// ([`nuld_core::conditional::PointWarp::BrdfTable`], five sections).
+    Brdf(Arc<BrdfPrior>),
 }
 
 impl ConditionalParts {
@@ -60,9 +72,18 @@ impl ConditionalParts {
         }
         let meta_bytes = postcard::to_allocvec(meta).context("cannot encode metadata")?;
         let mut sections = sections(info, &self.params, &self.table, &self.weights).to_vec();
-        let tree_info = self.prior.as_ref().map(|t| t.info());
-        if let (Some(tree), Some(tree_info)) = (&self.prior, &tree_info) {
-            sections.extend(tree.sections(tree_info));
+        let tree_info = match &self.prior {
+            Some(Prior::Envmap(tree)) => Some(tree.info()),
+            _ => None,
+        };
+        let brdf_info = match &self.prior {
+            Some(Prior::Brdf(prior)) => Some(prior.info()),
+            _ => None,
+        };
+        match (&self.prior, &tree_info, &brdf_info) {
+            (Some(Prior::Envmap(tree)), Some(info), _) => sections.extend(tree.sections(info)),
+            (Some(Prior::Brdf(prior)), _, Some(info)) => sections.extend(prior.sections(info)),
+            _ => {}
         }
         let mut out = AlignedBytes::zeroed(encoded_len(&meta_bytes, &sections));
         write(

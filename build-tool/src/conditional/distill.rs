@@ -16,9 +16,10 @@
 //!   ([`PointWarp::EnvmapTree`]) carries the map's tree, which the pool trained
 //!   through.
 
+use super::blob::Prior;
 use super::ConditionalParts;
 use crate::network::Params;
-use crate::sphere::brdf_albedo::directional_albedo;
+use crate::sphere::brdf_albedo::{directional_albedo, directional_albedo_metallic};
 use crate::sphere::EnvmapDensity;
 use crate::train::target::LoadedTarget;
 use glam::DVec2;
@@ -95,10 +96,15 @@ pub fn distill(
         })
         .collect();
     let (weights, prior) = match target {
-        LoadedTarget::GltfBrdf => (brdf_weights(&info), None),
+        LoadedTarget::GltfBrdf(prior) => (
+            brdf_weights(&info),
+            (info.point_warp() == Some(PointWarp::BrdfTable))
+                .then(|| Prior::Brdf(Arc::clone(prior))),
+        ),
         LoadedTarget::Envmap(env) => (
             envmap_weights(&info, &env.map),
-            (info.point_warp() == Some(PointWarp::EnvmapTree)).then(|| Arc::new(env.tree.clone())),
+            (info.point_warp() == Some(PointWarp::EnvmapTree))
+                .then(|| Prior::Envmap(Arc::new(env.tree.clone()))),
         ),
     };
     ConditionalParts {
@@ -125,21 +131,37 @@ fn envmap_weights(info: &ConditionalInfo, map: &EnvmapDensity) -> Vec<f32> {
         .collect()
 }
 
-/// The albedo `A`, then for the mixture warp `p_s`, at every weight-grid node.
+/// The albedo `A`, then for the mixture warp `p_s`, for the tabulated prior the
+/// metal's albedo, at every weight-grid node.
 fn brdf_weights(info: &ConditionalInfo) -> Vec<f32> {
     let weight_grid = info.weight_grid;
     let weight_nodes = weight_grid[0] * weight_grid[1];
+    let condition =
+        |node: u32| info.weight_grid_condition([node % weight_grid[0], node / weight_grid[0]]);
     // One quadrature per node gives both tables: `A` and `p_s = A_spec / A`.
     let albedos: Vec<BrdfParts<f64>> = (0..weight_nodes)
         .into_par_iter()
         .map(|node| {
-            let c = info.weight_grid_condition([node % weight_grid[0], node / weight_grid[0]]);
+            let c = condition(node);
             directional_albedo(BrdfModel::Gltf, c[0], c[1])
         })
         .collect();
     let mut weights: Vec<f32> = albedos.iter().map(|a| a.total() as f32).collect();
-    if info.weight_tables() > 1 {
-        weights.extend(albedos.iter().map(|a| (a.specular / a.total()) as f32));
+    match info.point_warp() {
+        Some(PointWarp::BrdfMixture) => {
+            weights.extend(albedos.iter().map(|a| (a.specular / a.total()) as f32));
+        }
+        Some(PointWarp::BrdfTable) => {
+            let metal: Vec<f32> = (0..weight_nodes)
+                .into_par_iter()
+                .map(|node| {
+                    let c = condition(node);
+                    directional_albedo_metallic(c[0], c[1], 1.0).total() as f32
+                })
+                .collect();
+            weights.extend(metal);
+        }
+        _ => {}
     }
     weights
 }
@@ -155,7 +177,7 @@ mod tests {
     fn table_holds_the_shipped_network_and_weights_the_albedo() {
         let shape = Shape::new(5, &[6], Activation::Relu, 2).unwrap();
         let params = Params::init(shape, 4);
-        let parts = distill(&params, &LoadedTarget::GltfBrdf, 3, [3, 2], [4, 3]);
+        let parts = distill(&params, &LoadedTarget::gltf_brdf(), 3, [3, 2], [4, 3]);
         assert_eq!(parts.table.len(), 3 * 2 * 3 * 5);
         assert_eq!(parts.weights.len(), 12);
         // Entry (node (2, 1), instance 2, index 4) against the network evaluated by
@@ -185,7 +207,7 @@ mod tests {
         let shape = Shape::new(5, &[6, 3], Activation::Relu, 2).unwrap();
         let brdf = info(
             &shape.with_lattice_residual(true),
-            &LoadedTarget::GltfBrdf,
+            &LoadedTarget::gltf_brdf(),
             3,
             [3, 2],
             [4, 5],
@@ -193,7 +215,7 @@ mod tests {
         assert_eq!((brdf.target, brdf.domain), (1, Domain::Hemisphere as u32));
         assert_eq!(brdf.cond_min, CONDITION_MIN.map(|x| x as f32));
         assert_eq!(brdf.cond_max, CONDITION_MAX.map(|x| x as f32));
-        assert_eq!(brdf.warp, PointWarp::BrdfMixture as u32);
+        assert_eq!(brdf.warp, PointWarp::BrdfTable as u32);
         assert_eq!(
             (brdf.n, brdf.instances, brdf.grid, brdf.weight_grid),
             (5, 3, [3, 2], [4, 5])

@@ -19,9 +19,11 @@
 use crate::baselines::warped_owen_sobol_directions;
 use crate::network::Params;
 use crate::progress::Progress;
+use crate::sphere::brdf_prior::BrdfPrior;
 use crate::sphere::metrics::diversity;
 use crate::sphere::metrics::{CapRadius, MeasuredCaps};
 use crate::sphere::{BrdfTarget, DirectionDensity};
+use crate::train::pool::brdf_table_direction;
 use crate::train::target::{EnvmapTarget, LoadedTarget};
 use anyhow::Result;
 use glam::{DVec2, DVec3};
@@ -39,6 +41,10 @@ pub struct QualityConfig {
     /// Held-out conditions in blob units: `(roughness, theta_o in degrees)` for a
     /// BRDF sampler, the normal's octahedral square point for an environment one.
     pub conditions: Vec<[f64; 2]>,
+    /// A BRDF sampler's metallic at each condition (0 where missing; environment
+    /// samplers ignore it).
+    #[serde(default)]
+    pub metallic: Vec<f64>,
     /// Instances (and baseline seeds) averaged per condition.
     pub instances: u32,
     /// Instances in the union of the diversity figure.
@@ -53,15 +59,21 @@ impl QualityConfig {
     /// A `k x k` grid of conditions at cell centres of `target`'s condition range
     /// (off any point-table grid with an odd node count... and most even ones):
     /// `(roughness, theta_o)` for the BRDF, the octahedral square `[0,1]^2` of the
-    /// normal for a map; 8 instances, unions of 64, 4096 caps.
+    /// normal for a map; a BRDF's metallic cycles through 0, 1 and 0.5; 8
+    /// instances, unions of 64, 4096 caps.
     pub fn held_out(target: &LoadedTarget, k: usize, seed: u64) -> Self {
         // Cell centre `j` of an axis of the unit square.
         let centre = |j: usize| (j as f64 + 0.5) / k as f64;
         let conditions = (0..k * k)
             .map(|j| target.condition([centre(j % k), centre(j / k)]))
             .collect();
+        let metallic = match target {
+            LoadedTarget::GltfBrdf(_) => (0..k * k).map(|j| [0.0, 1.0, 0.5][j % 3]).collect(),
+            LoadedTarget::Envmap(_) => Vec::new(),
+        };
         Self {
             conditions,
+            metallic,
             instances: 8,
             union_instances: 64,
             caps: 4096,
@@ -75,6 +87,9 @@ impl QualityConfig {
 pub struct ConditionQuality {
     /// In blob units (see [`QualityConfig::conditions`]).
     pub condition: [f64; 2],
+    /// A BRDF sampler's metallic.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub metallic: Option<f64>,
     /// An environment sampler's normal (world frame, `+z` up).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub normal: Option<[f64; 3]>,
@@ -112,21 +127,32 @@ pub struct Quality {
     pub mean_nn_ratio: f64,
 }
 
-/// The directions of instance `k` at `cond` (network mode, `params` as given),
-/// `p_s` the condition's lobe probability (used by the mixture warp,
+/// The directions of instance `k` of a BRDF sampler at `cond` and metallic 0
+/// (network mode, `params` as given, through the shared prior), `p_s` the
+/// condition's lobe probability (read by the mixture warp only,
 /// [`PointWarp::direction`]).
 pub fn instance_directions(params: &Params, cond: [f64; 2], p_s: f64, k: u32) -> Vec<DVec3> {
-    let unit = LoadedTarget::GltfBrdf.normalized(cond);
+    let unit = LoadedTarget::gltf_brdf().normalized(cond);
     let warp = PointWarp::of(ConditionalTarget::GltfBrdf, &params.shape);
+    let prior = BrdfPrior::shared();
     directions_at(
         params,
         unit,
         cond,
-        (Domain::Hemisphere, warp, None),
+        (Domain::Hemisphere, warp, None, Some((&prior, 0.0))),
         p_s,
         (k, false),
     )
 }
+
+/// How a sampler's points become directions: the domain, the warp, an
+/// environment sampler's tree, a BRDF sampler's prior and metallic.
+type How<'a> = (
+    Domain,
+    PointWarp,
+    Option<&'a CoreTree<'a>>,
+    Option<(&'a BrdfPrior, f64)>,
+);
 
 /// Instance `k`'s directions at the condition `cond` (blob units; `unit` its
 /// normalized form, the network's input) on `domain` through `warp` (and its
@@ -136,7 +162,7 @@ fn directions_at(
     params: &Params,
     unit: [f64; 2],
     cond: [f64; 2],
-    (domain, warp, tree): (Domain, PointWarp, Option<&CoreTree<'_>>),
+    (domain, warp, tree, brdf): How<'_>,
     p_s: f64,
     (k, randomized): (u32, bool),
 ) -> Vec<DVec3> {
@@ -147,7 +173,12 @@ fn directions_at(
             if randomized {
                 s = torus_shift(s, shift);
             }
-            DVec3::from_array(warp.direction(domain, cond, p_s, tree, s))
+            match (warp, brdf) {
+                (PointWarp::BrdfTable, Some((prior, m))) => {
+                    brdf_table_direction(prior, [cond[0], cond[1], m], DVec2::from(s)).0
+                }
+                _ => DVec3::from_array(warp.direction(domain, cond, p_s, tree, s)),
+            }
         })
         .collect()
 }
@@ -170,15 +201,17 @@ struct HeldOut {
     kind: ConditionalTarget,
     /// An environment sampler's map and tree.
     env: Option<Arc<EnvmapTarget>>,
+    /// A BRDF sampler's prior and metallic.
+    brdf: Option<(Arc<BrdfPrior>, f64)>,
 }
 
 impl HeldOut {
     /// `cond` of `target`, or `None` for a normal that no light reaches.
-    fn new(target: &LoadedTarget, cond: [f64; 2]) -> Result<Option<Self>> {
+    fn new(target: &LoadedTarget, cond: [f64; 2], metallic: f64) -> Result<Option<Self>> {
         let unit = target.normalized(cond);
         Ok(match target {
-            LoadedTarget::GltfBrdf => {
-                let t = BrdfTarget::new(cond[0], cond[1], Domain::Hemisphere)?;
+            LoadedTarget::GltfBrdf(prior) => {
+                let t = BrdfTarget::metallic(cond[0], cond[1], metallic, Domain::Hemisphere)?;
                 Some(Self {
                     unit,
                     cond,
@@ -188,6 +221,7 @@ impl HeldOut {
                     density: Box::new(t),
                     kind: ConditionalTarget::GltfBrdf,
                     env: None,
+                    brdf: Some((Arc::clone(prior), metallic)),
                 })
             }
             LoadedTarget::Envmap(env) => {
@@ -202,6 +236,7 @@ impl HeldOut {
                     density: Box::new(lit) as Box<dyn DirectionDensity>,
                     kind: ConditionalTarget::EnvmapNormal,
                     env: Some(Arc::clone(env)),
+                    brdf: None,
                 })
             }
         })
@@ -225,7 +260,8 @@ impl HeldOut {
             .into_par_iter()
             .map(|k| {
                 let (unit, cond, p_s) = (self.unit, self.cond, self.lobe_probability);
-                let how = (self.domain, warp, tree.as_ref());
+                let brdf = self.brdf.as_ref().map(|(p, m)| (p.as_ref(), *m));
+                let how = (self.domain, warp, tree.as_ref(), brdf);
                 directions_at(shipped, unit, cond, how, p_s, (k, false))
             })
             .collect();
@@ -233,7 +269,8 @@ impl HeldOut {
             .into_par_iter()
             .map(|k| {
                 let (unit, cond, p_s) = (self.unit, self.cond, self.lobe_probability);
-                let how = (self.domain, warp, tree.as_ref());
+                let brdf = self.brdf.as_ref().map(|(p, m)| (p.as_ref(), *m));
+                let how = (self.domain, warp, tree.as_ref(), brdf);
                 d(&directions_at(shipped, unit, cond, how, p_s, (k, true)))
             })
             .collect();
@@ -261,6 +298,7 @@ impl HeldOut {
             (n >= 2).then(|| diversity(&sets[..config.union_instances.max(2) as usize], &caps));
         ConditionQuality {
             condition: self.cond,
+            metallic: self.brdf.as_ref().map(|b| b.1),
             normal: self.normal.map(|n| n.to_array()),
             ours,
             baseline,
@@ -280,7 +318,8 @@ pub fn evaluate(params: &Params, target: &LoadedTarget, config: &QualityConfig) 
     // Seconds per condition for a map (exact cap measures of the lit map).
     let progress = Progress::stderr("quality", config.conditions.len() as u64, "condition");
     for (index, &cond) in config.conditions.iter().enumerate() {
-        if let Some(held) = HeldOut::new(target, cond)? {
+        let metallic = config.metallic.get(index).copied().unwrap_or(0.0);
+        if let Some(held) = HeldOut::new(target, cond, metallic)? {
             conditions.push(held.score(&shipped, config, index));
         }
         progress.inc(1);

@@ -5,9 +5,10 @@
 //!
 //! * **Nodes**: `G_r x G_t x G_m` conditions at the vertices of a regular grid over
 //!   roughness `[0.1, 1]`, `θo` `[0°, 89°]` and metallic `[0, 1]`. Before
-//!   normalization the target is linear in metallic, so two metallic nodes blended
-//!   as the tables are blend the albedo-weighted lobes, not the lobes at the
-//!   query's metallic: the warp still samples the blend exactly.
+//!   normalization the target is linear in metallic, and the blend weighs each
+//!   node by its mass before normalization (the tabulated albedo), so two
+//!   metallic nodes reproduce every metallic exactly
+//!   ([`nuld_core::brdf_prior`]).
 //! * **Space** ([`PriorSpace`]): the square of the tables is the hemisphere's
 //!   equal-area square of either the light direction `wi` itself, or of the half
 //!   vector `h`, with `wi = reflect(wo, h) = 2 (wo.h) h - wo`. In half-vector space
@@ -25,11 +26,11 @@
 
 use super::envmap_prior::tabulated;
 use glam::{DVec2, DVec3};
-use nuld_core::brdf::{
-    gltf_metallic, view_direction, MAX_METALLIC, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_METALLIC,
-    MIN_ROUGHNESS,
+use nuld_core::brdf::{gltf_metallic, view_direction};
+use nuld_core::brdf_prior::{
+    half_vector_direction, half_vector_point, node_condition, unit_condition, BrdfPriorInfo,
 };
-use nuld_core::marginal2d::{Blend, Marginal2D, Marginal2DError, Marginal2DShape};
+use nuld_core::marginal2d::{Blend, Marginal2D, Marginal2DError, Marginal2DShape, MAX_BLEND};
 use nuld_core::sphere::{hemisphere_to_square, square_to_hemisphere};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -38,12 +39,23 @@ use std::f64::consts::PI;
 /// the module docs is this over the table's vertices, at least 1).
 pub const SUPERSAMPLED_AXIS: u32 = 1024;
 
+/// The BRDF sampler's prior grid `[G_r, G_t, G_m]`: two metallic nodes are exact
+/// (module docs); 10 x 12 conditions in half-vector tables are where more nodes
+/// stopped paying (`eval brdf-prior`, docs/results/brdf-prior.md).
+pub const PRIOR_GRID: [u32; 3] = [10, 12, 2];
+
+/// The BRDF sampler's prior table size: 96 vertices per axis, 17.8 MB of state
+/// (64: 7.9 MB, a shifted lattice 0.979 of the exact warp's Owen-Sobol; 96:
+/// 0.936; 128: 31.6 MB, 0.919).
+pub const PRIOR_SIZE: u32 = 96;
+
 /// Which square the tables live on (module docs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub enum PriorSpace {
     /// The equal-area square of the light direction `wi`.
     Direction,
-    /// The equal-area square of the half vector `h`.
+    /// The equal-area square of the half vector `h`
+    /// ([`nuld_core::brdf_prior::half_vector_direction`]): the blob's prior.
     HalfVector,
 }
 
@@ -60,36 +72,29 @@ impl PriorSpace {
     /// `|dwi/dω_p|`, the solid angle of `wi` per solid angle of the table's own
     /// direction (1 for [`Self::Direction`]); `None` below the horizon.
     fn direction(self, wo: DVec3, p: DVec2) -> Option<(DVec3, f64)> {
-        let d = square_to_hemisphere(p);
         match self {
-            Self::Direction => (d.z > 0.0).then_some((d, 1.0)),
-            Self::HalfVector => {
-                let c = wo.dot(d);
-                let wi = 2.0 * c * d - wo;
-                (c > 0.0 && wi.z > 0.0).then(|| (wi.normalize(), 4.0 * c))
+            Self::Direction => {
+                let d = square_to_hemisphere(p);
+                (d.z > 0.0).then_some((d, 1.0))
             }
+            Self::HalfVector => half_vector_direction(wo.to_array(), p.to_array())
+                .map(|(wi, jac)| (DVec3::from_array(wi), jac)),
         }
     }
 
     /// The square point of the light direction `wi` for `wo` and the same
     /// Jacobian; `None` where no table point maps to `wi`.
     fn point(self, wo: DVec3, wi: DVec3) -> Option<(DVec2, f64)> {
-        if wi.z <= 0.0 {
-            return None;
-        }
         match self {
-            Self::Direction => Some((hemisphere_to_square(wi), 1.0)),
-            Self::HalfVector => {
-                let h = (wo + wi).normalize();
-                let c = wo.dot(h);
-                (h.z > 0.0 && c > 0.0).then(|| (hemisphere_to_square(h), 4.0 * c))
-            }
+            Self::Direction => (wi.z > 0.0).then(|| (hemisphere_to_square(wi), 1.0)),
+            Self::HalfVector => half_vector_point(wo.to_array(), wi.to_array())
+                .map(|(p, jac)| (DVec2::from_array(p), jac)),
         }
     }
 }
 
 /// The tabulated BRDF warp (module docs).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct BrdfPrior {
     /// Nodes per condition axis `[G_r, G_t, G_m]`.
     pub grid: [u32; 3],
@@ -103,24 +108,31 @@ pub struct BrdfPrior {
     pub marginal: Vec<f32>,
     /// Conditional CDFs.
     pub conditional: Vec<f32>,
+    /// Each node's mass before normalization (the trapezoid rule of
+    /// [`nuld_core::marginal2d::tabulate`] in `f64`): the blend's weights are
+    /// multiplied by them ([`nuld_core::brdf_prior::BrdfPrior::blend`]).
+    pub masses: Vec<f32>,
+    /// The four tables widened to `f64` (data, marginal, conditional, masses):
+    /// the trainer warps in `f64` ([`Self::core_f64`]) for its differences.
+    wide: [Vec<f64>; 4],
 }
 
-/// The condition of grid node `i` of `count` along `[lo, hi]`.
-fn node_value(i: u32, count: u32, lo: f64, hi: f64) -> f64 {
-    match count {
-        0 | 1 => lo,
-        c => lo + (hi - lo) * i as f64 / (c - 1) as f64,
+/// The trapezoid mass of an `s x s` table on `[0,1]^2` (what
+/// [`nuld_core::marginal2d::tabulate`] divides by).
+fn trapezoid_mass(table: &[f32], s: usize) -> f64 {
+    let weight = |i: usize| if i == 0 || i == s - 1 { 0.5 } else { 1.0 };
+    let mut sum = 0.0;
+    for j in 0..s {
+        for i in 0..s {
+            sum += weight(i) * weight(j) * table[j * s + i] as f64;
+        }
     }
-}
-
-/// `(x - lo) / (hi - lo)`.
-fn unit(x: f64, lo: f64, hi: f64) -> f64 {
-    (x - lo) / (hi - lo)
+    sum / ((s - 1) * (s - 1)) as f64
 }
 
 impl BrdfPrior {
     /// The prior on `grid` condition nodes and `size x size` table vertices in
-    /// `space`, tables in `f32` (as a blob would store them). `O(nodes R^2)` with
+    /// `space`, tables in `f32` (as a blob stores them). `O(nodes R^2)` with
     /// `R` = [`SUPERSAMPLED_AXIS`], in parallel over the nodes; the same bits for
     /// any thread count. An error if `size` is below 2, a grid axis is 0, or a
     /// node's table has no mass.
@@ -142,7 +154,7 @@ impl BrdfPrior {
         let tables: Vec<Vec<f32>> = (0..nodes)
             .into_par_iter()
             .map(|node| {
-                let [r, t, m] = Self::node_condition(grid, node);
+                let [r, t, m] = node_condition(grid, node);
                 let wo = view_direction(t);
                 let mut out = vec![0.0f32; s * s];
                 for j in 0..s {
@@ -169,7 +181,15 @@ impl BrdfPrior {
                 out
             })
             .collect();
+        let masses = tables.iter().map(|t| trapezoid_mass(t, s) as f32).collect();
         let [data, marginal, conditional] = tabulated(shape, &tables)?;
+        let widen = |v: &Vec<f32>| v.iter().map(|&x| x as f64).collect();
+        let wide = [
+            widen(&data),
+            widen(&marginal),
+            widen(&conditional),
+            widen(&masses),
+        ];
         Ok(Self {
             grid,
             space,
@@ -177,18 +197,60 @@ impl BrdfPrior {
             data,
             marginal,
             conditional,
+            masses,
+            wide,
         })
+    }
+
+    /// The BRDF sampler's prior ([`PRIOR_GRID`], [`PRIOR_SIZE`], half-vector
+    /// tables), built once per process (about 4 s on 2 cores) and shared.
+    pub fn shared() -> std::sync::Arc<Self> {
+        static PRIOR: std::sync::OnceLock<std::sync::Arc<BrdfPrior>> = std::sync::OnceLock::new();
+        PRIOR
+            .get_or_init(|| {
+                std::sync::Arc::new(
+                    Self::new(PRIOR_GRID, PRIOR_SIZE, PriorSpace::HalfVector)
+                        .expect("the BRDF has mass at every node"),
+                )
+            })
+            .clone()
+    }
+
+    /// [`Self::core`] over the tables widened to `f64` (the same values; the
+    /// warp's arithmetic in `f64`).
+    pub fn core_f64(&self) -> Option<nuld_core::brdf_prior::BrdfPrior<'_, f64>> {
+        (self.space == PriorSpace::HalfVector).then(|| {
+            let [data, marginal, conditional, masses] = &self.wide;
+            nuld_core::brdf_prior::BrdfPrior::view(self.info(), data, marginal, conditional, masses)
+                .expect("tables written by tabulate")
+        })
+    }
+
+    /// The blob sections of the tables ([`nuld_core::brdf_prior::sections`]).
+    pub fn sections<'s>(
+        &'s self,
+        info: &'s BrdfPriorInfo,
+    ) -> [nuld_core::blob::SectionSpec<'s>; 5] {
+        nuld_core::brdf_prior::sections(
+            info,
+            &self.data,
+            &self.marginal,
+            &self.conditional,
+            &self.masses,
+        )
+    }
+
+    /// The blob's info record of these tables.
+    pub fn info(&self) -> BrdfPriorInfo {
+        BrdfPriorInfo {
+            grid: self.grid,
+            size: self.shape.size[0],
+        }
     }
 
     /// `[roughness, θo in degrees, metallic]` of node `node` of `grid`.
     pub fn node_condition(grid: [u32; 3], node: u32) -> [f64; 3] {
-        let (i, rest) = (node % grid[0], node / grid[0]);
-        let (j, l) = (rest % grid[1], rest / grid[1]);
-        [
-            node_value(i, grid[0], MIN_ROUGHNESS, MAX_ROUGHNESS),
-            node_value(j, grid[1], 0.0, MAX_THETA_O_DEG),
-            node_value(l, grid[2], MIN_METALLIC, MAX_METALLIC),
-        ]
+        node_condition(grid, node)
     }
 
     /// The warp over the tables.
@@ -197,15 +259,33 @@ impl BrdfPrior {
             .expect("tables written by tabulate")
     }
 
-    /// The blend of the nodes around `[roughness, θo in degrees, metallic]`.
+    /// The runtime's prior over these tables (half-vector tables only; `None`
+    /// for direction ones): the one implementation every sampler draws from.
+    pub fn core(&self) -> Option<nuld_core::brdf_prior::BrdfPrior<'_, f32>> {
+        (self.space == PriorSpace::HalfVector).then(|| {
+            nuld_core::brdf_prior::BrdfPrior::view(
+                self.info(),
+                &self.data,
+                &self.marginal,
+                &self.conditional,
+                &self.masses,
+            )
+            .expect("tables written by tabulate")
+        })
+    }
+
+    /// The blend of the nodes around `[roughness, θo in degrees, metallic]`:
+    /// multilinear weights times the nodes' masses, as
+    /// [`nuld_core::brdf_prior::BrdfPrior::blend`] (in both spaces).
     pub fn blend(&self, condition: [f64; 3]) -> Blend<f32> {
-        let [r, t, m] = condition;
-        let params = [
-            unit(r, MIN_ROUGHNESS, MAX_ROUGHNESS) as f32,
-            unit(t, 0.0, MAX_THETA_O_DEG) as f32,
-            unit(m, MIN_METALLIC, MAX_METALLIC) as f32,
-        ];
-        Blend::multilinear(&params, &self.grid)
+        let unit = unit_condition(condition).map(|x| x as f32);
+        let multilinear = Blend::multilinear(&unit, &self.grid);
+        let pairs: Vec<(u32, f32)> = multilinear
+            .pairs()
+            .map(|(node, w)| (node, w * self.masses[node as usize]))
+            .collect();
+        debug_assert!(pairs.len() <= MAX_BLEND);
+        Blend::from_pairs(&pairs)
     }
 
     /// The light direction at primary sample `u` for `condition`, and its
@@ -239,9 +319,9 @@ impl BrdfPrior {
         }
     }
 
-    /// Bytes of the tables as `f32`: data, conditional and marginal CDFs.
+    /// Bytes of the tables as `f32`: data, conditional and marginal CDFs, masses.
     pub fn state_bytes(&self) -> usize {
-        4 * (self.data.len() + self.conditional.len() + self.marginal.len())
+        4 * (self.data.len() + self.conditional.len() + self.marginal.len() + self.masses.len())
     }
 }
 
@@ -260,7 +340,7 @@ mod tests {
     fn the_estimate_with_the_priors_pdf_is_the_albedo() {
         for space in [PriorSpace::Direction, PriorSpace::HalfVector] {
             let prior = BrdfPrior::new([3, 4, 2], 32, space).unwrap();
-            assert_eq!(prior.state_bytes(), 4 * 24 * (2 * 32 * 32 + 32));
+            assert_eq!(prior.state_bytes(), 4 * 24 * (2 * 32 * 32 + 32 + 1));
             let warp = prior.warp();
             for (c, condition) in [
                 [0.55, 29.666666666666668, 0.0],

@@ -123,15 +123,17 @@ impl BrdfTarget {
     /// The glTF target with cap measures from a rule of about `table_points`
     /// points, also used for profiles: cheaper to build than [`BrdfTarget::new`]
     /// (`2^14` points: ~1/16 of the time, cap measures off by a few `1e-4` more),
-    /// for callers that need many conditions (training).
+    /// for callers that need many conditions (training); `metallic` in `[0, 1]`
+    /// as for [`BrdfTarget::metallic`].
     pub fn coarse(
         roughness: f64,
         theta_o_deg: f64,
+        metallic: f64,
         table_points: usize,
     ) -> Result<Self, DirectionSpecError> {
         Self::with_rules(
             BrdfModel::Gltf,
-            [roughness, theta_o_deg, 0.0],
+            [roughness, theta_o_deg, metallic],
             Domain::Hemisphere,
             table_points,
             table_points,

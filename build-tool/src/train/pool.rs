@@ -23,12 +23,13 @@ use crate::discrepancy::caps::epoch_caps;
 use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use crate::discrepancy::GradientPath;
 use crate::seeding::derive_seed;
+use crate::sphere::brdf_prior::BrdfPrior;
 use crate::sphere::geometry::map_jacobian;
 use crate::sphere::{BrdfTarget, CapMeasureTable, DirectionDensity, TabulatedWarp};
 use anyhow::Result;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
-use nuld_core::brdf::{view_direction, BrdfModel};
+use nuld_core::brdf::{gltf_metallic, view_direction};
 use nuld_core::conditional::{ConditionalTarget, PointWarp};
 use nuld_core::network::{instance_offset, shifted_lattice_point, Shape};
 use nuld_core::sphere::{hemisphere_to_square, sphere_to_square, square_to_sphere};
@@ -49,12 +50,16 @@ pub const POOL_BASELINE_TABULATION: usize = 256;
 
 /// What a condition's target density is made of.
 pub enum ConditionDensity {
-    /// The glTF BRDF at a view.
+    /// The glTF metallic-roughness BRDF at a view.
     Brdf {
         /// View direction.
         wo: DVec3,
+        /// The metallic in `[0, 1]`.
+        metallic: f64,
         /// Directional albedo, the normalizer of the target density.
         albedo: f64,
+        /// The tabulated prior ([`PointWarp::BrdfTable`]).
+        prior: Arc<BrdfPrior>,
     },
     /// An environment map through the cosine about a normal.
     Envmap {
@@ -104,8 +109,14 @@ impl PoolCondition {
     /// `pdf_map(x) max(0, n.x) scale` for a map.
     pub fn pdf(&self, x: DVec3) -> f64 {
         match &self.density {
-            ConditionDensity::Brdf { wo, albedo } => {
-                BrdfModel::Gltf.cosine_weighted(*wo, x, self.cond[0]) / albedo
+            ConditionDensity::Brdf {
+                wo,
+                metallic,
+                albedo,
+                ..
+            } => {
+                gltf_metallic(wo.to_array(), x.to_array(), self.cond[0], *metallic) * x.z.max(0.0)
+                    / albedo
             }
             ConditionDensity::Envmap { normal, env, scale } => {
                 env.map.pdf(x) * normal.dot(x).max(0.0) * scale
@@ -126,6 +137,15 @@ impl PoolCondition {
     /// slopes through the sphere map, exact within the piece of the tree the
     /// point falls in; for the equal-area maps exact.
     pub fn direction(&self, p: DVec2) -> (DVec3, DVec3, DVec3) {
+        if let (
+            PointWarp::BrdfTable,
+            ConditionDensity::Brdf {
+                metallic, prior, ..
+            },
+        ) = (self.warp, &self.density)
+        {
+            return brdf_table_direction(prior, [self.cond[0], self.cond[1], *metallic], p);
+        }
         let tree = match &self.density {
             ConditionDensity::Envmap { env, .. } => Some(env.tree.tree()),
             ConditionDensity::Brdf { .. } => None,
@@ -174,6 +194,36 @@ impl PoolCondition {
             });
         (warp(p), jx, jy)
     }
+}
+
+/// The direction of the BRDF prior's primary point `p` at `[roughness, θo,
+/// metallic]` (`f64` warp over the prior's tables, [`BrdfPrior::core_f64`]) and
+/// its central differences of step `1e-6` along `p.x` and `p.y`, zeroed where
+/// they straddle the edge of the prior's support (a jump to `+z`, which no
+/// gradient can follow).
+pub fn brdf_table_direction(prior: &BrdfPrior, cond: [f64; 3], p: DVec2) -> (DVec3, DVec3, DVec3) {
+    let core = prior
+        .core_f64()
+        .expect("the BRDF sampler's prior is half-vector");
+    let at = |q: DVec2| core.sample(cond, q.to_array());
+    let (d, pdf) = at(p);
+    let h = 1e-6;
+    let diff = |e: DVec2| {
+        let (hi, p_hi) = at(p + h * e);
+        let (lo, p_lo) = at(p - h * e);
+        let j = (DVec3::from_array(hi) - DVec3::from_array(lo)) / (2.0 * h);
+        if p_hi > 0.0 && p_lo > 0.0 && j.is_finite() && j.length() < 1e3 {
+            j
+        } else {
+            DVec3::ZERO
+        }
+    };
+    let d = if pdf > 0.0 {
+        DVec3::from_array(d)
+    } else {
+        DVec3::Z
+    };
+    (d, diff(DVec2::X), diff(DVec2::Y))
 }
 
 /// Instances with pretraining targets per pool condition.
@@ -236,7 +286,11 @@ impl ConditionPool {
                 let seed = derive_seed(seed, p as u64);
                 let cond = loaded.condition(u);
                 match &loaded {
-                    LoadedTarget::GltfBrdf => condition(cond, caps, window, shape, seed),
+                    LoadedTarget::GltfBrdf(prior) => {
+                        let m = pool_metallic(sobol_burley::sample(p as u32, 2, scramble) as f64);
+                        let cond = [cond[0], cond[1], m];
+                        condition(prior, cond, caps, window, shape, seed)
+                    }
                     LoadedTarget::Envmap(env) => {
                         envmap_condition(env, cond, caps, window, shape, seed)
                     }
@@ -260,24 +314,36 @@ impl ConditionPool {
     }
 }
 
+/// A pool condition's metallic from a uniform `v`: `clamp(1.5 v - 0.25, 0, 1)`,
+/// so that a sixth of the pool is the pure dielectric, a sixth the pure metal
+/// (the materials renderers see most), the rest uniform between.
+pub fn pool_metallic(v: f64) -> f64 {
+    (1.5 * v - 0.25).clamp(0.0, 1.0)
+}
+
+/// The pool condition `[roughness, θo, metallic]` of the BRDF.
 fn condition(
-    cond: [f64; 2],
+    prior: &Arc<BrdfPrior>,
+    cond3: [f64; 3],
     caps: usize,
     window: usize,
     shape: &Shape,
     seed: u64,
 ) -> Result<PoolCondition> {
     let n = shape.n() as usize;
-    let target = BrdfTarget::coarse(cond[0], cond[1], POOL_RULE_POINTS)
+    let cond = [cond3[0], cond3[1]];
+    let target = BrdfTarget::coarse(cond[0], cond[1], cond3[2], POOL_RULE_POINTS)
         .expect("pool conditions lie in the condition range");
     let exact = TabulatedWarp::new(&target, POOL_BASELINE_TABULATION, 2)?;
     let baseline = exact.warp_all(&seeded_owen_sobol(n, seed));
     let pc = PoolCondition {
         cond,
-        unit: LoadedTarget::GltfBrdf.normalized(cond),
+        unit: LoadedTarget::GltfBrdf(Arc::clone(prior)).normalized(cond),
         density: ConditionDensity::Brdf {
             wo: view_direction(cond[1]),
+            metallic: cond3[2],
             albedo: target.albedo(),
+            prior: Arc::clone(prior),
         },
         domain: Domain::Hemisphere,
         caps: Vec::new(),
@@ -420,8 +486,9 @@ mod tests {
     fn brdf_baselines_are_the_exact_inverse_cdf() {
         let shape = Shape::new(64, &[4], Activation::Relu, 5).unwrap();
         for cond in [[0.13, 85.0], [0.25, 80.0], [0.5, 30.0]] {
-            let pc = condition(cond, 512, 256, &shape, 3).unwrap();
-            let target = BrdfTarget::coarse(cond[0], cond[1], POOL_RULE_POINTS).unwrap();
+            let prior = BrdfPrior::shared();
+            let pc = condition(&prior, [cond[0], cond[1], 0.0], 512, 256, &shape, 3).unwrap();
+            let target = BrdfTarget::coarse(cond[0], cond[1], 0.0, POOL_RULE_POINTS).unwrap();
             let exact = TabulatedWarp::new(&target, POOL_BASELINE_TABULATION, 2).unwrap();
             let u = seeded_owen_sobol(64, 3);
             let want = pc.window_loss(&exact.warp_all(&u), 256);

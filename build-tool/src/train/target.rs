@@ -3,6 +3,7 @@
 //! use the same), and [`LoadedTarget`], the data a pool is built from.
 
 use crate::seeding::content_hash;
+use crate::sphere::brdf_prior::BrdfPrior;
 use crate::sphere::envmap_tree::{prior_levels, PRIOR_GRID};
 use crate::sphere::{EnvmapDensity, EnvmapTree};
 use anyhow::{Context, Result};
@@ -58,11 +59,11 @@ impl TrainTarget {
         }
     }
 
-    /// Reads what the pool needs: nothing for the BRDF, the map (on the sphere) for
+    /// Reads what the pool needs: the shared prior for the BRDF, the map (on the sphere) for
     /// an environment; one-line errors naming the file.
     pub fn load(&self) -> Result<LoadedTarget> {
         match self {
-            Self::GltfBrdf => Ok(LoadedTarget::GltfBrdf),
+            Self::GltfBrdf => Ok(LoadedTarget::gltf_brdf()),
             Self::Envmap { path, .. } => {
                 let map = EnvmapDensity::from_file_filtered(path, Domain::Sphere)
                     .with_context(|| format!("environment map {}", path.display()))?;
@@ -77,8 +78,9 @@ impl TrainTarget {
 /// A [`TrainTarget`] with its data read.
 #[derive(Clone, Debug)]
 pub enum LoadedTarget {
-    /// The glTF BRDF (closed form, nothing to read).
-    GltfBrdf,
+    /// The glTF metallic-roughness BRDF (closed form) and its tabulated prior
+    /// ([`BrdfPrior::shared`]), whose primary space the network refines.
+    GltfBrdf(Arc<BrdfPrior>),
     /// The map's bilinearly filtered luminance as a density on the sphere, and its
     /// tree, the sampler's prior.
     Envmap(Arc<EnvmapTarget>),
@@ -96,11 +98,16 @@ pub struct EnvmapTarget {
 }
 
 impl LoadedTarget {
+    /// The glTF BRDF with the shared prior ([`BrdfPrior::shared`]).
+    pub fn gltf_brdf() -> Self {
+        Self::GltfBrdf(BrdfPrior::shared())
+    }
+
     /// The blob's target code of this family (which also fixes its domain,
     /// [`ConditionalTarget::domain`]).
     pub fn kind(&self) -> ConditionalTarget {
         match self {
-            Self::GltfBrdf => ConditionalTarget::GltfBrdf,
+            Self::GltfBrdf(_) => ConditionalTarget::GltfBrdf,
             Self::Envmap(_) => ConditionalTarget::EnvmapNormal,
         }
     }
@@ -111,7 +118,7 @@ impl LoadedTarget {
     /// octahedral square point in `[0,1]^2` for a map.
     pub fn condition_range(&self) -> ([f64; 2], [f64; 2]) {
         match self {
-            Self::GltfBrdf => (CONDITION_MIN, CONDITION_MAX),
+            Self::GltfBrdf(_) => (CONDITION_MIN, CONDITION_MAX),
             Self::Envmap(_) => ([0.0; 2], [1.0; 2]),
         }
     }
@@ -139,7 +146,7 @@ mod tests {
     /// octahedral square itself, bit for bit both ways (the pool relies on it).
     #[test]
     fn conditions_map_the_unit_square_onto_each_targets_range() {
-        let brdf = LoadedTarget::GltfBrdf;
+        let brdf = TrainTarget::GltfBrdf.load().unwrap();
         assert_eq!(brdf.condition([0.0, 0.0]), CONDITION_MIN);
         assert_eq!(brdf.condition([1.0, 1.0]), CONDITION_MAX);
         let mid = brdf.condition([0.5, 0.5]);

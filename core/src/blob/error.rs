@@ -472,6 +472,25 @@ pub enum ConditionalError {
     /// The tree's levels, counts or values are refused
     /// ([`crate::envmap_tree::EnvmapTree::new`]).
     Tree(crate::quadtree::QuadtreeError),
+    /// The [`SectionTag::BrdfPriorInfo`] section is not one
+    /// [`crate::brdf_prior::BrdfPriorInfo`] long.
+    BrdfPriorInfoSize {
+        /// Its length in bytes.
+        got: u64,
+        /// [`crate::brdf_prior::BRDF_PRIOR_INFO_LEN`].
+        expected: u64,
+    },
+    /// A BRDF prior table section's elements are not 4 bytes (f32).
+    BrdfPriorElementSize {
+        /// The section's [`SectionTag`] code.
+        tag: u32,
+        /// Its element size.
+        size: u32,
+    },
+    /// The BRDF prior's grid, sizes, lengths or values are refused
+    /// ([`crate::brdf_prior::BrdfPrior::new`]; a length error's slice 3 is the
+    /// masses).
+    BrdfPrior(crate::marginal2d::Marginal2DError),
 }
 
 impl core::fmt::Display for ConditionalError {
@@ -575,6 +594,15 @@ impl core::fmt::Display for ConditionalError {
                 write!(f, "blob environment tree top weights are {e} bytes each, not 4")
             }
             Self::Tree(e) => write!(f, "blob environment tree: {e}"),
+            Self::BrdfPriorInfoSize { got, expected } => write!(
+                f,
+                "blob BRDF prior info section is {got} bytes, not {expected}"
+            ),
+            Self::BrdfPriorElementSize { tag, size } => write!(
+                f,
+                "blob BRDF prior section {tag} has {size}-byte elements, not 4 (f32)"
+            ),
+            Self::BrdfPrior(e) => write!(f, "blob BRDF prior: {e}"),
         }
     }
 }

@@ -138,6 +138,19 @@ pub enum SectionTag {
     /// The environment prior's top-level weights, `f32` (`elem_size` 4),
     /// `[normal][node]` ([`crate::envmap_tree::top_len`]).
     EnvmapTreeTop = 9,
+    /// One [`crate::brdf_prior::BrdfPriorInfo`] (16 bytes): the BRDF prior's
+    /// condition grid and table size (samplers with
+    /// [`crate::conditional::PointWarp::BrdfTable`]).
+    BrdfPriorInfo = 10,
+    /// The BRDF prior's normalized vertex values, `f32` (`elem_size` 4),
+    /// `[node][row][column]` ([`crate::marginal2d::tabulate`]).
+    BrdfPriorData = 11,
+    /// The BRDF prior's marginal CDFs, `f32`, `[node][row]`.
+    BrdfPriorMarginal = 12,
+    /// The BRDF prior's conditional CDFs, `f32`, laid out as the data.
+    BrdfPriorConditional = 13,
+    /// The BRDF prior's node masses before normalization, `f32`, one per node.
+    BrdfPriorMasses = 14,
 }
 
 /// Contents of the [`SectionTag::PointSetInfo`] section.

@@ -55,6 +55,16 @@ pub enum PointWarp {
     /// point is the condition. Its density at the direction is the sampler's pdf.
     /// Environment blobs only.
     EnvmapTree = 2,
+    /// The network's point is a point of the primary sample space of the BRDF
+    /// prior ([`crate::brdf_prior`], the blob's prior sections): a residual on
+    /// the logit of the instance's shifted lattice point as for
+    /// [`Self::BrdfMixture`], and the direction is the prior's exact warp of the
+    /// glTF metallic-roughness BRDF times the cosine at `(roughness, θo,
+    /// metallic)`, metallic given at the query (the learned points are shared by
+    /// every metallic; the prior blends the metallic ends exactly). Its density
+    /// at the direction is the sampler's pdf, and the weight is `f cos / pdf`.
+    /// glTF BRDF blobs only; replaces [`Self::BrdfMixture`] in new blobs.
+    BrdfTable = 3,
 }
 
 impl PointWarp {
@@ -64,18 +74,19 @@ impl PointWarp {
             0 => Some(Self::EqualArea),
             1 => Some(Self::BrdfMixture),
             2 => Some(Self::EnvmapTree),
+            3 => Some(Self::BrdfTable),
             _ => None,
         }
     }
 
     /// The warp a network of `shape` is trained for on `target`: for a [lattice
     /// residual](Shape::lattice_residual) the target's prior
-    /// ([`BrdfMixture`](Self::BrdfMixture) or [`EnvmapTree`](Self::EnvmapTree)),
+    /// ([`BrdfTable`](Self::BrdfTable) or [`EnvmapTree`](Self::EnvmapTree)),
     /// else [`EqualArea`](Self::EqualArea).
     pub fn of(target: ConditionalTarget, shape: &Shape) -> Self {
         match (shape.lattice_residual(), target) {
             (false, _) => Self::EqualArea,
-            (true, ConditionalTarget::GltfBrdf) => Self::BrdfMixture,
+            (true, ConditionalTarget::GltfBrdf) => Self::BrdfTable,
             (true, ConditionalTarget::EnvmapNormal) => Self::EnvmapTree,
         }
     }
@@ -93,8 +104,11 @@ impl PointWarp {
     /// degrees)` and lobe probability `p_s`. A warp ignores the arguments it does not
     /// use. [`EnvmapTree`](Self::EnvmapTree) samples `tree` at the normal whose
     /// octahedral square point is `cond` ([`EnvmapTree::sample_square`]; without a
-    /// tree, which no parsed blob lacks, the equal-area map stands in). Unit vectors; never
-    /// panics.
+    /// tree, which no parsed blob lacks, the equal-area map stands in).
+    /// [`BrdfTable`](Self::BrdfTable) needs the prior's tables and the metallic,
+    /// which this signature does not carry: callers warp through
+    /// [`crate::brdf_prior::BrdfPrior::sample`] (here the equal-area map stands
+    /// in). Unit vectors; never panics.
     #[inline]
     pub fn direction<T: Real>(
         self,
@@ -353,10 +367,12 @@ impl ConditionalInfo {
     }
 
     /// Number of tables in the weight section: the weights, then for
-    /// [`PointWarp::BrdfMixture`] the lobe probabilities `p_s`.
+    /// [`PointWarp::BrdfMixture`] the lobe probabilities `p_s`, for
+    /// [`PointWarp::BrdfTable`] the metal's albedo (the weights being the
+    /// dielectric's; the albedo is linear in metallic between them).
     pub fn weight_tables(&self) -> u64 {
         match self.point_warp() {
-            Some(PointWarp::BrdfMixture) => 2,
+            Some(PointWarp::BrdfMixture | PointWarp::BrdfTable) => 2,
             _ => 1,
         }
     }

@@ -56,32 +56,35 @@ class NuldBlobFile {
 };
 
 // The sampler of one shading point: a BRDF blob's view `wo` (local frame, z = the
-// normal) and roughness, or an environment blob's normal `n` (world frame). `pixel`
-// picks the set and, for an environment blob, its random shift (any uint32_t, e.g.
-// a hash of the pixel); `u` in Sample(u) is the index of the sample, 0 to N - 1.
+// normal), roughness and metallic, or an environment blob's normal `n` (world
+// frame). `pixel` picks the set and its random shift (any uint32_t, e.g. a hash of
+// the pixel); `u` in Sample(u) is the index of the sample, 0 to N - 1.
 class NuldSampler {
   public:
-    NuldSampler(const NuldBlobFile &file, Vector3f wo_or_n, float roughness, uint32_t pixel)
-        : file_(file), at_(wo_or_n), roughness_(roughness), pixel_(pixel) {}
+    NuldSampler(const NuldBlobFile &file, Vector3f wo_or_n, float roughness, float metallic,
+                uint32_t pixel)
+        : file_(file), at_(wo_or_n), roughness_(roughness), metallic_(metallic), pixel_(pixel) {}
 
     std::optional<DirectionSample> Sample(uint32_t u) const {
         const NuldVec3 at = {at_.x, at_.y, at_.z};
         NuldSample s;
-        int32_t rc = Brdf() ? nuld_brdf_sample(file_.blob(), NULD_MODE_TABLE, at, roughness_,
-                                               pixel_, u, &s)
-                            // The unbiased mode: every sample drawn exactly from its pdf.
+        // The unbiased mode: every sample drawn exactly from its pdf.
+        int32_t rc = Brdf() ? nuld_brdf_sample_randomized(file_.blob(), NULD_MODE_TABLE, at,
+                                                          roughness_, metallic_, pixel_, u,
+                                                          pixel_, &s)
                             : nuld_envmap_sample_randomized(file_.blob(), NULD_MODE_TABLE, at,
                                                             pixel_, u, pixel_, &s);
         if (rc != NULD_OK) return std::nullopt;
         return DirectionSample{{s.direction[0], s.direction[1], s.direction[2]}, s.pdf, s.weight};
     }
 
-    // The pdf of a sample in direction wi; 0 for a BRDF blob (not served yet).
+    // The pdf of a sample in direction wi.
     float PDF(Vector3f wi) const {
-        const NuldVec3 n = {at_.x, at_.y, at_.z}, d = {wi.x, wi.y, wi.z};
+        const NuldVec3 at = {at_.x, at_.y, at_.z}, d = {wi.x, wi.y, wi.z};
         float pdf = 0;
-        if (Brdf() || nuld_envmap_pdf(file_.blob(), n, d, &pdf) != NULD_OK) return 0;
-        return pdf;
+        int32_t rc = Brdf() ? nuld_brdf_pdf(file_.blob(), at, roughness_, metallic_, d, &pdf)
+                            : nuld_envmap_pdf(file_.blob(), at, d, &pdf);
+        return rc == NULD_OK ? pdf : 0;
     }
 
     uint32_t Count() const { return file_.info().len; }
@@ -91,6 +94,7 @@ class NuldSampler {
     const NuldBlobFile &file_;
     Vector3f at_;
     float roughness_;
+    float metallic_;
     uint32_t pixel_;
 };
 
@@ -101,7 +105,7 @@ int main(int argc, char **argv) try {
         throw std::runtime_error("a point set: sample it with nuld_point_2d or nuld_direction");
     bool brdf = file.info().target == NULD_TARGET_GLTF_BRDF;
     Vector3f at = brdf ? Vector3f{0.5f, 0.2f, 0.8f} : Vector3f{0.3f, -0.2f, 0.9f};
-    NuldSampler sampler(file, at, 0.3f, 17);
+    NuldSampler sampler(file, at, 0.3f, 1.0f, 17);  // a metal for a BRDF blob
     // For a BRDF blob, light reflected from a sky of radiance 1 + max(0, x); for an
     // environment blob, the unbiased estimate of the cosine's integral, pi.
     double estimate = 0, worst_pdf_error = 0;
@@ -117,11 +121,14 @@ int main(int argc, char **argv) try {
             float cos = at.x * s->wi.x + at.y * s->wi.y + at.z * s->wi.z;
             float norm = std::sqrt(at.x * at.x + at.y * at.y + at.z * at.z);
             estimate += std::fmax(0.0f, cos / norm) / s->pdf / sampler.Count();
-            worst_pdf_error = std::fmax(worst_pdf_error, std::fabs(sampler.PDF(s->wi) / s->pdf - 1));
         }
+        if (s->pdf > 0)
+            worst_pdf_error = std::fmax(worst_pdf_error, std::fabs(sampler.PDF(s->wi) / s->pdf - 1));
     }
     if (brdf)
-        std::printf("BRDF, N = %u: reflected radiance %.5f\n", sampler.Count(), estimate);
+        std::printf("metal BRDF, N = %u: reflected radiance %.5f; "
+                    "PDF(wi) / Sample(u).pdf - 1 at most %.1e\n",
+                    sampler.Count(), estimate, worst_pdf_error);
     else
         std::printf("environment, N = %u: integral of the cosine %.4f (pi = 3.1416); "
                     "PDF(wi) / Sample(u).pdf - 1 at most %.1e\n",

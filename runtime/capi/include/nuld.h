@@ -278,18 +278,17 @@ typedef struct NuldSample {
    */
   float direction[3];
   /**
-   * The estimator weight of every sample of the condition, finite and at
-   * least 0:
-   * the directional albedo A of a BRDF sampler (integral of L f cos ~ A / N
-   * times the sum of L(direction)), the irradiance E(n) of an environment
-   * sampler (~ E / N times the sum of f(direction)).
+   * The estimator weight, finite and at least 0: for a BRDF sampler f cos /
+   * pdf of the direction (integral of L f cos ~ 1 / N times the sum of L
+   * weight; the albedo A for blobs of the earlier mixture prior), for an
+   * environment sampler the irradiance E(n) of every sample of the normal
+   * (~ E / N times the sum of f(direction)).
    */
   float weight;
   /**
    * The solid-angle density of the sampler's prior at `direction`, per
-   * steradian, finite and at least 0: exact for an environment sampler (for L f cos / pdf
-   * and multiple importance sampling); 0 for a BRDF sampler, whose prior pdf
-   * is not served yet (use `weight`).
+   * steradian, finite and at least 0: exact (for L f cos / pdf and multiple
+   * importance sampling); 0 for BRDF blobs of the earlier mixture prior.
    */
   float pdf;
 } NuldSample;
@@ -405,12 +404,13 @@ int32_t nuld_direction(const struct NuldBlob *blob, uint32_t set, uint32_t index
 
 /**
  * Sample `index` of instance `instance` of a BRDF sampler for the view `wo`
- * (local frame, z = the normal, any length) at `roughness`, in `mode`, written
- * to `*out`. The runtime's `BrdfSampler::sample`: roughness clamps into the
- * blob's range (NaN to its lower end), a view below the horizon reads as grazing
- * and a zero or non-finite one as normal incidence, index wraps modulo N and
- * table mode's instance modulo S. O(1) in table mode. `out->pdf` is 0 (not served
- * yet). `NULD_ERR_WRONG_TARGET` for an environment sampler.
+ * (local frame, z = the normal, any length) at `roughness` and `metallic`, in
+ * `mode`, written to `*out`, with its pdf and the weight f cos / pdf. The
+ * runtime's `BrdfSampler::sample`: roughness clamps into the blob's range,
+ * metallic into [0, 1] (NaN to the lower ends), a view below the horizon reads
+ * as grazing and a zero or non-finite one as normal incidence, index wraps
+ * modulo N and table mode's instance modulo S. O(1) in table mode.
+ * `NULD_ERR_WRONG_TARGET` for an environment sampler.
  *
  * # Safety
  * `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
@@ -420,9 +420,48 @@ int32_t nuld_brdf_sample(const struct NuldBlob *blob,
                          uint32_t mode,
                          struct NuldVec3 wo,
                          float roughness,
+                         float metallic,
                          uint32_t instance,
                          uint32_t index,
                          struct NuldSample *out);
+
+/**
+ * The **unbiased mode** of `nuld_brdf_sample`: the set's primary point shifted
+ * on the torus by a random vector drawn from `seed` (one random number per
+ * pixel), so that every sample is distributed exactly as its `pdf`. The
+ * runtime's `BrdfSampler::sample_randomized`.
+ *
+ * # Safety
+ * As `nuld_brdf_sample`.
+ */
+int32_t nuld_brdf_sample_randomized(const struct NuldBlob *blob,
+                                    uint32_t mode,
+                                    struct NuldVec3 wo,
+                                    float roughness,
+                                    float metallic,
+                                    uint32_t instance,
+                                    uint32_t index,
+                                    uint32_t seed,
+                                    struct NuldSample *out);
+
+/**
+ * The solid-angle density of a BRDF sampler's prior at the unit local
+ * `direction` for the view `wo`, `roughness` and `metallic`, written to
+ * `*out`: what `NuldSample::pdf` is for a sample there, for any direction
+ * (multiple importance sampling); both modes share it; 0 below the horizon and
+ * for blobs of the earlier mixture prior. The runtime's `BrdfSampler::pdf`.
+ * `NULD_ERR_WRONG_TARGET` for an environment sampler.
+ *
+ * # Safety
+ * `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
+ * for writing a float.
+ */
+int32_t nuld_brdf_pdf(const struct NuldBlob *blob,
+                      struct NuldVec3 wo,
+                      float roughness,
+                      float metallic,
+                      struct NuldVec3 direction,
+                      float *out);
 
 /**
  * Sample `index` of instance `instance` of an environment sampler at the surface
@@ -481,10 +520,12 @@ int32_t nuld_envmap_pdf(const struct NuldBlob *blob,
  * `cond` in the blob's units (`NuldBlobInfo::cond_min` to `cond_max`;
  * for a BRDF sampler roughness and view angle in degrees, the view in the
  * xz-plane on the +x side; for an environment sampler the normal's octahedral
- * square point), in `mode`, written to `*out`: the runtime's
- * `ConditionalSampler::sample`, what `build-tool sample --cond` prints. For
- * tools; renderers use `nuld_brdf_sample` and `nuld_envmap_sample`. The
- * condition clamps into the range (NaN to its lower end). O(1) in table mode.
+ * square point) and, for a BRDF sampler, `metallic` (ignored by environment
+ * samplers), in `mode`, written to `*out`: the runtime's
+ * `ConditionalSampler::sample_metallic`, what `build-tool sample --cond
+ * A,B,METALLIC` prints. For tools; renderers use `nuld_brdf_sample` and
+ * `nuld_envmap_sample`. The condition clamps into the range, metallic into [0,
+ * 1] (NaN to the lower ends). O(1) in table mode.
  *
  * # Safety
  * `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
@@ -493,14 +534,16 @@ int32_t nuld_envmap_pdf(const struct NuldBlob *blob,
 int32_t nuld_conditional_sample(const struct NuldBlob *blob,
                                 uint32_t mode,
                                 struct NuldVec2 cond,
+                                float metallic,
                                 uint32_t instance,
                                 uint32_t index,
                                 struct NuldSample *out);
 
 /**
  * The unbiased mode of `nuld_conditional_sample` (as
- * `nuld_envmap_sample_randomized`): `ConditionalSampler::sample_randomized`,
- * what `build-tool sample --cond C --randomize SEED` prints.
+ * `nuld_envmap_sample_randomized`):
+ * `ConditionalSampler::sample_randomized_metallic`, what `build-tool sample
+ * --cond C --randomize SEED` prints.
  *
  * # Safety
  * As `nuld_conditional_sample`.
@@ -508,6 +551,7 @@ int32_t nuld_conditional_sample(const struct NuldBlob *blob,
 int32_t nuld_conditional_sample_randomized(const struct NuldBlob *blob,
                                            uint32_t mode,
                                            struct NuldVec2 cond,
+                                           float metallic,
                                            uint32_t instance,
                                            uint32_t index,
                                            uint32_t seed,
@@ -515,8 +559,9 @@ int32_t nuld_conditional_sample_randomized(const struct NuldBlob *blob,
 
 /**
  * The prior's pdf at the unit `direction` for the condition `cond` (blob
- * units) of either sampler, written to `*out`: the runtime's
- * `ConditionalSampler::pdf` (0 for a BRDF sampler).
+ * units) of either sampler and, for a BRDF sampler, `metallic`, written to
+ * `*out`: the runtime's `ConditionalSampler::pdf_metallic` (0 for BRDF blobs
+ * of the earlier mixture prior).
  *
  * # Safety
  * `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
@@ -524,6 +569,7 @@ int32_t nuld_conditional_sample_randomized(const struct NuldBlob *blob,
  */
 int32_t nuld_conditional_pdf(const struct NuldBlob *blob,
                              struct NuldVec2 cond,
+                             float metallic,
                              struct NuldVec3 direction,
                              float *out);
 

@@ -59,10 +59,10 @@ pub use blob::{
 };
 pub use error::{nuld_error_message, nuld_last_error, NuldStatus};
 pub use sample::{
-    nuld_brdf_sample, nuld_conditional_pdf, nuld_conditional_sample,
-    nuld_conditional_sample_randomized, nuld_direction, nuld_envmap_pdf, nuld_envmap_sample,
-    nuld_envmap_sample_randomized, nuld_point_2d, NuldSample, NuldVec2, NuldVec3,
-    NULD_MODE_NETWORK, NULD_MODE_TABLE,
+    nuld_brdf_pdf, nuld_brdf_sample, nuld_brdf_sample_randomized, nuld_conditional_pdf,
+    nuld_conditional_sample, nuld_conditional_sample_randomized, nuld_direction, nuld_envmap_pdf,
+    nuld_envmap_sample, nuld_envmap_sample_randomized, nuld_point_2d, NuldSample, NuldVec2,
+    NuldVec3, NULD_MODE_NETWORK, NULD_MODE_TABLE,
 };
 
 /// The freestanding libraries' panic handler. No panic is reachable (crate docs);

@@ -64,16 +64,15 @@ pub struct NuldSample {
     /// A unit direction: local frame (z = the normal) for a BRDF sampler, the
     /// map's world frame for an environment sampler.
     pub direction: [f32; 3],
-    /// The estimator weight of every sample of the condition, finite and at
-    /// least 0:
-    /// the directional albedo A of a BRDF sampler (integral of L f cos ~ A / N
-    /// times the sum of L(direction)), the irradiance E(n) of an environment
-    /// sampler (~ E / N times the sum of f(direction)).
+    /// The estimator weight, finite and at least 0: for a BRDF sampler f cos /
+    /// pdf of the direction (integral of L f cos ~ 1 / N times the sum of L
+    /// weight; the albedo A for blobs of the earlier mixture prior), for an
+    /// environment sampler the irradiance E(n) of every sample of the normal
+    /// (~ E / N times the sum of f(direction)).
     pub weight: f32,
     /// The solid-angle density of the sampler's prior at `direction`, per
-    /// steradian, finite and at least 0: exact for an environment sampler (for L f cos / pdf
-    /// and multiple importance sampling); 0 for a BRDF sampler, whose prior pdf
-    /// is not served yet (use `weight`).
+    /// steradian, finite and at least 0: exact (for L f cos / pdf and multiple
+    /// importance sampling); 0 for BRDF blobs of the earlier mixture prior.
     pub pdf: f32,
 }
 
@@ -152,12 +151,13 @@ pub unsafe extern "C" fn nuld_direction(
 }
 
 /// Sample `index` of instance `instance` of a BRDF sampler for the view `wo`
-/// (local frame, z = the normal, any length) at `roughness`, in `mode`, written
-/// to `*out`. The runtime's `BrdfSampler::sample`: roughness clamps into the
-/// blob's range (NaN to its lower end), a view below the horizon reads as grazing
-/// and a zero or non-finite one as normal incidence, index wraps modulo N and
-/// table mode's instance modulo S. O(1) in table mode. `out->pdf` is 0 (not served
-/// yet). `NULD_ERR_WRONG_TARGET` for an environment sampler.
+/// (local frame, z = the normal, any length) at `roughness` and `metallic`, in
+/// `mode`, written to `*out`, with its pdf and the weight f cos / pdf. The
+/// runtime's `BrdfSampler::sample`: roughness clamps into the blob's range,
+/// metallic into [0, 1] (NaN to the lower ends), a view below the horizon reads
+/// as grazing and a zero or non-finite one as normal incidence, index wraps
+/// modulo N and table mode's instance modulo S. O(1) in table mode.
+/// `NULD_ERR_WRONG_TARGET` for an environment sampler.
 ///
 /// # Safety
 /// `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
@@ -168,16 +168,42 @@ pub unsafe extern "C" fn nuld_brdf_sample(
     mode: u32,
     wo: NuldVec3,
     roughness: f32,
+    metallic: f32,
     instance: u32,
     index: u32,
     out: *mut NuldSample,
 ) -> i32 {
+    let material = (roughness, metallic);
     // SAFETY: by the caller's contract (all three functions below).
-    status(unsafe { brdf_sample(blob, mode, wo, roughness, instance, index, out) })
+    status(unsafe { brdf_sample(blob, mode, wo, material, (instance, index), None, out) })
 }
 
-/// [`nuld_brdf_sample`]'s body. The BRDF entry points stay this thin so that a
-/// new condition of the sampler (a metallic parameter) is one more argument here.
+/// The **unbiased mode** of `nuld_brdf_sample`: the set's primary point shifted
+/// on the torus by a random vector drawn from `seed` (one random number per
+/// pixel), so that every sample is distributed exactly as its `pdf`. The
+/// runtime's `BrdfSampler::sample_randomized`.
+///
+/// # Safety
+/// As `nuld_brdf_sample`.
+#[no_mangle]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn nuld_brdf_sample_randomized(
+    blob: *const NuldBlob,
+    mode: u32,
+    wo: NuldVec3,
+    roughness: f32,
+    metallic: f32,
+    instance: u32,
+    index: u32,
+    seed: u32,
+    out: *mut NuldSample,
+) -> i32 {
+    let material = (roughness, metallic);
+    // SAFETY: by the caller's contract.
+    status(unsafe { brdf_sample(blob, mode, wo, material, (instance, index), Some(seed), out) })
+}
+
+/// The body of both BRDF entry points, randomized with `seed` if any.
 ///
 /// # Safety
 /// As [`nuld_brdf_sample`].
@@ -185,20 +211,52 @@ unsafe fn brdf_sample(
     blob: *const NuldBlob,
     m: u32,
     wo: NuldVec3,
-    roughness: f32,
-    instance: u32,
-    index: u32,
+    (roughness, metallic): (f32, f32),
+    (instance, index): (u32, u32),
+    seed: Option<u32>,
     out: *mut NuldSample,
 ) -> Result<(), NuldStatus> {
     // SAFETY: by the caller's contract.
     let brdf = unsafe { view(blob)?.brdf()? };
     let wo = Vec3::from(wo);
-    let s = match mode(m)? {
-        Mode::Table => brdf.sample(wo, roughness, instance, index),
-        Mode::Network => brdf.network().sample(wo, roughness, instance, index),
+    let (r, mt) = (roughness, metallic);
+    let s = match (mode(m)?, seed) {
+        (Mode::Table, None) => brdf.sample(wo, r, mt, instance, index),
+        (Mode::Table, Some(x)) => brdf.sample_randomized(wo, r, mt, instance, index, x),
+        (Mode::Network, None) => brdf.network().sample(wo, r, mt, instance, index),
+        (Mode::Network, Some(x)) => brdf
+            .network()
+            .sample_randomized(wo, r, mt, instance, index, x),
     };
     // SAFETY: by the caller's contract.
     unsafe { write(out, s.into()) }
+}
+
+/// The solid-angle density of a BRDF sampler's prior at the unit local
+/// `direction` for the view `wo`, `roughness` and `metallic`, written to
+/// `*out`: what `NuldSample::pdf` is for a sample there, for any direction
+/// (multiple importance sampling); both modes share it; 0 below the horizon and
+/// for blobs of the earlier mixture prior. The runtime's `BrdfSampler::pdf`.
+/// `NULD_ERR_WRONG_TARGET` for an environment sampler.
+///
+/// # Safety
+/// `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
+/// for writing a float.
+#[no_mangle]
+pub unsafe extern "C" fn nuld_brdf_pdf(
+    blob: *const NuldBlob,
+    wo: NuldVec3,
+    roughness: f32,
+    metallic: f32,
+    direction: NuldVec3,
+    out: *mut f32,
+) -> i32 {
+    // SAFETY: by the caller's contract.
+    status(unsafe { view(blob) }.and_then(View::brdf).and_then(|brdf| {
+        let pdf = brdf.pdf(wo.into(), roughness, metallic, direction.into());
+        // SAFETY: by the caller's contract.
+        unsafe { write(out, pdf) }
+    }))
 }
 
 /// Sample `index` of instance `instance` of an environment sampler at the surface
@@ -303,10 +361,12 @@ pub unsafe extern "C" fn nuld_envmap_pdf(
 /// `cond` in the blob's units (`NuldBlobInfo::cond_min` to `cond_max`;
 /// for a BRDF sampler roughness and view angle in degrees, the view in the
 /// xz-plane on the +x side; for an environment sampler the normal's octahedral
-/// square point), in `mode`, written to `*out`: the runtime's
-/// `ConditionalSampler::sample`, what `build-tool sample --cond` prints. For
-/// tools; renderers use `nuld_brdf_sample` and `nuld_envmap_sample`. The
-/// condition clamps into the range (NaN to its lower end). O(1) in table mode.
+/// square point) and, for a BRDF sampler, `metallic` (ignored by environment
+/// samplers), in `mode`, written to `*out`: the runtime's
+/// `ConditionalSampler::sample_metallic`, what `build-tool sample --cond
+/// A,B,METALLIC` prints. For tools; renderers use `nuld_brdf_sample` and
+/// `nuld_envmap_sample`. The condition clamps into the range, metallic into [0,
+/// 1] (NaN to the lower ends). O(1) in table mode.
 ///
 /// # Safety
 /// `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
@@ -316,32 +376,38 @@ pub unsafe extern "C" fn nuld_conditional_sample(
     blob: *const NuldBlob,
     mode: u32,
     cond: NuldVec2,
+    metallic: f32,
     instance: u32,
     index: u32,
     out: *mut NuldSample,
 ) -> i32 {
+    let at = (cond, metallic);
     // SAFETY: by the caller's contract.
-    status(unsafe { conditional_sample(blob, mode, cond, instance, index, None, out) })
+    status(unsafe { conditional_sample(blob, mode, at, instance, index, None, out) })
 }
 
 /// The unbiased mode of `nuld_conditional_sample` (as
-/// `nuld_envmap_sample_randomized`): `ConditionalSampler::sample_randomized`,
-/// what `build-tool sample --cond C --randomize SEED` prints.
+/// `nuld_envmap_sample_randomized`):
+/// `ConditionalSampler::sample_randomized_metallic`, what `build-tool sample
+/// --cond C --randomize SEED` prints.
 ///
 /// # Safety
 /// As `nuld_conditional_sample`.
 #[no_mangle]
+#[allow(clippy::too_many_arguments)]
 pub unsafe extern "C" fn nuld_conditional_sample_randomized(
     blob: *const NuldBlob,
     mode: u32,
     cond: NuldVec2,
+    metallic: f32,
     instance: u32,
     index: u32,
     seed: u32,
     out: *mut NuldSample,
 ) -> i32 {
+    let at = (cond, metallic);
     // SAFETY: by the caller's contract.
-    status(unsafe { conditional_sample(blob, mode, cond, instance, index, Some(seed), out) })
+    status(unsafe { conditional_sample(blob, mode, at, instance, index, Some(seed), out) })
 }
 
 /// The body of both conditional entry points, randomized with `seed` if any.
@@ -351,7 +417,7 @@ pub unsafe extern "C" fn nuld_conditional_sample_randomized(
 unsafe fn conditional_sample(
     blob: *const NuldBlob,
     m: u32,
-    cond: NuldVec2,
+    (cond, metallic): (NuldVec2, f32),
     instance: u32,
     index: u32,
     seed: Option<u32>,
@@ -359,20 +425,23 @@ unsafe fn conditional_sample(
 ) -> Result<(), NuldStatus> {
     // SAFETY: by the caller's contract.
     let cs = unsafe { view(blob)?.conditional()? };
-    let c = Vec2::from(cond);
+    let (c, mt) = (Vec2::from(cond), metallic);
     let s = match (mode(m)?, seed) {
-        (Mode::Table, None) => cs.sample(c, instance, index),
-        (Mode::Table, Some(r)) => cs.sample_randomized(c, instance, index, r),
-        (Mode::Network, None) => cs.network().sample(c, instance, index),
-        (Mode::Network, Some(r)) => cs.network().sample_randomized(c, instance, index, r),
+        (Mode::Table, None) => cs.sample_metallic(c, mt, instance, index),
+        (Mode::Table, Some(r)) => cs.sample_randomized_metallic(c, mt, instance, index, r),
+        (Mode::Network, None) => cs.network().sample_metallic(c, mt, instance, index),
+        (Mode::Network, Some(r)) => cs
+            .network()
+            .sample_randomized_metallic(c, mt, instance, index, r),
     };
     // SAFETY: by the caller's contract.
     unsafe { write(out, s.into()) }
 }
 
 /// The prior's pdf at the unit `direction` for the condition `cond` (blob
-/// units) of either sampler, written to `*out`: the runtime's
-/// `ConditionalSampler::pdf` (0 for a BRDF sampler).
+/// units) of either sampler and, for a BRDF sampler, `metallic`, written to
+/// `*out`: the runtime's `ConditionalSampler::pdf_metallic` (0 for BRDF blobs
+/// of the earlier mixture prior).
 ///
 /// # Safety
 /// `blob` must point to a `NuldBlob` whose bytes are alive; `out` must be valid
@@ -381,6 +450,7 @@ unsafe fn conditional_sample(
 pub unsafe extern "C" fn nuld_conditional_pdf(
     blob: *const NuldBlob,
     cond: NuldVec2,
+    metallic: f32,
     direction: NuldVec3,
     out: *mut f32,
 ) -> i32 {
@@ -389,7 +459,7 @@ pub unsafe extern "C" fn nuld_conditional_pdf(
         unsafe { view(blob) }
             .and_then(View::conditional)
             .and_then(|cs| {
-                let pdf = cs.pdf(cond.into(), direction.into());
+                let pdf = cs.pdf_metallic(cond.into(), metallic, direction.into());
                 // SAFETY: by the caller's contract.
                 unsafe { write(out, pdf) }
             }),

@@ -8,6 +8,8 @@
 
 use glam::{Vec2, Vec3};
 use nuld_core::blob::{BlobError, Domain};
+use nuld_core::brdf::{gltf_metallic, view_direction_real};
+use nuld_core::brdf_prior::BrdfPrior;
 use nuld_core::conditional::{
     randomization_shift, torus_shift, unpack_point, ConditionalInfo, ConditionalTarget, GridCell,
     PointWarp,
@@ -35,8 +37,10 @@ pub use network::NetworkSampler;
 /// any `g`, and it is what multiple importance sampling weighs with
 /// ([`ConditionalSampler::pdf`] answers it for any direction). Environment samplers
 /// ([`nuld_core::conditional::PointWarp::EnvmapTree`]) return the exact pdf of their
-/// prior, the map's light times the cosine; a BRDF sampler's prior pdf is not
-/// served yet, and it returns 0 there: use its `weight`.
+/// prior, the map's light times the cosine; BRDF samplers on the tabulated prior
+/// ([`nuld_core::conditional::PointWarp::BrdfTable`]) the exact pdf of their prior,
+/// the BRDF times the cosine, and the weight `f cos / pdf` of the direction; BRDF
+/// blobs of the earlier mixture prior return 0: use their `weight`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sample {
     /// A unit vector (`z >= 0` on the hemisphere), in the local frame (`z` = normal).
@@ -73,6 +77,8 @@ pub struct ConditionalSampler<'a> {
     weights: &'a [f32],
     /// The environment prior ([`PointWarp::EnvmapTree`] samplers).
     tree: Option<EnvmapTree<'a>>,
+    /// The BRDF prior ([`PointWarp::BrdfTable`] samplers).
+    brdf_prior: Option<BrdfPrior<'a, f32>>,
 }
 
 /// Where network mode reads its parameters: the blob's f16 bits (zero-copy), or
@@ -178,6 +184,23 @@ impl<'a> ConditionalSampler<'a> {
     #[inline]
     pub fn lobe_probability(&self, cond: Vec2) -> f32 {
         self.weight_table_lerp(&self.weight_cell(cond), 1)
+    }
+
+    /// The directional albedo at `cond` of a BRDF of metallic `metallic`
+    /// (clamped into `[0, 1]`, NaN as 0): for a [`PointWarp::BrdfTable`] sampler
+    /// `(1 - m) A_0 + m A_1`, the weight section's two tables (the dielectric's
+    /// and the metal's albedo) interpolated as the weights, exact in `m` since
+    /// the BRDF is linear in it; for every other sampler [`Self::weight`].
+    /// Finite and `>= 0`. O(1), never panics.
+    #[inline]
+    pub fn albedo(&self, cond: Vec2, metallic: f32) -> f32 {
+        let cell = self.weight_cell(cond);
+        let dielectric = self.weight_table_lerp(&cell, 0);
+        if self.warp != PointWarp::BrdfTable {
+            return dielectric;
+        }
+        let m = nuld_core::brdf::clamp_metallic(metallic);
+        (1.0 - m) * dielectric + m * self.weight_table_lerp(&cell, 1)
     }
 
     /// Table mode's point of the unit square for index `i` (mod `n`) of instance
@@ -316,8 +339,16 @@ impl<'a> ConditionalSampler<'a> {
     /// ```
     #[inline]
     pub fn sample(&self, cond: Vec2, instance: u32, i: u32) -> Sample {
+        self.sample_metallic(cond, 0.0, instance, i)
+    }
+
+    /// [`Self::sample`] for a BRDF of metallic `metallic` (clamped into `[0,1]`,
+    /// NaN as 0): read by [`PointWarp::BrdfTable`] samplers' prior, ignored by
+    /// every other warp. O(1), never panics.
+    #[inline]
+    pub fn sample_metallic(&self, cond: Vec2, metallic: f32, instance: u32, i: u32) -> Sample {
         let u = self.info.normalize(cond.to_array());
-        self.mapped(self.square_point_at(u, instance, i), u)
+        self.mapped(self.square_point_at(u, instance, i), u, metallic)
     }
 
     /// The **unbiased mode** of table mode: [`Self::sample`]'s point shifted on the
@@ -328,32 +359,55 @@ impl<'a> ConditionalSampler<'a> {
     /// shift; an optimized set's partly). O(1), never panics.
     #[inline]
     pub fn sample_randomized(&self, cond: Vec2, instance: u32, i: u32, seed: u32) -> Sample {
+        self.sample_randomized_metallic(cond, 0.0, instance, i, seed)
+    }
+
+    /// [`Self::sample_randomized`] for a BRDF of metallic `metallic`
+    /// ([`Self::sample_metallic`]).
+    #[inline]
+    pub fn sample_randomized_metallic(
+        &self,
+        cond: Vec2,
+        metallic: f32,
+        instance: u32,
+        i: u32,
+        seed: u32,
+    ) -> Sample {
         let u = self.info.normalize(cond.to_array());
-        self.randomized(self.square_point_at(u, instance, i), u, seed)
+        self.randomized(self.square_point_at(u, instance, i), u, metallic, seed)
     }
 
     /// The unbiased mode's sample of point `p` at the normalized condition `u`:
     /// `p` shifted on the torus by [`randomization_shift`]`(seed)`, then
     /// [`Self::mapped`] (both modes').
     #[inline]
-    pub(crate) fn randomized(&self, p: Vec2, u: [f32; 2], seed: u32) -> Sample {
+    pub(crate) fn randomized(&self, p: Vec2, u: [f32; 2], metallic: f32, seed: u32) -> Sample {
         let p = torus_shift(p.to_array(), randomization_shift(seed));
-        self.mapped(Vec2::from_array(p), u)
+        self.mapped(Vec2::from_array(p), u, metallic)
     }
 
     /// The solid-angle density at the unit `direction` of the sampler's prior at
     /// `cond` (blob units): what [`Sample::pdf`] returns for a sample there, for
     /// any direction (multiple importance sampling). For environment samplers the
     /// tree's exact pdf ([`EnvmapTree::pdf_square`]) at the normal whose
-    /// octahedral square point is the clamped condition; 0 for samplers without an
-    /// exact prior. O(tree levels), never
-    /// panics.
+    /// octahedral square point is the clamped condition; for BRDF samplers on the
+    /// tabulated prior the prior's exact pdf at metallic 0 ([`Self::pdf_metallic`]
+    /// for others); 0 for samplers without an exact prior. O(tree levels),
+    /// never panics.
     #[inline]
     pub fn pdf(&self, cond: Vec2, direction: Vec3) -> f32 {
+        self.pdf_metallic(cond, 0.0, direction)
+    }
+
+    /// [`Self::pdf`] for a BRDF of metallic `metallic` ([`Self::sample_metallic`]).
+    #[inline]
+    pub fn pdf_metallic(&self, cond: Vec2, metallic: f32, direction: Vec3) -> f32 {
         let u = self.info.normalize(cond.to_array());
-        match (self.warp, &self.tree) {
-            (PointWarp::EnvmapTree, Some(tree)) => {
-                tree.pdf_square(self.info.denormalize(u), direction.to_array())
+        let c = self.info.denormalize(u);
+        match (self.warp, &self.tree, &self.brdf_prior) {
+            (PointWarp::EnvmapTree, Some(tree), _) => tree.pdf_square(c, direction.to_array()),
+            (PointWarp::BrdfTable, _, Some(prior)) => {
+                prior.pdf([c[0], c[1], metallic], direction.to_array())
             }
             _ => 0.0,
         }
@@ -364,7 +418,24 @@ impl<'a> ConditionalSampler<'a> {
     /// [`Self::weight`]; one weight-grid cell serves the weight and the lobe
     /// probability.
     #[inline]
-    pub(crate) fn mapped(&self, p: Vec2, u: [f32; 2]) -> Sample {
+    pub(crate) fn mapped(&self, p: Vec2, u: [f32; 2], metallic: f32) -> Sample {
+        if let (PointWarp::BrdfTable, Some(prior)) = (self.warp, &self.brdf_prior) {
+            // The clamped condition in blob units, as the prior's nodes see it.
+            let [roughness, theta] = self.info.denormalize(u);
+            let cond = [roughness, theta, metallic];
+            let (direction, pdf) = prior.sample(cond, p.to_array());
+            let f = gltf_metallic(view_direction_real(theta), direction, roughness, metallic);
+            let weight = if pdf > 0.0 {
+                f * direction[2] / pdf
+            } else {
+                0.0
+            };
+            return Sample {
+                direction: Vec3::from_array(direction),
+                weight: if weight.is_finite() { weight } else { 0.0 },
+                pdf,
+            };
+        }
         let cell = self.weight_cell_at(u);
         if let (PointWarp::EnvmapTree, Some(tree)) = (self.warp, &self.tree) {
             // The clamped condition is the normal's octahedral square point.

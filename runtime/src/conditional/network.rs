@@ -64,9 +64,16 @@ impl<'a> NetworkSampler<'a> {
     /// ```
     #[inline]
     pub fn sample(&self, cond: Vec2, instance: u32, i: u32) -> Sample {
+        self.sample_metallic(cond, 0.0, instance, i)
+    }
+
+    /// [`Self::sample`] for a BRDF of metallic `metallic`
+    /// ([`ConditionalSampler::sample_metallic`]).
+    #[inline]
+    pub fn sample_metallic(&self, cond: Vec2, metallic: f32, instance: u32, i: u32) -> Sample {
         let u = self.0.info().normalize(cond.to_array());
         self.0
-            .mapped(self.0.network_square_point_at(u, instance, i), u)
+            .mapped(self.0.network_square_point_at(u, instance, i), u, metallic)
     }
 
     /// The unbiased mode in network mode: as
@@ -74,9 +81,22 @@ impl<'a> NetworkSampler<'a> {
     /// torus by `randomization_shift(seed)` before the warp.
     #[inline]
     pub fn sample_randomized(&self, cond: Vec2, instance: u32, i: u32, seed: u32) -> Sample {
+        self.sample_randomized_metallic(cond, 0.0, instance, i, seed)
+    }
+
+    /// [`Self::sample_randomized`] for a BRDF of metallic `metallic`.
+    #[inline]
+    pub fn sample_randomized_metallic(
+        &self,
+        cond: Vec2,
+        metallic: f32,
+        instance: u32,
+        i: u32,
+        seed: u32,
+    ) -> Sample {
         let u = self.0.info().normalize(cond.to_array());
-        self.0
-            .randomized(self.0.network_square_point_at(u, instance, i), u, seed)
+        let p = self.0.network_square_point_at(u, instance, i);
+        self.0.randomized(p, u, metallic, seed)
     }
 
     /// The prior's pdf at `direction` ([`ConditionalSampler::pdf`]; the same
@@ -84,5 +104,11 @@ impl<'a> NetworkSampler<'a> {
     #[inline]
     pub fn pdf(&self, cond: Vec2, direction: glam::Vec3) -> f32 {
         self.0.pdf(cond, direction)
+    }
+
+    /// [`Self::pdf`] for a BRDF of metallic `metallic`.
+    #[inline]
+    pub fn pdf_metallic(&self, cond: Vec2, metallic: f32, direction: glam::Vec3) -> f32 {
+        self.0.pdf_metallic(cond, metallic, direction)
     }
 }

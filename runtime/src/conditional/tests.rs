@@ -131,8 +131,8 @@ fn a_decoded_network_samples_the_same_bits() {
             cs.network().sample(c, instance, i)
         );
         assert_eq!(
-            BrdfNetwork(fast).sample(wo, c.x, instance, i),
-            BrdfSampler(cs).network().sample(wo, c.x, instance, i)
+            BrdfNetwork(fast).sample(wo, c.x, 0.0, instance, i),
+            BrdfSampler(cs).network().sample(wo, c.x, 0.0, instance, i)
         );
         assert_eq!(
             EnvmapNetwork(fast).sample(n, instance, i),
@@ -510,8 +510,8 @@ fn directions_are_unit_vectors_on_the_hemisphere() {
         for s in [
             cs.sample(c, k, k / 3),
             cs.network().sample(c, k, k / 3),
-            BrdfSampler(cs).sample(wo, c.x, k, k / 3),
-            BrdfSampler(cs).network().sample(wo, c.x, k, k / 3),
+            BrdfSampler(cs).sample(wo, c.x, 0.0, k, k / 3),
+            BrdfSampler(cs).network().sample(wo, c.x, 0.0, k, k / 3),
         ] {
             let d = s.direction;
             assert!(
@@ -543,9 +543,12 @@ fn sample_brdf_rotates_the_xz_plane_set_to_the_view_azimuth() {
         let (r, i) = (0.2 + (k % 7) as f32 / 10.0, k / 5);
         let cond = Vec2::new(r, theta_ref as f32);
         for (got, plain) in [
-            (BrdfSampler(cs).sample(wo, r, k, i), cs.sample(cond, k, i)),
             (
-                BrdfSampler(cs).network().sample(wo, r, k, i),
+                BrdfSampler(cs).sample(wo, r, 0.0, k, i),
+                cs.sample(cond, k, i),
+            ),
+            (
+                BrdfSampler(cs).network().sample(wo, r, 0.0, k, i),
                 cs.network().sample(cond, k, i),
             ),
         ] {
@@ -562,12 +565,12 @@ fn sample_brdf_rotates_the_xz_plane_set_to_the_view_azimuth() {
     // Degenerate views are normal incidence, azimuth 0.
     for wo in [Vec3::ZERO, Vec3::NAN, Vec3::INFINITY, Vec3::Z * 2.0] {
         assert_eq!(
-            BrdfSampler(cs).sample(wo, 0.5, 1, 1),
+            BrdfSampler(cs).sample(wo, 0.5, 0.0, 1, 1),
             cs.sample(Vec2::new(0.5, 0.0), 1, 1)
         );
     }
     // Below the horizon reads as grazing (clamped to the range's 80°).
-    let below = BrdfSampler(cs).sample(Vec3::new(1.0, 0.0, -0.5), 0.5, 1, 1);
+    let below = BrdfSampler(cs).sample(Vec3::new(1.0, 0.0, -0.5), 0.5, 0.0, 1, 1);
     assert_eq!(below, cs.sample(Vec2::new(0.5, 90.0), 1, 1));
 }
 

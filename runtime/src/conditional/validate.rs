@@ -4,10 +4,12 @@
 use super::{ConditionalSampler, NetworkParams};
 use crate::section::{record, typed_section};
 use nuld_core::blob::{BlobError, ConditionalError, Domain, Layout, SectionTag};
+use nuld_core::brdf_prior::{BrdfPrior, BrdfPriorInfo};
 use nuld_core::conditional::{ConditionalInfo, ConditionalTarget, PointWarp};
 use nuld_core::envmap_tree::{
     node_count, top_len, EnvmapTree, NodeRecord, TreeInfo, MAX_TREE_LEVELS, TOP_LEVELS,
 };
+use nuld_core::marginal2d::Marginal2DError;
 use nuld_core::network::Activation;
 use nuld_core::quadtree::QuadtreeError;
 use nuld_core::quantize::f16_is_finite;
@@ -24,6 +26,9 @@ impl<'a> ConditionalSampler<'a> {
     pub(crate) fn validate(layout: &Layout<'a>) -> Result<Self, BlobError> {
         let sampler = Self::view(layout)?;
         sampler.check_values()?;
+        if sampler.brdf_prior.is_some() {
+            brdf_prior(layout, true)?;
+        }
         Ok(sampler)
     }
 
@@ -52,6 +57,11 @@ impl<'a> ConditionalSampler<'a> {
         }
         let warp = match info.point_warp() {
             Some(PointWarp::BrdfMixture)
+                if !(target == ConditionalTarget::GltfBrdf && domain == Domain::Hemisphere) =>
+            {
+                return fail(ConditionalError::UnknownPointWarp(info.warp))
+            }
+            Some(PointWarp::BrdfTable)
                 if !(target == ConditionalTarget::GltfBrdf && domain == Domain::Hemisphere) =>
             {
                 return fail(ConditionalError::UnknownPointWarp(info.warp))
@@ -139,6 +149,10 @@ impl<'a> ConditionalSampler<'a> {
             PointWarp::EnvmapTree => Some(tree_view(layout)?),
             _ => None,
         };
+        let brdf_prior = match warp {
+            PointWarp::BrdfTable => Some(brdf_prior(layout, false)?),
+            _ => None,
+        };
         Ok(Self {
             info,
             shape,
@@ -149,6 +163,7 @@ impl<'a> ConditionalSampler<'a> {
             table,
             weights,
             tree,
+            brdf_prior,
         })
     }
 
@@ -219,6 +234,48 @@ fn tree_view<'a>(layout: &Layout<'a>) -> Result<EnvmapTree<'a>, BlobError> {
     )?;
     EnvmapTree::view(info.levels, nodes, info.grid, top)
         .map_err(|e| ConditionalError::Tree(e).into())
+}
+
+/// The BRDF prior's five sections: with `check`, every value read once
+/// ([`BrdfPrior::new`], `O(nodes size^2)`); without, counts only (`O(1)`).
+fn brdf_prior<'a>(layout: &Layout<'a>, check: bool) -> Result<BrdfPrior<'a, f32>, BlobError> {
+    let info: BrdfPriorInfo = record(layout, SectionTag::BrdfPriorInfo, |got, expected| {
+        ConditionalError::BrdfPriorInfoSize { got, expected }
+    })?;
+    let shape = info
+        .shape()
+        .ok_or(ConditionalError::BrdfPrior(Marginal2DError::Shape))?;
+    let prior_length = |slice: u8| {
+        move |expected, got| {
+            ConditionalError::BrdfPrior(Marginal2DError::Length {
+                slice,
+                expected,
+                got,
+            })
+        }
+    };
+    let table = |tag: SectionTag, slice: u8, len: Option<usize>| {
+        typed_section::<f32, ConditionalError>(
+            layout,
+            tag,
+            |size| ConditionalError::BrdfPriorElementSize {
+                tag: tag as u32,
+                size,
+            },
+            || Ok(len.map_or(u64::MAX, |n| n as u64)),
+            prior_length(slice),
+        )
+    };
+    let data = table(SectionTag::BrdfPriorData, 0, shape.data_len())?;
+    let marginal = table(SectionTag::BrdfPriorMarginal, 1, shape.marginal_len())?;
+    let conditional = table(SectionTag::BrdfPriorConditional, 2, shape.data_len())?;
+    let masses = table(SectionTag::BrdfPriorMasses, 3, Some(shape.nodes as usize))?;
+    let prior = if check {
+        BrdfPrior::new(info, data, marginal, conditional, masses)
+    } else {
+        BrdfPrior::view(info, data, marginal, conditional, masses)
+    };
+    prior.map_err(|e| ConditionalError::BrdfPrior(e).into())
 }
 
 /// `Err(e)` as a [`BlobError`].

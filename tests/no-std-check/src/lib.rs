@@ -103,7 +103,13 @@ pub unsafe extern "C" fn nuld_check_conditional(
                 0 => cs.sample(Vec2::new(c0, c1), instance, i),
                 1 => cs.network().sample(Vec2::new(c0, c1), instance, i),
                 2 => match nuld_runtime::BrdfSampler::try_from(cs) {
-                    Ok(brdf) => brdf.sample(Vec3::new(c1, 0.0, 1.0), c0, instance, i),
+                    Ok(brdf) => {
+                        // The unbiased mode on the tabulated prior, and its pdf.
+                        let wo = Vec3::new(c1, 0.0, 1.0);
+                        let s = brdf.sample_randomized(wo, c0, c1, instance, i, instance ^ i);
+                        let pdf = brdf.pdf(wo, c0, c1, s.direction);
+                        nuld_runtime::Sample { pdf, ..s }
+                    }
                     Err(_) => return 1,
                 },
                 4 => match cs.decode_network(&mut decoded) {

@@ -95,7 +95,13 @@ pub fn measure(map: &EnvmapDensity, samples: u32) -> Result<Vec<(String, f64)>> 
         PointWarp::EnvmapTree,
         crate::conditional::bake::ENVMAP_INSTANCE_SLOTS,
     )?;
-    let parts = random_parts(shape, 64, crate::conditional::bake::ENVMAP_GRID, 3)?;
+    let parts = random_parts(
+        shape,
+        PointWarp::EnvmapTree,
+        64,
+        crate::conditional::bake::ENVMAP_GRID,
+        3,
+    )?;
     let blob = envmap_parts(parts, Arc::new(tree.clone())).to_blob(&Metadata {
         generator: "bench",
         target: "envmap",

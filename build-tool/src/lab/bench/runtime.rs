@@ -7,7 +7,7 @@
 //! Speed does not depend on the network's or the table's values, so the samplers
 //! are timed on blobs with random contents ([`random_parts`]).
 
-use crate::conditional::blob::ConditionalParts;
+use crate::conditional::blob::{ConditionalParts, Prior};
 use crate::conditional::distill::info;
 use crate::pointset::AlignedBytes;
 use crate::sphere::{BrdfTarget, DirectionDensity, EnvmapTree};
@@ -56,17 +56,23 @@ pub fn random_shape(
 /// of [`LoadedTarget::GltfBrdf`]) with random contents: `n` points, `instances`
 /// stored instances, a `grid` point table of random codes, a 7 x 9 weight table
 /// of weights in `[0.5, 1.6)`, and a network of `shape` ([`random_shape`]) with f16
-/// parameters uniform in `[-0.6, 0.6]`, with the shape's point warp (for
-/// the BRDF mixture a second weight-grid table of lobe probabilities
-/// uniform in `[0.02, 0.98)`). Deterministic for a seed.
+/// parameters uniform in `[-0.6, 0.6]`, with the point warp `warp` for a
+/// lattice-residual shape (for the BRDF mixture a second weight-grid table of
+/// lobe probabilities uniform in `[0.02, 0.98)`; for the tabulated BRDF prior its
+/// tables, [`crate::sphere::brdf_prior::BrdfPrior::shared`]), else the equal-area
+/// map. Deterministic for a seed.
 pub fn random_parts(
     shape: Shape,
+    warp: PointWarp,
     instances: u32,
     grid: [u32; 2],
     seed: u64,
 ) -> Result<ConditionalParts> {
     let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
-    let info = info(&shape, &LoadedTarget::GltfBrdf, instances, grid, [7, 9]);
+    let mut info = info(&shape, &LoadedTarget::gltf_brdf(), instances, grid, [7, 9]);
+    if shape.lattice_residual() {
+        info.warp = warp as u32;
+    }
     let params = (0..shape.param_len())
         .map(|_| nuld_core::quantize::f16_encode(rng.random_range(-0.6f32..=0.6)))
         .collect();
@@ -84,12 +90,14 @@ pub fn random_parts(
             }
         })
         .collect();
+    let prior = (info.point_warp() == Some(PointWarp::BrdfTable))
+        .then(|| Prior::Brdf(crate::sphere::brdf_prior::BrdfPrior::shared()));
     Ok(ConditionalParts {
         info,
         params,
         table,
         weights,
-        prior: None,
+        prior,
     })
 }
 /// `parts` (of a lattice-residual network) as an environment sampler on the
@@ -107,7 +115,7 @@ pub fn envmap_parts(mut parts: ConditionalParts, tree: Arc<EnvmapTree>) -> Condi
     parts
         .weights
         .truncate(parts.info.weight_table_len() as usize);
-    parts.prior = Some(tree);
+    parts.prior = Some(Prior::Envmap(tree));
     parts
 }
 
@@ -182,7 +190,7 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
         .collect();
     let targets = conds
         .iter()
-        .map(|c| BrdfTarget::coarse(c.x as f64, c.y as f64, INCUMBENT_RULE_POINTS))
+        .map(|c| BrdfTarget::coarse(c.x as f64, c.y as f64, 0.0, INCUMBENT_RULE_POINTS))
         .collect::<Result<Vec<_>, _>>()?;
     let meta = Metadata {
         generator: "bench",
@@ -193,7 +201,7 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
     let slots = crate::train::TrainConfig::default().instance_slots;
     let blob = |hidden: &[u32], act| -> Result<AlignedBytes> {
         let shape = random_shape(n, hidden, act, PointWarp::BrdfMixture, slots)?;
-        random_parts(shape, 16, [10, 9], 2)?.to_blob(&meta)
+        random_parts(shape, PointWarp::BrdfMixture, 16, [10, 9], 2)?.to_blob(&meta)
     };
     let (relu, silu) = (
         blob(&[32, 32], Activation::Relu)?,
@@ -233,7 +241,7 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
     rows.push((
         "table: BrdfSampler::sample".into(),
         ns_per_sample(samples, |s| {
-            black_box(relu.sample(views[at(s)], conds[at(s)].x, s / n, s % n));
+            black_box(relu.sample(views[at(s)], conds[at(s)].x, 0.0, s / n, s % n));
         }),
     ));
     for (name, cs) in [

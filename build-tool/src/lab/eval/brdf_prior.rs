@@ -93,15 +93,24 @@ pub fn held_out(s: &BrdfPriorSettings) -> Vec<[f64; 3]> {
         .collect()
 }
 
-/// The figures of the mixture and of every `(space, grid, size)` of `s`, with
-/// `progress` told after each held-out condition's judge and each configuration.
-pub fn evaluate(s: &BrdfPriorSettings, progress: &dyn Fn(&str)) -> Result<Vec<BrdfPriorRow>> {
-    let judging = JudgeSettings {
+/// The judge settings of `s`.
+pub fn judging(s: &BrdfPriorSettings) -> JudgeSettings {
+    JudgeSettings {
         n: s.n,
         instances: s.instances,
         caps: s.caps,
         seed: s.seed,
-    };
+    }
+}
+
+/// The figures of the mixture and of every `(space, grid, size)` of `s`, with
+/// `progress` told after each held-out condition's judge and each configuration;
+/// and the judges (for a baked sampler's figures, [`super::brdf_sampler`]).
+pub fn evaluate(
+    s: &BrdfPriorSettings,
+    progress: &dyn Fn(&str),
+) -> Result<(Vec<BrdfPriorRow>, Vec<Judge<BrdfTarget>>)> {
+    let judging = judging(s);
     let mut judges: Vec<Judge<BrdfTarget>> = Vec::new();
     for (index, c) in held_out(s).into_iter().enumerate() {
         let target = BrdfTarget::metallic(c[0], c[1], c[2], Domain::Hemisphere)?;
@@ -153,7 +162,7 @@ pub fn evaluate(s: &BrdfPriorSettings, progress: &dyn Fn(&str)) -> Result<Vec<Br
             }
         }
     }
-    Ok(rows)
+    Ok((rows, judges))
 }
 
 /// The rows as a Markdown table.
@@ -207,13 +216,14 @@ mod tests {
             conds.iter().map(|c| c[2]).take(3).collect::<Vec<_>>(),
             [0.0, 0.5, 1.0]
         );
-        let rows = evaluate(&s, &|_| {}).unwrap();
+        let (rows, judges) = evaluate(&s, &|_| {}).unwrap();
+        assert_eq!(judges.len(), 4);
         assert_eq!(rows.len(), 5);
         assert_eq!(rows[0].kind, "mixture");
         for r in &rows[1..] {
             assert_eq!(
                 r.state_bytes,
-                4 * 12 * (2 * (r.size * r.size) as usize + r.size as usize)
+                4 * 12 * (2 * (r.size * r.size) as usize + r.size as usize + 1)
             );
         }
         for r in &rows {

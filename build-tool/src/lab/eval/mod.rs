@@ -23,6 +23,7 @@
 //! on held-out conditions (`build-tool eval conditional`).
 
 pub mod brdf_prior;
+pub mod brdf_sampler;
 pub mod cache;
 pub mod conditional;
 pub mod envmap_prior;

@@ -79,6 +79,11 @@ impl<C: Sync> Judge<C> {
     pub fn d(&self, pts: &[DVec3]) -> f64 {
         self.caps.l2_squared(pts, CapRadius::ThetaUniform).0.sqrt()
     }
+
+    /// The baseline's mean cap L2 (what ratios divide by).
+    pub fn baseline(&self) -> f64 {
+        self.baseline
+    }
 }
 
 /// `(mean, worst)` over the judges of Owen-Sobol and of shifted-lattice sets

@@ -9,8 +9,11 @@
 //! same bits as the zero-copy f16 path, faster), as a CPU renderer would.
 //!
 //! * BRDF sampling: [`BrdfSampler::sample`] (table mode) or
-//!   [`BrdfNetwork::sample`] (network mode) at the local view
-//!   direction and the roughness; the weight is the sample's own (the albedo `A`);
+//!   [`BrdfNetwork::sample`] (network mode) at the local view direction, the
+//!   roughness and the metallic, or their unbiased mode
+//!   ([`BrdfSampler::sample_randomized`]): the unbiased mode weighs by the
+//!   sample's own `f cos / pdf`, a fixed instance by the albedo
+//!   ([`BrdfSampler::albedo`]; its set follows the target `f cos / A`, as below);
 //! * environment sampling: [`EnvmapSampler::sample`] or
 //!   [`EnvmapNetwork::sample`] at the world normal, or their unbiased mode
 //!   ([`EnvmapSampler::sample_randomized`], `nuld-unbiased`, the pixel key's low
@@ -214,12 +217,22 @@ impl DirectionSampler for NuldSampler<'_> {
         out.clear();
         let k = key.instance();
         let normal = at.frame.to_world(DVec3::Z).as_vec3();
-        let (wo, r) = (at.wo.as_vec3(), at.roughness as f32);
+        let (wo, r, m) = (at.wo.as_vec3(), at.roughness as f32, 0.0);
         match self.kind {
-            Kind::Brdf(t) => out.extend((0..n).map(|i| brdf_sample(at, t.sample(wo, r, k, i)))),
-            Kind::BrdfNetwork(t) => {
-                out.extend((0..n).map(|i| brdf_sample(at, t.sample(wo, r, k, i))))
-            }
+            Kind::Brdf(t) => out.extend((0..n).map(|i| {
+                let s = match self.randomized {
+                    false => t.sample(wo, r, m, k, i),
+                    true => t.sample_randomized(wo, r, m, k, i, key.scramble()),
+                };
+                self.brdf_sample(at, s, (wo, r, m))
+            })),
+            Kind::BrdfNetwork(t) => out.extend((0..n).map(|i| {
+                let s = match self.randomized {
+                    false => t.sample(wo, r, m, k, i),
+                    true => t.sample_randomized(wo, r, m, k, i, key.scramble()),
+                };
+                self.brdf_sample(at, s, (wo, r, m))
+            })),
             Kind::Envmap(t, env) => out.extend((0..n).map(|i| {
                 let s = match self.randomized {
                     false => t.sample(normal, k, i),
@@ -256,6 +269,32 @@ impl DirectionSampler for NuldSampler<'_> {
 }
 
 impl NuldSampler<'_> {
+    /// A BRDF sample in the world frame weighted by the density it follows
+    /// (module docs): the runtime's weight `f cos / pdf` in the unbiased mode;
+    /// the albedo `A` for a fixed instance, whose set follows the target
+    /// `f cos / A` (the weight of blobs of the earlier mixture prior in either
+    /// mode, whose samples carry no pdf). The runtime's directions are unit to
+    /// f32 rounding; used as they come.
+    fn brdf_sample(
+        &self,
+        at: &ShadingPoint,
+        s: nuld_runtime::Sample,
+        (wo, roughness, metallic): (nuld_runtime::glam::Vec3, f32, f32),
+    ) -> Sample {
+        let weight = match (
+            self.randomized && s.pdf > 0.0,
+            BrdfSampler::try_from(self.sampler),
+        ) {
+            (false, Ok(t)) => t.albedo(wo, roughness, metallic),
+            _ => s.weight,
+        };
+        Sample {
+            direction: at.frame.to_world(s.direction.as_dvec3()),
+            weight: weight as f64,
+            pdf: 0.0,
+        }
+    }
+
     /// An environment sample (world frame) weighted by the density it follows
     /// (module docs): the runtime's exact pdf in the unbiased mode, the target
     /// `q = L cos / E` for a fixed instance.
@@ -295,16 +334,6 @@ fn target_density(at: &ShadingPoint, env: &Environment, e: f64, l: DVec3) -> f64
     }
 }
 
-/// A BRDF sample in the world frame with the runtime's weight, the albedo. The
-/// runtime's directions are unit to f32 rounding; used as they come.
-fn brdf_sample(at: &ShadingPoint, s: nuld_runtime::Sample) -> Sample {
-    Sample {
-        direction: at.frame.to_world(s.direction.as_dvec3()),
-        weight: s.weight as f64,
-        pdf: 0.0,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -341,15 +370,18 @@ mod tests {
             ours.samples(&at, key, 8, &mut out);
             for (i, s) in out.iter().enumerate() {
                 let want = match mode {
-                    NuldMode::Table => cs.sample(wo, 0.4, key.instance(), i as u32),
-                    NuldMode::Network => cs.network().sample(wo, 0.4, key.instance(), i as u32),
+                    NuldMode::Table => cs.sample(wo, 0.4, 0.0, key.instance(), i as u32),
+                    NuldMode::Network => {
+                        cs.network().sample(wo, 0.4, 0.0, key.instance(), i as u32)
+                    }
                 };
                 let got = s.direction.as_vec3();
                 assert_eq!(
                     got.to_array().map(f32::to_bits),
                     want.direction.to_array().map(f32::to_bits)
                 );
-                assert_eq!(s.weight, want.weight as f64);
+                // A fixed instance weighs by the albedo (module docs).
+                assert_eq!(s.weight, cs.albedo(wo, 0.4, 0.0) as f64);
             }
             // At a tilted normal the world directions are the runtime's local ones
             // carried by the frame: back in the local frame they agree to rounding,
@@ -362,8 +394,10 @@ mod tests {
             ours.samples(&tilted, key, 8, &mut out);
             for (i, s) in out.iter().enumerate() {
                 let want = match mode {
-                    NuldMode::Table => cs.sample(wo, 0.4, key.instance(), i as u32),
-                    NuldMode::Network => cs.network().sample(wo, 0.4, key.instance(), i as u32),
+                    NuldMode::Table => cs.sample(wo, 0.4, 0.0, key.instance(), i as u32),
+                    NuldMode::Network => {
+                        cs.network().sample(wo, 0.4, 0.0, key.instance(), i as u32)
+                    }
                 };
                 let local = tilted.frame.to_local(s.direction);
                 assert!((local - want.direction.as_dvec3()).length() < 1e-12);

@@ -482,7 +482,7 @@ impl ConditionalReport {
         let mut written = Vec::new();
         for c in picks.into_iter().map(|i| pool[i]) {
             // Only the density is drawn: no cap-measure table worth building.
-            let target = BrdfTarget::coarse(c.roughness, c.theta_o_deg, 1 << 10)?;
+            let target = BrdfTarget::coarse(c.roughness, c.theta_o_deg, 0.0, 1 << 10)?;
             for e in &c.examples {
                 let square: Vec<glam::DVec2> = e
                     .directions

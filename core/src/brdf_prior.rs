@@ -1,0 +1,309 @@
+//! The BRDF sampler's prior: the glTF metallic-roughness BRDF times the cosine,
+//! `f(wo, wi) max(n.wi, 0)` ([`crate::brdf::gltf_metallic`], base colour 1),
+//! tabulated in the half vector's equal-area square for each node of a grid of
+//! conditions `(roughness, θo, metallic)` and sampled exactly between the nodes
+//! ([`crate::marginal2d`]).
+//!
+//! **Nodes.** `G_r x G_t x G_m` conditions at the vertices of a regular grid over
+//! roughness `[MIN_ROUGHNESS, MAX_ROUGHNESS]`, `θo` `[0°, MAX_THETA_O_DEG]` and
+//! metallic `[0, 1]`; node `(i, j, l)` is table `i + G_r (j + G_t l)`
+//! ([`node_condition`]). The view is the xz-plane one of
+//! [`crate::brdf::view_direction`].
+//!
+//! **The half-vector square.** A table point `p` is the half vector
+//! `h = square_to_hemisphere(p)` and the light direction is the mirror of the view
+//! about it, `wi = 2 (wo.h) h - wo` ([`half_vector_direction`]). The specular
+//! peak sits at `h = n` for every view, so tables of neighbouring `θo` agree
+//! where the lobe is (a direction square needs twice the conditions for the same
+//! quality). A point whose `wi` falls below the horizon (or with `wo.h <= 0`)
+//! has no direction: a table tabulated from the target holds 0 there, and the
+//! bilinear interpolant's rare leak into it returns `(+z, pdf 0)`.
+//!
+//! **Blending: exact in metallic.** The tables are normalized, and each node's
+//! mass before normalization (the tabulated albedo over `2π`) is stored beside
+//! them. A query blends the nodes around it with multilinear weights *times
+//! their masses* ([`BrdfPrior::blend`]): it samples the interpolation of the
+//! unnormalized target `f cos`. The target is linear in metallic, `f_m = (1 - m)
+//! f_0 + m f_1`, so two metallic nodes (`G_m = 2`) reproduce every metallic
+//! exactly, up to the tabulation of the ends.
+//!
+//! **Densities.** The warp's pdf per unit area of the square over `2π` is the
+//! half vector's per steradian (the map is equal-area), and `|dwi/dh| = 4 |wo.h|`,
+//! so the light direction's pdf is `pdf_square / (8 π wo.h)`. Whatever the tables
+//! approximate, [`BrdfPrior::pdf`] is the density of [`BrdfPrior::sample`]'s
+//! directions: `f cos / pdf` is an unbiased estimate of the albedo.
+
+use crate::brdf::{
+    clamp_metallic, clamp_roughness, clamp_theta_o_deg, view_direction_real, MAX_METALLIC,
+    MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_METALLIC, MIN_ROUGHNESS,
+};
+use crate::marginal2d::{Blend, Marginal2D, Marginal2DError, Marginal2DShape, MAX_BLEND};
+use crate::real::Real;
+use crate::sphere::{hemisphere_to_square_real, square_to_hemisphere_real};
+use bytemuck::{Pod, Zeroable};
+
+/// The prior's info section (16 bytes, `#[repr(C)]`, little-endian): the
+/// condition grid and the tables' vertices per axis.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
+pub struct BrdfPriorInfo {
+    /// Nodes per condition axis `[G_r, G_t, G_m]`, each at least 2.
+    pub grid: [u32; 3],
+    /// Vertices per axis of each node's square table, at least 2.
+    pub size: u32,
+}
+
+/// Size of [`BrdfPriorInfo`] in bytes.
+pub const BRDF_PRIOR_INFO_LEN: usize = core::mem::size_of::<BrdfPriorInfo>();
+
+const _: () = assert!(BRDF_PRIOR_INFO_LEN == 16);
+
+/// Most vertices per table axis a blob may declare (a table of `4096^2` values is
+/// 64 MiB, more than any prior needs).
+pub const MAX_PRIOR_SIZE: u32 = 4096;
+
+/// Most nodes per condition axis a blob may declare.
+pub const MAX_PRIOR_GRID: u32 = 256;
+
+impl BrdfPriorInfo {
+    /// Node tables `G_r G_t G_m`; `None` unless every axis has 2 to
+    /// [`MAX_PRIOR_GRID`] nodes and the size is 2 to [`MAX_PRIOR_SIZE`].
+    pub fn nodes(&self) -> Option<u32> {
+        let grid_ok = self.grid.iter().all(|g| (2..=MAX_PRIOR_GRID).contains(g));
+        (grid_ok && (2..=MAX_PRIOR_SIZE).contains(&self.size))
+            .then(|| self.grid[0] * self.grid[1] * self.grid[2])
+    }
+
+    /// The tables' shape ([`Self::nodes`] tables of `size x size` vertices).
+    pub fn shape(&self) -> Option<Marginal2DShape> {
+        Some(Marginal2DShape {
+            size: [self.size; 2],
+            nodes: self.nodes()?,
+        })
+    }
+}
+
+/// The five sections of a BRDF prior, in the order `core/FORMAT.md` lists them,
+/// ready for [`crate::blob::write`] (after a conditional blob's own,
+/// [`crate::conditional::sections`]). Checks no length: a reader validates them.
+pub fn sections<'s>(
+    info: &'s BrdfPriorInfo,
+    data: &'s [f32],
+    marginal: &'s [f32],
+    conditional: &'s [f32],
+    masses: &'s [f32],
+) -> [crate::blob::SectionSpec<'s>; 5] {
+    use crate::blob::{SectionSpec, SectionTag};
+    let table = |tag, values: &'s [f32]| SectionSpec {
+        tag,
+        elem_size: 4,
+        bytes: bytemuck::cast_slice(values),
+    };
+    [
+        SectionSpec {
+            tag: SectionTag::BrdfPriorInfo,
+            elem_size: BRDF_PRIOR_INFO_LEN as u32,
+            bytes: bytemuck::bytes_of(info),
+        },
+        table(SectionTag::BrdfPriorData, data),
+        table(SectionTag::BrdfPriorMarginal, marginal),
+        table(SectionTag::BrdfPriorConditional, conditional),
+        table(SectionTag::BrdfPriorMasses, masses),
+    ]
+}
+
+/// The condition `[roughness, θo in degrees, metallic]` of node `node` of `grid`
+/// (module docs; an axis of fewer than 2 nodes sits at its lower end).
+pub fn node_condition(grid: [u32; 3], node: u32) -> [f64; 3] {
+    let at = |i: u32, count: u32, lo: f64, hi: f64| match count {
+        0 | 1 => lo,
+        c => lo + (hi - lo) * i as f64 / (c - 1) as f64,
+    };
+    let g0 = grid[0].max(1);
+    let g1 = grid[1].max(1);
+    let (i, rest) = (node % g0, node / g0);
+    let (j, l) = (rest % g1, rest / g1);
+    [
+        at(i, grid[0], MIN_ROUGHNESS, MAX_ROUGHNESS),
+        at(j, grid[1], 0.0, MAX_THETA_O_DEG),
+        at(l, grid[2], MIN_METALLIC, MAX_METALLIC),
+    ]
+}
+
+/// The condition `[roughness, θo in degrees, metallic]` clamped into the
+/// prior's ranges (NaN to their lower ends) and placed on `[0,1]^3`.
+#[inline]
+pub fn unit_condition<T: Real>(cond: [T; 3]) -> [T; 3] {
+    let r = clamp_roughness(cond[0]);
+    let t = clamp_theta_o_deg(cond[1]);
+    let m = clamp_metallic(cond[2]);
+    [
+        (r - T::of(MIN_ROUGHNESS)) / T::of(MAX_ROUGHNESS - MIN_ROUGHNESS),
+        t / T::of(MAX_THETA_O_DEG),
+        (m - T::of(MIN_METALLIC)) / T::of(MAX_METALLIC - MIN_METALLIC),
+    ]
+}
+
+fn dot<T: Real>(a: [T; 3], b: [T; 3]) -> T {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn normalized<T: Real>(v: [T; 3]) -> Option<[T; 3]> {
+    let len = dot(v, v).sqrt();
+    (len > T::ZERO && len.is_finite()).then(|| v.map(|c| c / len))
+}
+
+/// The light direction of the half-vector square point `p` for the unit view
+/// `wo`, `wi = 2 (wo.h) h - wo` with `h = square_to_hemisphere(p)`, and the
+/// Jacobian `|dwi/dh| = 4 wo.h`; `None` where `wo.h <= 0` or `wi.z <= 0`.
+#[inline]
+pub fn half_vector_direction<T: Real>(wo: [T; 3], p: [T; 2]) -> Option<([T; 3], T)> {
+    let h = square_to_hemisphere_real(p);
+    let c = dot(wo, h);
+    // NaN fails the comparison too.
+    if c.partial_cmp(&T::ZERO) != Some(core::cmp::Ordering::Greater) {
+        return None;
+    }
+    let two_c = T::of(2.0) * c;
+    let wi = normalized([0, 1, 2].map(|a| two_c * h[a] - wo[a]))?;
+    (wi[2] > T::ZERO).then_some((wi, T::of(4.0) * c))
+}
+
+/// The inverse of [`half_vector_direction`]: the square point of the half vector
+/// `h = (wo + wi) / |wo + wi|` and `4 wo.h`; `None` where no table point maps to
+/// `wi` (`wi.z <= 0`, `h.z <= 0` or `wo.h <= 0`).
+#[inline]
+pub fn half_vector_point<T: Real>(wo: [T; 3], wi: [T; 3]) -> Option<([T; 2], T)> {
+    if wi[2].partial_cmp(&T::ZERO) != Some(core::cmp::Ordering::Greater) {
+        return None;
+    }
+    let h = normalized([0, 1, 2].map(|a| wo[a] + wi[a]))?;
+    let c = dot(wo, h);
+    (h[2] > T::ZERO && c > T::ZERO).then(|| (hemisphere_to_square_real(h), T::of(4.0) * c))
+}
+
+/// The tabulated BRDF prior over borrowed tables (module docs): node tables as
+/// [`crate::marginal2d::tabulate`] writes them and each node's mass.
+#[derive(Clone, Copy, Debug)]
+pub struct BrdfPrior<'a, T> {
+    grid: [u32; 3],
+    warp: Marginal2D<'a, T>,
+    masses: &'a [T],
+}
+
+impl<'a, T: Real> BrdfPrior<'a, T> {
+    /// The prior over `info`'s tables, every value checked
+    /// ([`Marginal2D::new`]) and every mass finite and positive. `O(nodes
+    /// size^2)`, once.
+    pub fn new(
+        info: BrdfPriorInfo,
+        data: &'a [T],
+        marginal: &'a [T],
+        conditional: &'a [T],
+        masses: &'a [T],
+    ) -> Result<Self, Marginal2DError> {
+        let shape = info.shape().ok_or(Marginal2DError::Shape)?;
+        let warp = Marginal2D::new(shape, data, marginal, conditional)?;
+        Self::with_masses(info, warp, masses, true)
+    }
+
+    /// The prior over tables that [`Self::new`] has checked before: shape and
+    /// lengths only, `O(1)`. Never panics on any values.
+    pub fn view(
+        info: BrdfPriorInfo,
+        data: &'a [T],
+        marginal: &'a [T],
+        conditional: &'a [T],
+        masses: &'a [T],
+    ) -> Result<Self, Marginal2DError> {
+        let shape = info.shape().ok_or(Marginal2DError::Shape)?;
+        let warp = Marginal2D::view(shape, data, marginal, conditional)?;
+        Self::with_masses(info, warp, masses, false)
+    }
+
+    fn with_masses(
+        info: BrdfPriorInfo,
+        warp: Marginal2D<'a, T>,
+        masses: &'a [T],
+        check: bool,
+    ) -> Result<Self, Marginal2DError> {
+        let nodes = info.nodes().ok_or(Marginal2DError::Shape)?;
+        if masses.len() != nodes as usize {
+            return Err(Marginal2DError::Length {
+                slice: 3,
+                expected: nodes as u64,
+                got: masses.len() as u64,
+            });
+        }
+        if check {
+            if let Some(i) = masses.iter().position(|&m| !(m > T::ZERO && m.is_finite())) {
+                return Err(Marginal2DError::NoMass { node: i as u32 });
+            }
+        }
+        Ok(Self {
+            grid: info.grid,
+            warp,
+            masses,
+        })
+    }
+
+    /// Nodes per condition axis `[G_r, G_t, G_m]`.
+    pub fn grid(&self) -> [u32; 3] {
+        self.grid
+    }
+
+    /// The blend at `cond = [roughness, θo in degrees, metallic]` (clamped,
+    /// [`unit_condition`]): the multilinear weights of the (up to 8) nodes
+    /// around it times the nodes' masses, so that the warp samples the
+    /// interpolated unnormalized target (module docs).
+    #[inline]
+    pub fn blend(&self, cond: [T; 3]) -> Blend<T> {
+        let multilinear = Blend::multilinear(&unit_condition(cond), &self.grid);
+        let mut pairs = [(0u32, T::ZERO); MAX_BLEND];
+        let mut len = 0;
+        for (node, w) in multilinear.pairs() {
+            let mass = self.masses.get(node as usize).copied().unwrap_or(T::ZERO);
+            if let Some(slot) = pairs.get_mut(len) {
+                *slot = (node, w * mass);
+                len += 1;
+            }
+        }
+        Blend::from_pairs(&pairs[..len])
+    }
+
+    /// The light direction of primary sample `u` in `[0,1]^2` (clamped) for the
+    /// xz-plane view of `cond = [roughness, θo in degrees, metallic]`, and its
+    /// solid-angle pdf (per steradian); `(+z, 0)` for a point without a
+    /// direction (module docs). `O(8 log size)`, never panics.
+    #[inline]
+    pub fn sample(&self, cond: [T; 3], u: [T; 2]) -> ([T; 3], T) {
+        let wo = view_direction_real(cond[1]);
+        let (p, pdf) = self.warp.sample(u, &self.blend(cond));
+        match half_vector_direction(wo, p) {
+            Some((wi, jac)) => (wi, pdf / (T::of(2.0) * T::PI * jac)),
+            None => ([T::ZERO, T::ZERO, T::ONE], T::ZERO),
+        }
+    }
+
+    /// The solid-angle pdf of [`Self::sample`]'s directions at the unit
+    /// direction `wi` (xz-plane view); 0 where the prior draws nothing.
+    #[inline]
+    pub fn pdf(&self, cond: [T; 3], wi: [T; 3]) -> T {
+        let wo = view_direction_real(cond[1]);
+        match half_vector_point(wo, wi) {
+            Some((p, jac)) => self.warp.pdf(p, &self.blend(cond)) / (T::of(2.0) * T::PI * jac),
+            None => T::ZERO,
+        }
+    }
+
+    /// The primary sample that [`Self::sample`] maps to the unit direction `wi`;
+    /// `None` where no table point maps to `wi`.
+    pub fn invert(&self, cond: [T; 3], wi: [T; 3]) -> Option<[T; 2]> {
+        let wo = view_direction_real(cond[1]);
+        let (p, _) = half_vector_point(wo, wi)?;
+        Some(self.warp.invert(p, &self.blend(cond)))
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,244 @@
+extern crate std;
+
+use super::*;
+use crate::brdf::{gltf_metallic, view_direction_real};
+use crate::marginal2d::tabulate;
+use crate::sphere::hemisphere_to_square;
+use crate::test_rng::Rng;
+use std::vec;
+use std::vec::Vec;
+
+include!("../../tests/data/gltf_albedo_reference.rs");
+include!("../../tests/data/gltf_metal_albedo_reference.rs");
+
+/// The reference tables hold more than the tests below read.
+#[test]
+fn the_reference_tables_cover_the_range() {
+    assert_eq!(REFERENCE_THETAS[5], 85.0);
+    assert_eq!(REFERENCE_ROUGHNESSES[0], crate::brdf::MIN_ROUGHNESS);
+    // At roughness 0.1 the diffuse and specular parts make the albedo.
+    for (j, (d, s)) in REFERENCE_DIFFUSE
+        .iter()
+        .zip(REFERENCE_SPECULAR_R01)
+        .enumerate()
+    {
+        assert!((d + s - REFERENCE_ALBEDO[0][j]).abs() < 1e-5);
+    }
+    assert!(REFERENCE_METAL_ALBEDO_89
+        .iter()
+        .all(|a| (0.0..1.0).contains(a)));
+}
+
+/// Tables of `f cos |dwi/dh|` sampled at each vertex of the half-vector square
+/// (no supersampling: the tests need a consistent prior, not a good one), with
+/// each node's trapezoid mass.
+struct Tables {
+    info: BrdfPriorInfo,
+    data: Vec<f64>,
+    marginal: Vec<f64>,
+    conditional: Vec<f64>,
+    masses: Vec<f64>,
+}
+
+impl Tables {
+    fn new(grid: [u32; 3], size: u32) -> Self {
+        let info = BrdfPriorInfo { grid, size };
+        let shape = info.shape().unwrap();
+        let s = size as usize;
+        let mut data = Vec::new();
+        for node in 0..shape.nodes {
+            let [r, t, m] = node_condition(grid, node);
+            let wo = view_direction_real(t);
+            for j in 0..s {
+                for i in 0..s {
+                    let p = [i as f64 / (s - 1) as f64, j as f64 / (s - 1) as f64];
+                    data.push(match half_vector_direction(wo, p) {
+                        Some((wi, jac)) => gltf_metallic(wo, wi, r, m) * wi[2] * jac,
+                        None => 0.0,
+                    });
+                }
+            }
+        }
+        let raw = data.clone();
+        let mut marginal = vec![0.0; shape.marginal_len().unwrap()];
+        let mut conditional = vec![0.0; shape.data_len().unwrap()];
+        tabulate(shape, &mut data, &mut marginal, &mut conditional).unwrap();
+        // Each node's mass: raw over normalized at its largest vertex.
+        let masses = (0..shape.nodes as usize)
+            .map(|k| {
+                let block = k * s * s..(k + 1) * s * s;
+                let at = block
+                    .clone()
+                    .max_by(|&a, &b| raw[a].total_cmp(&raw[b]))
+                    .unwrap();
+                raw[at] / data[at]
+            })
+            .collect();
+        Self {
+            info,
+            data,
+            marginal,
+            conditional,
+            masses,
+        }
+    }
+
+    fn prior(&self) -> BrdfPrior<'_, f64> {
+        BrdfPrior::new(
+            self.info,
+            &self.data,
+            &self.marginal,
+            &self.conditional,
+            &self.masses,
+        )
+        .unwrap()
+    }
+}
+
+#[test]
+fn the_real_hemisphere_inverse_is_the_f64_one() {
+    let mut g = Rng(3);
+    for _ in 0..10_000 {
+        let p = [g.next(), g.next()];
+        let d = square_to_hemisphere_real(p);
+        let want = hemisphere_to_square(glam::DVec3::from(d));
+        let got = hemisphere_to_square_real(d);
+        assert!((got[0] - want.x).abs() < 1e-12 && (got[1] - want.y).abs() < 1e-12);
+        assert!((got[0] - p[0]).abs() < 1e-9 && (got[1] - p[1]).abs() < 1e-9);
+        let d32 = d.map(|c| c as f32);
+        let got32 = hemisphere_to_square_real(d32);
+        assert!((got32[0] as f64 - p[0]).abs() < 2e-4, "{got32:?} {p:?}");
+    }
+    assert_eq!(hemisphere_to_square_real([0.0, 0.0, 1.0]), [0.5, 0.5]);
+    assert_eq!(hemisphere_to_square_real([f64::NAN; 3]), [0.5, 0.5]);
+}
+
+#[test]
+fn the_half_vector_maps_invert_each_other_and_mirror_the_view() {
+    let mut g = Rng(5);
+    let wo = view_direction_real(50.0f64);
+    let mut hits = 0;
+    for _ in 0..10_000 {
+        let p = [g.next(), g.next()];
+        let Some((wi, jac)) = half_vector_direction(wo, p) else {
+            continue;
+        };
+        hits += 1;
+        let h = square_to_hemisphere_real(p);
+        // wi and wo make equal angles with h, in the plane of both.
+        assert!((dot(wi, h) - dot(wo, h)).abs() < 1e-12);
+        assert!((jac - 4.0 * dot(wo, h)).abs() < 1e-12);
+        let (q, back) = half_vector_point(wo, wi).unwrap();
+        assert!((q[0] - p[0]).abs() < 1e-9 && (q[1] - p[1]).abs() < 1e-9);
+        assert!((back - jac).abs() < 1e-9);
+    }
+    assert!(hits > 2_500, "{hits}");
+    assert!(half_vector_point(wo, [0.0, 0.0, -1.0]).is_none());
+}
+
+/// Over the prior's own samples, `(1/M) Σ f cos / pdf` is the albedo of the
+/// independent reference table at a reference condition (`A_m = (1 - m) A_0 +
+/// m A_1`), at metallic 0, 0.5 and 1 between nodes in roughness and `θo`; and
+/// `pdf` and `invert` answer for every sample.
+#[test]
+fn the_estimate_with_the_priors_pdf_is_the_reference_albedo() {
+    let tables = Tables::new([4, 5, 2], 48);
+    let prior = tables.prior();
+    let mut g = Rng(11);
+    for (ri, ti) in [(3, 1), (4, 3), (5, 4)] {
+        for m in [0.0, 0.5, 1.0] {
+            let (r, t) = (REFERENCE_ROUGHNESSES[ri], REFERENCE_THETAS[ti]);
+            let want = (1.0 - m) * REFERENCE_ALBEDO[ri][ti] + m * REFERENCE_METAL_ALBEDO[ri][ti];
+            let cond = [r, t, m];
+            let wo = view_direction_real(t);
+            let count = 1 << 16;
+            let (mut sum, mut sum2) = (0.0, 0.0);
+            for _ in 0..count {
+                let u = [g.next(), g.next()];
+                let (wi, pdf) = prior.sample(cond, u);
+                if pdf == 0.0 {
+                    continue;
+                }
+                let back = prior.pdf(cond, wi);
+                assert!((back - pdf).abs() <= 1e-9 * pdf, "{back} {pdf}");
+                let v = prior.invert(cond, wi).unwrap();
+                assert!((v[0] - u[0]).abs() < 1e-6 && (v[1] - u[1]).abs() < 1e-6);
+                let y = gltf_metallic(wo, wi, r, m) * wi[2] / pdf;
+                sum += y;
+                sum2 += y * y;
+            }
+            let mean = sum / count as f64;
+            let se = ((sum2 / count as f64 - mean * mean) / count as f64).sqrt();
+            assert!(
+                (mean - want).abs() < 4.0 * se + 1e-6,
+                "{cond:?}: {mean} vs {want} (se {se})"
+            );
+        }
+    }
+}
+
+/// Two metallic nodes give every metallic exactly: at a vertex of a node's
+/// table the blend's density is proportional to `f_m cos |dwi/dh|`, with
+/// `f_m` from the BRDF itself (not from the tables), for any `m`.
+#[test]
+fn two_metallic_nodes_blend_into_the_target_at_any_metallic() {
+    let size = 32;
+    let tables = Tables::new([3, 4, 2], size);
+    let prior = tables.prior();
+    let [r, t, _] = node_condition([3, 4, 2], 1 + 3 * 2);
+    let wo = view_direction_real(t);
+    for m in [0.3, 0.77] {
+        let mut ratios = Vec::new();
+        for (i, j) in [(16, 16), (18, 16), (21, 17), (17, 13), (19, 19)] {
+            let p = [i as f64 / (size - 1) as f64, j as f64 / (size - 1) as f64];
+            let Some((wi, jac)) = half_vector_direction(wo, p) else {
+                continue;
+            };
+            let target = gltf_metallic(wo, wi, r, m) * wi[2] * jac;
+            let pdf_square = prior.pdf([r, t, m], wi) * 2.0 * core::f64::consts::PI * jac;
+            ratios.push(pdf_square / target);
+        }
+        assert!(ratios.len() >= 4);
+        for q in &ratios {
+            assert!((q / ratios[0] - 1.0).abs() < 1e-9, "m {m}: {ratios:?}");
+        }
+    }
+}
+
+#[test]
+fn bad_tables_are_refused_and_views_check_lengths_only() {
+    let tables = Tables::new([2, 2, 2], 4);
+    let bad = BrdfPriorInfo {
+        grid: [1, 2, 2],
+        size: 4,
+    };
+    let t = &tables;
+    assert!(BrdfPrior::new(bad, &t.data, &t.marginal, &t.conditional, &t.masses).is_err());
+    let mut masses = t.masses.clone();
+    masses[3] = 0.0;
+    assert_eq!(
+        BrdfPrior::new(t.info, &t.data, &t.marginal, &t.conditional, &masses).unwrap_err(),
+        Marginal2DError::NoMass { node: 3 }
+    );
+    let view = BrdfPrior::view(t.info, &t.data, &t.marginal, &t.conditional, &masses).unwrap();
+    // A zero mass cannot make the view panic; the node just drops out.
+    let (wi, pdf) = view.sample([0.5, 30.0, 1.0], [0.3, 0.6]);
+    assert!(pdf >= 0.0 && wi[2] >= 0.0);
+    assert!(BrdfPrior::view(t.info, &t.data, &t.marginal, &t.conditional, &masses[1..]).is_err());
+    assert_eq!(
+        BrdfPriorInfo {
+            grid: [2, 3, 2],
+            size: 5
+        }
+        .nodes(),
+        Some(12)
+    );
+    assert_eq!(
+        BrdfPriorInfo {
+            grid: [2, 3, 2],
+            size: MAX_PRIOR_SIZE + 1
+        }
+        .nodes(),
+        None
+    );
+}
