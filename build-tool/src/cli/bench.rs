@@ -183,10 +183,10 @@ const RUNTIME_SAMPLES: u32 = 2_000_000;
 fn run_runtime() -> Result<()> {
     let t = runtime::measure(RUNTIME_SAMPLES)?;
     println!("runtime ns per sample, one thread, n = 64 (best of 3)");
-    println!("{:<44} {:>10} {:>12}", "method", "ns/sample", "/ incumbent");
+    println!("{:<68} {:>10} {:>12}", "method", "ns/sample", "/ incumbent");
     let base = t.rows.first().map_or(f64::NAN, |r| r.1);
     for (name, ns) in &t.rows {
-        println!("{name:<44} {ns:>10.1} {:>11.2}x", ns / base);
+        println!("{name:<68} {ns:>10.1} {:>11.2}x", ns / base);
     }
     Ok(())
 }

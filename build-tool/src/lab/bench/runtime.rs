@@ -161,7 +161,10 @@ pub(crate) fn ns_per_sample(count: u32, mut f: impl FnMut(u32)) -> f64 {
 
 /// Times, one thread, `samples` samples per method (a tenth of it for network
 /// mode): the incumbent (direction only, and with its estimator weight
-/// `f cos / p` as a renderer needs it), table mode (`sample` and `sample_brdf`),
+/// `f cos / p` as a renderer needs it), table mode (`sample` and `sample_brdf`;
+/// on the BRDF mixture prior of earlier blobs, and on the default bake's
+/// tabulated prior with metallic 0, 0.5 and 1 in turn, also its unbiased mode and
+/// decoded network mode),
 /// and network mode at n 64 with hidden [32, 32] ReLU and [64, 64] SiLU, each on
 /// the blob's f16 weights and on weights decoded once
 /// ([`nuld_runtime::ConditionalSampler::decode_network`]). Every
@@ -242,6 +245,39 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
         "table: BrdfSampler::sample".into(),
         ns_per_sample(samples, |s| {
             black_box(relu.sample(views[at(s)], conds[at(s)].x, 0.0, s / n, s % n));
+        }),
+    ));
+    // The default bake's sampler: the tabulated prior (shared, 17.8 MB), metallic
+    // 0, 0.5 and 1 in turn.
+    let table_blob = {
+        let shape = random_shape(n, &[32, 32], Activation::Relu, PointWarp::BrdfTable, slots)?;
+        random_parts(shape, PointWarp::BrdfTable, 16, [10, 9], 2)?.to_blob(&meta)?
+    };
+    let prior = sampler(&table_blob)?;
+    let metallic = |s: u32| [0.0, 0.5, 1.0][(s / n) as usize % 3];
+    rows.push((
+        "tabulated prior, table: BrdfSampler::sample".into(),
+        ns_per_sample(samples, |s| {
+            let (v, r) = (views[at(s)], conds[at(s)].x);
+            black_box(prior.sample(v, r, metallic(s), s / n, s % n));
+        }),
+    ));
+    rows.push((
+        "tabulated prior, table: BrdfSampler::sample_randomized".into(),
+        ns_per_sample(samples, |s| {
+            let (v, r) = (views[at(s)], conds[at(s)].x);
+            black_box(prior.sample_randomized(v, r, metallic(s), s / n, s % n, s));
+        }),
+    ));
+    let mut prior_buf = vec![0.0f32; prior.decoded_network_len()];
+    let prior_net = prior
+        .decode_network(&mut prior_buf)
+        .ok_or_else(|| anyhow!("decode_network refused a buffer of its own length"))?;
+    rows.push((
+        "tabulated prior, network [32,32] relu: decoded, BrdfNetwork::sample".into(),
+        ns_per_sample(samples / 10, |s| {
+            let (v, r) = (views[at(s)], conds[at(s)].x);
+            black_box(prior_net.sample(v, r, metallic(s), s / n, s % n));
         }),
     ));
     for (name, cs) in [
