@@ -20,9 +20,13 @@
 // Each `nuld_*` function is the Rust function it names, in the same order of
 // operations. Table mode and the point lookups reproduce the runtime to `f32`
 // rounding of the driver's `sin`, `cos`, `sqrt` and division (`acos` is libm's,
-// ported); network mode
-// adds the driver's `exp` and the order of its multiply-adds (the runtime's dot
-// product order is kept; a driver may still fuse a multiply and an add).
+// ported, and so is `atan` for the BRDF prior; an environment sampler's pdf of a
+// given direction goes through the driver's `atan`); network mode adds the
+// driver's `exp` and the order of its multiply-adds (the runtime's dot product
+// order is kept; a driver may still fuse a multiply and an add). The BRDF prior's
+// warp (warp 3) inverts tabulated CDFs: where its density is low, a rounding of a
+// CDF moves the point by that rounding over the density, for the runtime as for
+// the shader.
 
 // ---- Blob layout (core/FORMAT.md): byte offsets and codes ----------------------
 
@@ -56,6 +60,11 @@ const NULD_TAG_WEIGHT_TABLE: u32 = 6u;
 const NULD_TAG_ENVMAP_TREE_INFO: u32 = 7u;
 const NULD_TAG_ENVMAP_TREE_NODES: u32 = 8u;
 const NULD_TAG_ENVMAP_TREE_TOP: u32 = 9u;
+const NULD_TAG_BRDF_PRIOR_INFO: u32 = 10u;
+const NULD_TAG_BRDF_PRIOR_DATA: u32 = 11u;
+const NULD_TAG_BRDF_PRIOR_MARGINAL: u32 = 12u;
+const NULD_TAG_BRDF_PRIOR_CONDITIONAL: u32 = 13u;
+const NULD_TAG_BRDF_PRIOR_MASSES: u32 = 14u;
 
 // `Domain` codes.
 const NULD_DOMAIN_SQUARE: u32 = 0u;
@@ -96,6 +105,7 @@ const NULD_ACTIVATION_SILU: u32 = 1u;
 const NULD_WARP_EQUAL_AREA: u32 = 0u;
 const NULD_WARP_BRDF_MIXTURE: u32 = 1u;
 const NULD_WARP_ENVMAP_TREE: u32 = 2u;
+const NULD_WARP_BRDF_TABLE: u32 = 3u;
 // `TreeInfo` fields (core/src/envmap_tree.rs).
 const NULD_TREE_INFO_LEVELS: u32 = 0u;
 const NULD_TREE_INFO_GRID: u32 = 4u;
@@ -103,6 +113,12 @@ const NULD_TREE_INFO_GRID: u32 = 4u;
 const NULD_TREE_TOP_LEVELS: u32 = 3u;
 const NULD_TREE_TOP_NODES: u32 = 84u;
 const NULD_TREE_MAX_LEVELS: u32 = 24u;
+// `BrdfPriorInfo` fields (core/src/brdf_prior.rs).
+const NULD_PRIOR_INFO_GRID: u32 = 0u;
+const NULD_PRIOR_INFO_SIZE: u32 = 12u;
+// `MAX_BLEND` (core/src/marginal2d.rs): nodes in one blend, the corners of a
+// cell of the prior's three condition axes.
+const NULD_MAX_BLEND: u32 = 8u;
 // `TOP_FLOOR` and the smallest usable normal length of `unit_or_z`, as the f32
 // `T::of` rounds them to (bits 0x3a83126f, 0x1e3ce508).
 const NULD_TREE_TOP_FLOOR: f32 = 0.001000000047497451305389404296875;
@@ -126,6 +142,16 @@ const NULD_RADIANS_PER_DEGREE: f32 = 0.01745329238474369049;
 const NULD_MIN_ROUGHNESS: f32 = 0.10000000149011611938;
 const NULD_MAX_ROUGHNESS: f32 = 1.0;
 const NULD_MAX_THETA_O_DEG: f32 = 89.0;
+// `MAX_ROUGHNESS - MIN_ROUGHNESS` of `unit_condition` (core/src/brdf_prior.rs),
+// subtracted in f64 and rounded to f32 (bits 0x3f666666).
+const NULD_ROUGHNESS_SPAN: f32 = 0.89999997615814208984375;
+// `F0` and `1 - F0` of `schlick_fresnel` (core/src/brdf.rs), the second
+// subtracted in f64, both rounded to f32 (bits 0x3d23d70a, 0x3f75c28f).
+const NULD_F0: f32 = 0.039999999105930328369140625;
+const NULD_ONE_MINUS_F0: f32 = 0.959999978542327880859375;
+// `4 / pi` of `hemisphere_to_square_real` (core/src/sphere.rs), divided in f64
+// and rounded to f32 (bits 0x3fa2f983).
+const NULD_FRAC_4_PI: f32 = 1.27323949337005615234375;
 // `2^-20`: the clamp of the shifted lattice point before its logit
 // (core/src/network/features.rs `LATTICE_LOGIT_EPS`).
 const NULD_LATTICE_LOGIT_EPS: f32 = 0.00000095367431640625;
@@ -1058,11 +1084,554 @@ fn nuld_torus_shift(p: vec2<f32>, shift: vec2<f32>) -> vec2<f32> {
     return out;
 }
 
+// ---- The glTF BRDF with metallic (core/src/brdf.rs) ----------------------------
+
+// Rust: `clamp_roughness`: `roughness` clamped into `[0.1, 1]`, NaN as 0.1.
+fn nuld_clamp_roughness(roughness: f32) -> f32 {
+    if nuld_is_nan(roughness) {
+        return NULD_MIN_ROUGHNESS;
+    }
+    return clamp(roughness, NULD_MIN_ROUGHNESS, NULD_MAX_ROUGHNESS);
+}
+
+// Rust: `clamp_theta_o_deg`: `theta_o` in degrees clamped into `[0, 89]`, NaN as 0.
+fn nuld_clamp_theta_o(theta_o_deg: f32) -> f32 {
+    if nuld_is_nan(theta_o_deg) {
+        return 0.0;
+    }
+    return clamp(theta_o_deg, 0.0, NULD_MAX_THETA_O_DEG);
+}
+
+// Rust: `view_direction_real`: the xz-plane view `(sin t, 0, cos t)` of `theta_o`
+// (degrees, clamped), `t` in radians.
+fn nuld_view_direction(theta_o_deg: f32) -> vec3<f32> {
+    let t = nuld_clamp_theta_o(theta_o_deg) * NULD_RADIANS_PER_DEGREE;
+    return vec3<f32>(sin(t), 0.0, cos(t));
+}
+
+// Rust: `ggx_d`: `alpha^2 / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2)` for `n.h > 0`
+// (above 1 as 1), 0 for `n.h <= 0` or NaN.
+fn nuld_ggx_d(n_dot_h: f32, alpha: f32) -> f32 {
+    if nuld_is_nan(n_dot_h) || n_dot_h <= 0.0 {
+        return 0.0;
+    }
+    let c = min(n_dot_h, 1.0);
+    let a2 = alpha * alpha;
+    let t = c * c * (a2 - 1.0) + 1.0;
+    return a2 / (NULD_PI * t * t);
+}
+
+// Rust: `smith_vis`: the height-correlated Smith visibility
+// `0.5 / ((n.l) sqrt(a2 + (1 - a2)(n.v)^2) + (n.v) sqrt(a2 + (1 - a2)(n.l)^2))`,
+// `a2 = alpha^2`, the cosines clamped into `[0, 1]` (NaN as 0); 0 when both are 0.
+fn nuld_smith_vis(n_dot_v: f32, n_dot_l: f32, alpha: f32) -> f32 {
+    let nv = nuld_clamp01(n_dot_v);
+    let nl = nuld_clamp01(n_dot_l);
+    let a2 = alpha * alpha;
+    let denom = nl * sqrt(a2 + (1.0 - a2) * nv * nv) + nv * sqrt(a2 + (1.0 - a2) * nl * nl);
+    if denom > 0.0 {
+        return 0.5 / denom;
+    }
+    return 0.0;
+}
+
+// Rust: `schlick_fresnel`: `F0 + (1 - F0)(1 - |v.h|)^5`, `|v.h|` clamped into
+// `[0, 1]` (NaN as 0, so `F = 1`).
+fn nuld_schlick_fresnel(v_dot_h: f32) -> f32 {
+    let c = nuld_clamp01(abs(v_dot_h));
+    let m = 1.0 - c;
+    let m2 = m * m;
+    return NULD_F0 + NULD_ONE_MINUS_F0 * m2 * m2 * m;
+}
+
+// Rust: `gltf_metallic_parts_of`: the diffuse `(1 - m)(1 - F) / pi` and specular
+// `((1 - m) F + m) D Vis` parts from the pair's cosines
+// `c = (n.v, n.l, n.h, v.h)`, `alpha` and the clamped metallic `m`.
+fn nuld_gltf_metallic_parts_of(c: vec4<f32>, alpha: f32, metallic: f32) -> vec2<f32> {
+    let f = nuld_schlick_fresnel(c.w);
+    let dielectric = 1.0 - metallic;
+    return vec2<f32>(
+        dielectric * ((1.0 - f) / NULD_PI),
+        (dielectric * f + metallic) * nuld_ggx_d(c.z, alpha) * nuld_smith_vis(c.x, c.y, alpha),
+    );
+}
+
+// Rust: `gltf_metallic` (`gltf_metallic_parts` with `pair_cosines`, `alpha` and
+// `clamp_metallic`): the glTF 2.0 BRDF with metallic `m` and base colour 1,
+// `(1 - m)((1 - F)/pi + F D Vis) + m D Vis`, for the unit view `wo` and light
+// `wi` (normal `+z`), the roughness clamped into `[0.1, 1]` and the metallic into
+// `[0, 1]` (`nuld_clamp01`: `MIN_METALLIC` is 0, `MAX_METALLIC` 1; NaN as 0); 0
+// when either direction is at or below the horizon or not finite, or `wo + wi = 0`.
+fn nuld_gltf_metallic(wo: vec3<f32>, wi: vec3<f32>, roughness: f32, metallic: f32) -> f32 {
+    let finite = nuld_is_finite(wo.x) && nuld_is_finite(wo.y) && nuld_is_finite(wo.z)
+        && nuld_is_finite(wi.x) && nuld_is_finite(wi.y) && nuld_is_finite(wi.z);
+    if !finite || wo.z <= 0.0 || wi.z <= 0.0 {
+        return 0.0;
+    }
+    let s = vec3<f32>(wo.x + wi.x, wo.y + wi.y, wo.z + wi.z);
+    let len = sqrt(s.x * s.x + s.y * s.y + s.z * s.z);
+    if nuld_is_nan(len) || len <= 0.0 {
+        return 0.0;
+    }
+    let h = vec3<f32>(s.x / len, s.y / len, s.z / len);
+    let v_dot_h = wo.x * h.x + wo.y * h.y + wo.z * h.z;
+    let c = vec4<f32>(min(wo.z, 1.0), min(wi.z, 1.0), h.z, v_dot_h);
+    let r = nuld_clamp_roughness(roughness);
+    let parts = nuld_gltf_metallic_parts_of(c, r * r, nuld_clamp01(metallic));
+    return parts.x + parts.y;
+}
+
+// ---- The BRDF prior (core/src/brdf_prior.rs, core/src/marginal2d.rs) --------
+
+// Rust: `BrdfPrior` (`BrdfPrior::view` over the blob's sections): the condition
+// grid `(G_r, G_t, G_m)`, the tables' vertices per axis `S` (`Marginal2D`'s
+// `nx = ny`) and the byte offsets of the data, marginal, conditional and mass
+// sections (tags 11-14).
+struct NuldBrdfPrior {
+    grid: vec3<u32>,
+    size: u32,
+    data: u32,
+    marginal: u32,
+    conditional: u32,
+    masses: u32,
+}
+
+// Rust: `ConditionalSampler::brdf_prior`: the blob's BRDF prior (warp 3).
+fn nuld_brdf_prior() -> NuldBrdfPrior {
+    let info = nuld_section(NULD_TAG_BRDF_PRIOR_INFO);
+    let grid = vec3<u32>(
+        nuld_u32(info + NULD_PRIOR_INFO_GRID),
+        nuld_u32(info + NULD_PRIOR_INFO_GRID + 4u),
+        nuld_u32(info + NULD_PRIOR_INFO_GRID + 8u),
+    );
+    return NuldBrdfPrior(
+        max(grid, vec3<u32>(2u, 2u, 2u)),
+        max(nuld_u32(info + NULD_PRIOR_INFO_SIZE), 2u),
+        nuld_section(NULD_TAG_BRDF_PRIOR_DATA),
+        nuld_section(NULD_TAG_BRDF_PRIOR_MARGINAL),
+        nuld_section(NULD_TAG_BRDF_PRIOR_CONDITIONAL),
+        nuld_section(NULD_TAG_BRDF_PRIOR_MASSES),
+    );
+}
+
+// Rust: `Blend` (core/src/marginal2d.rs): `(node, weight)` pairs, here always the
+// eight corners of the condition's cell in `Blend::multilinear`'s corner order
+// (bit `k` of corner `c` = `4 h + l` picks the upper node along axis `k`; `lo`
+// holds corners 0-3, `hi` corners 4-7). A corner the Rust blend leaves out has
+// weight 0 here, and adds `0 * v = +0` to every sum (`v` finite and `>= 0`): the
+// same bits.
+struct NuldBlend {
+    nodes_lo: vec4<u32>,
+    nodes_hi: vec4<u32>,
+    weights_lo: vec4<f32>,
+    weights_hi: vec4<f32>,
+}
+
+// Rust: `BrdfPrior::blend` (with `unit_condition`, `Blend::multilinear` and
+// `Blend::from_pairs`): the nodes around `cond = (roughness, theta_o in degrees,
+// metallic)`, clamped (NaN to the lower ends) and placed on `[0,1]^3`, each
+// weighed by its multilinear weight times its mass (weights not above 0 as 0).
+fn nuld_brdf_blend(pr: NuldBrdfPrior, cond: vec3<f32>) -> NuldBlend {
+    // `unit_condition`; the metallic's `(m - 0) / (1 - 0)` is `m` exactly.
+    let unit = vec3<f32>(
+        (nuld_clamp_roughness(cond.x) - NULD_MIN_ROUGHNESS) / NULD_ROUGHNESS_SPAN,
+        nuld_clamp_theta_o(cond.y) / NULD_MAX_THETA_O_DEG,
+        nuld_clamp01(cond.z),
+    );
+    var lower = vec3<u32>(0u, 0u, 0u);
+    var frac = vec3<f32>(0.0, 0.0, 0.0);
+    var stride = vec3<u32>(0u, 0u, 0u);
+    var s = 1u;
+    for (var k = 0u; k < 3u; k++) {
+        stride[k] = s;
+        let c = pr.grid[k];
+        s = s * c;
+        let pos = nuld_clamp01(unit[k]) * f32(c - 1u);
+        let i = min(u32(floor(pos)), c - 2u);
+        lower[k] = i;
+        frac[k] = pos - f32(i);
+    }
+    var b: NuldBlend;
+    for (var corner = 0u; corner < NULD_MAX_BLEND; corner++) {
+        var node = 0u;
+        var w = 1.0;
+        for (var k = 0u; k < 3u; k++) {
+            let up = (corner >> k) & 1u;
+            node = node + (lower[k] + up) * stride[k];
+            if up == 1u {
+                w = w * frac[k];
+            } else {
+                w = w * (1.0 - frac[k]);
+            }
+        }
+        var m = w * nuld_f32(pr.masses + 4u * node);
+        if !(m > 0.0) {
+            m = 0.0;
+        }
+        if corner < 4u {
+            b.nodes_lo[corner] = node;
+            b.weights_lo[corner] = m;
+        } else {
+            b.nodes_hi[corner - 4u] = node;
+            b.weights_hi[corner - 4u] = m;
+        }
+    }
+    return b;
+}
+
+// Rust: `Marginal2D::blended`: the blend of the `f32` at element `at` of each
+// node's block of `block` elements of the section at byte `section`, summed in
+// corner order.
+fn nuld_blended(b: NuldBlend, section: u32, block: u32, at: u32) -> f32 {
+    var s = 0.0;
+    for (var k = 0u; k < 4u; k++) {
+        s = s + b.weights_lo[k] * nuld_f32(section + 4u * (b.nodes_lo[k] * block + at));
+    }
+    for (var k = 0u; k < 4u; k++) {
+        s = s + b.weights_hi[k] * nuld_f32(section + 4u * (b.nodes_hi[k] * block + at));
+    }
+    return s;
+}
+
+// Rust: `Marginal2D::m`: the blend's marginal CDF at row `j`.
+fn nuld_prior_m(pr: NuldBrdfPrior, b: NuldBlend, j: u32) -> f32 {
+    return nuld_blended(b, pr.marginal, pr.size, j);
+}
+
+// Rust: `Marginal2D::c`: the blend's conditional CDF at vertex `i` of row `j`.
+fn nuld_prior_c(pr: NuldBrdfPrior, b: NuldBlend, j: u32, i: u32) -> f32 {
+    return nuld_blended(b, pr.conditional, pr.size * pr.size, j * pr.size + i);
+}
+
+// Rust: `Marginal2D::f`: the blend's density at vertex `i` of row `j`.
+fn nuld_prior_f(pr: NuldBrdfPrior, b: NuldBlend, j: u32, i: u32) -> f32 {
+    return nuld_blended(b, pr.data, pr.size * pr.size, j * pr.size + i);
+}
+
+// Rust: `Marginal2D::c_at`: the conditional CDF at vertex `i` of the row at
+// `y = (j + t) dy`.
+fn nuld_prior_c_at(pr: NuldBrdfPrior, b: NuldBlend, j: u32, t: f32, i: u32) -> f32 {
+    return (1.0 - t) * nuld_prior_c(pr, b, j, i) + t * nuld_prior_c(pr, b, j + 1u, i);
+}
+
+// Rust: `Marginal2D::f_at`: the density at vertex `i` of the row at `y = (j + t) dy`.
+fn nuld_prior_f_at(pr: NuldBrdfPrior, b: NuldBlend, j: u32, t: f32, i: u32) -> f32 {
+    return (1.0 - t) * nuld_prior_f(pr, b, j, i) + t * nuld_prior_f(pr, b, j + 1u, i);
+}
+
+// The `cdf` closures of `Marginal2D::sample`'s two `search`es: along `y`
+// (`axis` 0) the marginal `m(k)`, along `x` (`axis` 1) the row's `c_at(j, t, k)`.
+fn nuld_prior_cdf(pr: NuldBrdfPrior, b: NuldBlend, axis: u32, j: u32, t: f32, k: u32) -> f32 {
+    if axis == 0u {
+        return nuld_prior_m(pr, b, k);
+    }
+    return nuld_prior_c_at(pr, b, j, t, k);
+}
+
+// Rust: `search` (core/src/marginal2d.rs): the interval `k` in `0..n-1` with
+// `cdf(k) <= goal < cdf(k + 1)` (Rust's `target`) of `nuld_prior_cdf` (binary search), stepped off
+// intervals without mass: down while empty, then up while empty.
+fn nuld_search(pr: NuldBrdfPrior, b: NuldBlend, axis: u32, j: u32, t: f32, n: u32, goal: f32) -> u32 {
+    var lo = 0u;
+    var hi = n - 1u;
+    while hi - lo > 1u {
+        let mid = lo + (hi - lo) / 2u;
+        if nuld_prior_cdf(pr, b, axis, j, t, mid) <= goal {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    var k = lo;
+    while k > 0u && nuld_prior_cdf(pr, b, axis, j, t, k + 1u) <= nuld_prior_cdf(pr, b, axis, j, t, k) {
+        k -= 1u;
+    }
+    while k + 2u < n && nuld_prior_cdf(pr, b, axis, j, t, k + 1u) <= nuld_prior_cdf(pr, b, axis, j, t, k) {
+        k += 1u;
+    }
+    return k;
+}
+
+// Rust: `solve_linear`: the `s` in `[0, 1]` with `a s + (b - a) s^2 / 2 = v`
+// (`a, b >= 0`), as `2 v / (a + sqrt(a^2 + 2 (b - a) v))`; 0 without mass.
+fn nuld_solve_linear(a: f32, b: f32, v0: f32) -> f32 {
+    let v = max(v0, 0.0);
+    let disc = max(a * a + 2.0 * (b - a) * v, 0.0);
+    let den = a + sqrt(disc);
+    if den > 0.0 {
+        return nuld_clamp01(2.0 * v / den);
+    }
+    return 0.0;
+}
+
+// Rust: `cell` (core/src/marginal2d.rs): the cell `k <= n - 2` of `x` (clamped into
+// `[0, 1]`) on `n` vertices and the position `s` in it, `x = (k + s) / (n - 1)`.
+struct NuldVertexCell {
+    k: u32,
+    s: f32,
+}
+
+fn nuld_vertex_cell(x: f32, n: u32) -> NuldVertexCell {
+    let pos = nuld_clamp01(x) * f32(n - 1u);
+    let k = min(u32(floor(pos)), n - 2u);
+    return NuldVertexCell(k, nuld_clamp01(pos - f32(k)));
+}
+
+// Rust: `Marginal2D::pdf`: the blend's bilinear value at `p` (clamped) over its
+// mass, per unit area of the square; 0 for a blend without mass.
+fn nuld_marginal_pdf(pr: NuldBrdfPrior, b: NuldBlend, p: vec2<f32>) -> f32 {
+    let total = nuld_prior_m(pr, b, pr.size - 1u);
+    if !(total > 0.0) {
+        return 0.0;
+    }
+    let cx = nuld_vertex_cell(p.x, pr.size);
+    let cy = nuld_vertex_cell(p.y, pr.size);
+    let i = cx.k;
+    let s = cx.s;
+    let j = cy.k;
+    let t = cy.s;
+    let lo = (1.0 - s) * nuld_prior_f(pr, b, j, i) + s * nuld_prior_f(pr, b, j, i + 1u);
+    let hi = (1.0 - s) * nuld_prior_f(pr, b, j + 1u, i) + s * nuld_prior_f(pr, b, j + 1u, i + 1u);
+    return ((1.0 - t) * lo + t * hi) / total;
+}
+
+// Rust: `Marginal2D::sample`: the point of the square drawn from the blend's
+// density at primary sample `u` (clamped, NaN as 0) and its density
+// (`nuld_marginal_pdf`): the marginal's row interval and the root within it for
+// `y`, then the same along the row blended at `y` for `x`.
+struct NuldPointPdf {
+    p: vec2<f32>,
+    pdf: f32,
+}
+
+fn nuld_marginal_sample(pr: NuldBrdfPrior, b: NuldBlend, u: vec2<f32>) -> NuldPointPdf {
+    let n = pr.size;
+    let total = nuld_prior_m(pr, b, n - 1u);
+    let target_y = nuld_clamp01(u.y) * total;
+    let j = nuld_search(pr, b, 0u, 0u, 0.0, n, target_y);
+    let dy = 1.0 / f32(n - 1u);
+    let r0 = nuld_prior_c(pr, b, j, n - 1u);
+    let r1 = nuld_prior_c(pr, b, j + 1u, n - 1u);
+    let t = nuld_solve_linear(r0 * dy, r1 * dy, target_y - nuld_prior_m(pr, b, j));
+    let y = (f32(j) + t) * dy;
+    let row_total = nuld_prior_c_at(pr, b, j, t, n - 1u);
+    // A row without mass (only at a row interval's end): any x, density 0.
+    var x = nuld_clamp01(u.x);
+    if row_total > 0.0 {
+        let target_x = nuld_clamp01(u.x) * row_total;
+        let i = nuld_search(pr, b, 1u, j, t, n, target_x);
+        let dx = 1.0 / f32(n - 1u);
+        let g0 = nuld_prior_f_at(pr, b, j, t, i);
+        let g1 = nuld_prior_f_at(pr, b, j, t, i + 1u);
+        let s = nuld_solve_linear(g0 * dx, g1 * dx, target_x - nuld_prior_c_at(pr, b, j, t, i));
+        x = (f32(i) + s) * dx;
+    }
+    let p = vec2<f32>(min(x, 1.0), min(y, 1.0));
+    return NuldPointPdf(p, nuld_marginal_pdf(pr, b, p));
+}
+
+// `libm::atanf`'s constants (FreeBSD s_atanf.c): `atan(0.5)`, `atan(1)`,
+// `atan(1.5)` and `atan(inf) = pi/2` split in high parts (bits 0x3eed6338,
+// 0x3f490fda, 0x3f7b985e, 0x3fc90fda) and low parts (bits 0x31ac3769, 0x33222168,
+// 0x33140fb4, 0x33a22168), and the coefficients of its polynomial.
+const NULD_ATAN_HI_0: f32 = 4.6364760399e-01;
+const NULD_ATAN_HI_1: f32 = 7.8539812565e-01;
+const NULD_ATAN_HI_2: f32 = 9.8279368877e-01;
+const NULD_ATAN_HI_3: f32 = 1.5707962513e+00;
+const NULD_ATAN_LO_0: f32 = 5.0121582440e-09;
+const NULD_ATAN_LO_1: f32 = 3.7748947079e-08;
+const NULD_ATAN_LO_2: f32 = 3.4473217170e-08;
+const NULD_ATAN_LO_3: f32 = 7.5497894159e-08;
+const NULD_ATAN_T0: f32 = 3.3333328366e-01;
+const NULD_ATAN_T1: f32 = -1.9999158382e-01;
+const NULD_ATAN_T2: f32 = 1.4253635705e-01;
+const NULD_ATAN_T3: f32 = -1.0648017377e-01;
+const NULD_ATAN_T4: f32 = 6.1687607318e-02;
+
+// Rust: `libm::atanf`, operation for operation (its argument reduction to
+// `atan(c) + atan((x - c) / (1 + c x))` for `c` of 0.5, 1, 1.5 and inf, `id` 0-3,
+// and `id` 4 for none, Rust's -1). The built-in `atan` may be far less accurate
+// (Vulkan allows 4096 ulps; lavapipe's moves the BRDF prior's pdf of a direction
+// by 3e-4 relative), and the half vector's square point feeds the prior's table
+// interpolation.
+fn nuld_atan(x0: f32) -> f32 {
+    var x = x0;
+    let hx = bitcast<u32>(x);
+    let negative = (hx >> 31u) != 0u;
+    let ix = hx & 0x7fffffffu;
+    if ix >= 0x4c800000u {
+        // |x| >= 2^26: pi/2 (Rust adds 2^-120, which rounds away), NaN as itself.
+        if nuld_is_nan(x) {
+            return x;
+        }
+        if negative {
+            return -NULD_ATAN_HI_3;
+        }
+        return NULD_ATAN_HI_3;
+    }
+    var id = 4u;
+    if ix < 0x3ee00000u {
+        // |x| < 0.4375; below 2^-12, x itself.
+        if ix < 0x39800000u {
+            return x;
+        }
+    } else {
+        x = abs(x);
+        if ix < 0x3f980000u {
+            if ix < 0x3f300000u {
+                // 7/16 <= |x| < 11/16
+                x = (2.0 * x - 1.0) / (2.0 + x);
+                id = 0u;
+            } else {
+                // 11/16 <= |x| < 19/16
+                x = (x - 1.0) / (x + 1.0);
+                id = 1u;
+            }
+        } else if ix < 0x401c0000u {
+            // |x| < 2.4375
+            x = (x - 1.5) / (1.0 + 1.5 * x);
+            id = 2u;
+        } else {
+            // 2.4375 <= |x| < 2^26
+            x = -1.0 / x;
+            id = 3u;
+        }
+    }
+    let z = x * x;
+    let w = z * z;
+    let s1 = z * (NULD_ATAN_T0 + w * (NULD_ATAN_T2 + w * NULD_ATAN_T4));
+    let s2 = w * (NULD_ATAN_T1 + w * NULD_ATAN_T3);
+    if id == 4u {
+        return x - x * (s1 + s2);
+    }
+    var hi = NULD_ATAN_HI_3;
+    var lo = NULD_ATAN_LO_3;
+    if id == 0u {
+        hi = NULD_ATAN_HI_0;
+        lo = NULD_ATAN_LO_0;
+    } else if id == 1u {
+        hi = NULD_ATAN_HI_1;
+        lo = NULD_ATAN_LO_1;
+    } else if id == 2u {
+        hi = NULD_ATAN_HI_2;
+        lo = NULD_ATAN_LO_2;
+    }
+    let r = hi - ((x * (s1 + s2) - lo) - x);
+    if negative {
+        return -r;
+    }
+    return r;
+}
+
+// Rust: `hemisphere_to_square_real` (core/src/sphere.rs), with libm's `atan`
+// (`nuld_atan`): the inverse of `nuld_square_to_hemisphere` without `atan2`, per wedge of
+// the concentric map (`|x| >= |y|`: `a = r sign(x)`, `b = a atan(y / x) 4/pi`;
+// else `b = r sign(y)`, `a = b atan(x / y) 4/pi`) with `r = sqrt(1 - |z|)`; the
+// pole and NaN read as the centre.
+fn nuld_hemisphere_to_square(d: vec3<f32>) -> vec2<f32> {
+    let r = min(sqrt(max(1.0 - abs(d.z), 0.0)), 1.0);
+    let x = d.x;
+    let y = d.y;
+    let planar = x != 0.0 || y != 0.0;
+    if !(r > 0.0) || !planar || nuld_is_nan(x) || nuld_is_nan(y) {
+        return vec2<f32>(0.5, 0.5);
+    }
+    var a: f32;
+    var b: f32;
+    if abs(x) >= abs(y) {
+        a = nuld_copysign(r, x);
+        b = a * nuld_atan(y / x) * NULD_FRAC_4_PI;
+    } else {
+        b = nuld_copysign(r, y);
+        a = b * nuld_atan(x / y) * NULD_FRAC_4_PI;
+    }
+    return vec2<f32>(0.5 * (a + 1.0), 0.5 * (b + 1.0));
+}
+
+// Rust: `half_vector_direction` and `half_vector_point` (core/src/brdf_prior.rs):
+// a light direction `w` (or a square point `w.xy`) and the Jacobian
+// `jac = |dwi/dh| = 4 wo.h`; `jac = 0` where Rust has `None`.
+struct NuldHalfVector {
+    w: vec3<f32>,
+    jac: f32,
+}
+
+// Rust: `half_vector_direction`: the light direction `wi = 2 (wo.h) h - wo` of
+// the half vector `h` of the square point `p` (divided by its length, as
+// `normalized`), for the unit view `wo`; none where `wo.h <= 0` or `wi.z <= 0`.
+fn nuld_half_vector_direction(wo: vec3<f32>, p: vec2<f32>) -> NuldHalfVector {
+    let missing = NuldHalfVector(vec3<f32>(0.0, 0.0, 1.0), 0.0);
+    let h = nuld_square_to_hemisphere(p);
+    let c = wo.x * h.x + wo.y * h.y + wo.z * h.z;
+    if !(c > 0.0) {
+        return missing;
+    }
+    let two_c = 2.0 * c;
+    let v = vec3<f32>(two_c * h.x - wo.x, two_c * h.y - wo.y, two_c * h.z - wo.z);
+    let len = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+    if !(len > 0.0 && nuld_is_finite(len)) {
+        return missing;
+    }
+    let wi = vec3<f32>(v.x / len, v.y / len, v.z / len);
+    if !(wi.z > 0.0) {
+        return missing;
+    }
+    return NuldHalfVector(wi, 4.0 * c);
+}
+
+// Rust: `half_vector_point`: the square point (in `w.xy`) of the half vector
+// `h = (wo + wi) / |wo + wi|`; none where `wi.z <= 0`, `h.z <= 0` or `wo.h <= 0`.
+fn nuld_half_vector_point(wo: vec3<f32>, wi: vec3<f32>) -> NuldHalfVector {
+    let missing = NuldHalfVector(vec3<f32>(0.5, 0.5, 0.0), 0.0);
+    if !(wi.z > 0.0) {
+        return missing;
+    }
+    let v = vec3<f32>(wo.x + wi.x, wo.y + wi.y, wo.z + wi.z);
+    let len = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+    if !(len > 0.0 && nuld_is_finite(len)) {
+        return missing;
+    }
+    let h = vec3<f32>(v.x / len, v.y / len, v.z / len);
+    let c = wo.x * h.x + wo.y * h.y + wo.z * h.z;
+    if !(h.z > 0.0 && c > 0.0) {
+        return missing;
+    }
+    return NuldHalfVector(vec3<f32>(nuld_hemisphere_to_square(h), 0.0), 4.0 * c);
+}
+
+// Rust: `BrdfPrior::sample`: the light direction of primary sample `u` for the
+// xz-plane view of `cond = (roughness, theta_o in degrees, metallic)` and its
+// solid-angle pdf, the square's over `2 pi |dwi/dh|`; `(+z, 0)` for a point without
+// a direction. Step 11 of core/FORMAT.md.
+fn nuld_brdf_prior_sample(pr: NuldBrdfPrior, cond: vec3<f32>, u: vec2<f32>) -> NuldTreeSample {
+    let wo = nuld_view_direction(cond.y);
+    let s = nuld_marginal_sample(pr, nuld_brdf_blend(pr, cond), u);
+    let hv = nuld_half_vector_direction(wo, s.p);
+    if hv.jac > 0.0 {
+        return NuldTreeSample(hv.w, s.pdf / (2.0 * NULD_PI * hv.jac));
+    }
+    return NuldTreeSample(vec3<f32>(0.0, 0.0, 1.0), 0.0);
+}
+
+// Rust: `BrdfPrior::pdf`: the solid-angle pdf of `nuld_brdf_prior_sample`'s
+// directions at the unit direction `wi` (xz-plane view); 0 where the prior draws
+// nothing.
+fn nuld_brdf_prior_pdf(pr: NuldBrdfPrior, cond: vec3<f32>, wi: vec3<f32>) -> f32 {
+    let wo = nuld_view_direction(cond.y);
+    let hv = nuld_half_vector_point(wo, wi);
+    if hv.jac > 0.0 {
+        return nuld_marginal_pdf(pr, nuld_brdf_blend(pr, cond), hv.w.xy) / (2.0 * NULD_PI * hv.jac);
+    }
+    return 0.0;
+}
+
 // ---- Samples (runtime/src/brdf.rs) -------------------------------------
 
 // Rust: `Sample`: a unit direction (local frame, `z` = normal), the estimator
-// weight of its condition, and the prior's solid-angle pdf at the direction (0
-// for a sampler without an exact prior). 32 bytes in a storage buffer.
+// weight (of its condition; for BRDF samplers on the tabulated prior, warp 3,
+// `f cos / pdf` of the direction), and the prior's solid-angle pdf at the
+// direction (0 for a sampler without an exact prior). 32 bytes in a storage
+// buffer.
 struct NuldSample {
     direction: vec3<f32>,
     weight: f32,
@@ -1072,56 +1641,111 @@ struct NuldSample {
 // Rust: `ConditionalSampler::sample` (table mode): direction `i` (mod n) of
 // instance `instance` (mod instances) at condition `cond` (blob units; for BRDF
 // samplers `(roughness, theta_o in degrees)`, the view in the xz-plane, `+x` side;
-// for environment samplers the normal's octahedral square point).
+// for environment samplers the normal's octahedral square point); a BRDF sampler
+// on the tabulated prior (warp 3) samples the dielectric (metallic 0).
 fn nuld_sample(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
+    return nuld_sample_metallic(cond, 0.0, instance, i);
+}
+
+// Rust: `ConditionalSampler::sample_metallic`: `nuld_sample` for a BRDF of
+// metallic `metallic` (clamped into `[0, 1]`, NaN as 0), which warp 3 reads and
+// every other warp ignores.
+fn nuld_sample_metallic(cond: vec2<f32>, metallic: f32, instance: u32, i: u32) -> NuldSample {
     let cs = nuld_conditional();
     let u = nuld_normalize(cs.info, cond);
-    return nuld_mapped(cs, nuld_square_point_of(cs, u, instance, i), u);
+    return nuld_mapped(cs, nuld_square_point_of(cs, u, instance, i), u, metallic);
 }
 
 // Rust: `ConditionalSampler::sample_randomized` (table mode, the unbiased mode):
 // the table's point shifted on the torus by `nuld_randomization_shift(seed)`.
 fn nuld_sample_randomized(cond: vec2<f32>, instance: u32, i: u32, seed: u32) -> NuldSample {
+    return nuld_sample_randomized_metallic(cond, 0.0, instance, i, seed);
+}
+
+// Rust: `ConditionalSampler::sample_randomized_metallic`: the unbiased mode at
+// metallic `metallic` (`nuld_sample_metallic`).
+fn nuld_sample_randomized_metallic(cond: vec2<f32>, metallic: f32, instance: u32, i: u32, seed: u32) -> NuldSample {
     let cs = nuld_conditional();
     let u = nuld_normalize(cs.info, cond);
     let p = nuld_square_point_of(cs, u, instance, i);
-    return nuld_mapped(cs, nuld_torus_shift(p, nuld_randomization_shift(seed)), u);
+    return nuld_mapped(cs, nuld_torus_shift(p, nuld_randomization_shift(seed)), u, metallic);
 }
 
 // Rust: `NetworkSampler::sample` (network mode): as `nuld_sample`;
 // instances wrap modulo the instance slots (without slots every u32 is its own set).
 fn nuld_sample_network(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
+    return nuld_sample_network_metallic(cond, 0.0, instance, i);
+}
+
+// Rust: `NetworkSampler::sample_metallic`: network mode at metallic `metallic`.
+fn nuld_sample_network_metallic(cond: vec2<f32>, metallic: f32, instance: u32, i: u32) -> NuldSample {
     let cs = nuld_conditional();
     let u = nuld_normalize(cs.info, cond);
-    return nuld_mapped(cs, nuld_network_square_point_of(cs, u, instance, i), u);
+    return nuld_mapped(cs, nuld_network_square_point_of(cs, u, instance, i), u, metallic);
 }
 
 // Rust: `NetworkSampler::sample_randomized`: the unbiased mode in network mode.
 fn nuld_sample_network_randomized(cond: vec2<f32>, instance: u32, i: u32, seed: u32) -> NuldSample {
+    return nuld_sample_network_randomized_metallic(cond, 0.0, instance, i, seed);
+}
+
+// Rust: `NetworkSampler::sample_randomized_metallic`: the unbiased mode in network
+// mode at metallic `metallic`.
+fn nuld_sample_network_randomized_metallic(cond: vec2<f32>, metallic: f32, instance: u32, i: u32, seed: u32) -> NuldSample {
     let cs = nuld_conditional();
     let u = nuld_normalize(cs.info, cond);
     let p = nuld_network_square_point_of(cs, u, instance, i);
-    return nuld_mapped(cs, nuld_torus_shift(p, nuld_randomization_shift(seed)), u);
+    return nuld_mapped(cs, nuld_torus_shift(p, nuld_randomization_shift(seed)), u, metallic);
 }
 
 // Rust: `ConditionalSampler::pdf`: the prior's solid-angle pdf at the unit
-// `direction` for condition `cond` (environment samplers; 0 for the others).
+// `direction` for condition `cond` (environment samplers, and BRDF samplers on
+// the tabulated prior at metallic 0; 0 for the others).
 fn nuld_pdf(cond: vec2<f32>, direction: vec3<f32>) -> f32 {
+    return nuld_pdf_metallic(cond, 0.0, direction);
+}
+
+// Rust: `ConditionalSampler::pdf_metallic`: `nuld_pdf` at metallic `metallic`
+// (warp 3's prior at the clamped condition; the environment tree at the normal of
+// the clamped condition).
+fn nuld_pdf_metallic(cond: vec2<f32>, metallic: f32, direction: vec3<f32>) -> f32 {
     let cs = nuld_conditional();
-    if cs.info.warp != NULD_WARP_ENVMAP_TREE {
-        return 0.0;
+    let c = nuld_denormalize(cs.info, nuld_normalize(cs.info, cond));
+    if cs.info.warp == NULD_WARP_ENVMAP_TREE {
+        return nuld_tree_pdf_square(nuld_tree(), c, direction);
     }
-    let u = nuld_normalize(cs.info, cond);
-    return nuld_tree_pdf_square(nuld_tree(), nuld_denormalize(cs.info, u), direction);
+    if cs.info.warp == NULD_WARP_BRDF_TABLE {
+        return nuld_brdf_prior_pdf(nuld_brdf_prior(), vec3<f32>(c.x, c.y, metallic), direction);
+    }
+    return 0.0;
+}
+
+// Rust: `ConditionalSampler::albedo`: the directional albedo at `cond` of a BRDF
+// of metallic `metallic` (clamped into `[0, 1]`, NaN as 0): for warp 3
+// `(1 - m) A_0 + m A_1`, the weight section's two tables interpolated as the
+// weights; for every other warp the weight (`nuld_weight`).
+fn nuld_albedo(cond: vec2<f32>, metallic: f32) -> f32 {
+    let cs = nuld_conditional();
+    let cell = nuld_locate(nuld_normalize(cs.info, cond), cs.info.weight_grid);
+    let dielectric = nuld_weight_table_lerp(cs, cell, 0u);
+    if cs.info.warp != NULD_WARP_BRDF_TABLE {
+        return dielectric;
+    }
+    let m = nuld_clamp01(metallic);
+    return (1.0 - m) * dielectric + m * nuld_weight_table_lerp(cs, cell, 1u);
 }
 
 // Rust: `ConditionalSampler::mapped`: the sample of the square point `p` at the
 // normalized condition `u`: the direction of the blob's point warp (warp 0: the
 // domain's equal-area map; warp 1: the BRDF mixture at the clamped condition with
 // the lobe probability of the weight section's second table; warp 2: the
-// environment tree at the normal of the clamped condition, with its pdf) and the
-// weight.
-fn nuld_mapped(cs: NuldConditional, p: vec2<f32>, u: vec2<f32>) -> NuldSample {
+// environment tree at the normal of the clamped condition, with its pdf; warp 3:
+// the BRDF prior at the clamped condition and `metallic`, with its pdf) and the
+// weight (warp 3: `f cos / pdf` of the direction, `nuld_brdf_table_mapped`).
+fn nuld_mapped(cs: NuldConditional, p: vec2<f32>, u: vec2<f32>, metallic: f32) -> NuldSample {
+    if cs.info.warp == NULD_WARP_BRDF_TABLE {
+        return nuld_brdf_table_mapped(cs, p, u, metallic);
+    }
     let cell = nuld_locate(u, cs.info.weight_grid);
     let weight = nuld_weight_table_lerp(cs, cell, 0u);
     if cs.info.warp == NULD_WARP_ENVMAP_TREE {
@@ -1136,6 +1760,25 @@ fn nuld_mapped(cs: NuldConditional, p: vec2<f32>, u: vec2<f32>) -> NuldSample {
         direction = nuld_to_direction(cs.info.domain, p);
     }
     return NuldSample(direction, weight, 0.0);
+}
+
+// Rust: the `PointWarp::BrdfTable` branch of `ConditionalSampler::mapped`: the
+// prior's direction and pdf at the clamped condition `(roughness, theta_o)` and
+// `metallic` (`nuld_brdf_prior_sample`), and the weight `f cos / pdf` with `f` the
+// glTF BRDF with metallic (`nuld_gltf_metallic`; 0 where the pdf is 0 or the
+// quotient is not finite). Step 11 of core/FORMAT.md.
+fn nuld_brdf_table_mapped(cs: NuldConditional, p: vec2<f32>, u: vec2<f32>, metallic: f32) -> NuldSample {
+    let c = nuld_denormalize(cs.info, u);
+    let s = nuld_brdf_prior_sample(nuld_brdf_prior(), vec3<f32>(c.x, c.y, metallic), p);
+    let f = nuld_gltf_metallic(nuld_view_direction(c.y), s.direction, c.x, metallic);
+    var weight = 0.0;
+    if s.pdf > 0.0 {
+        weight = f * s.direction.z / s.pdf;
+    }
+    if !nuld_is_finite(weight) {
+        weight = 0.0;
+    }
+    return NuldSample(s.direction, weight, s.pdf);
 }
 
 // `libm::acosf`'s constants (FreeBSD e_acosf.c): pi/2 split in a high part
@@ -1226,17 +1869,61 @@ fn nuld_rotate(s: NuldSample, azimuth: vec2<f32>) -> NuldSample {
     return NuldSample(vec3<f32>(c * d.x - sn * d.y, sn * d.x + c * d.y, d.z), s.weight, s.pdf);
 }
 
-// Rust: `BrdfSampler::sample` (table mode, glTF BRDF samplers): the set
-// at `(roughness, theta_o)` of the view `wo` (local frame, `z` = normal, any length),
-// turned about `z` to the view's azimuth.
-fn nuld_sample_brdf(wo: vec3<f32>, roughness: f32, instance: u32, i: u32) -> NuldSample {
+// Rust: `unrotate` (runtime/src/brdf.rs): `d` turned about `z` by minus the
+// azimuth `(cos phi, sin phi)`, into the frame of the xz-plane view.
+fn nuld_unrotate(d: vec3<f32>, azimuth: vec2<f32>) -> vec3<f32> {
+    let c = azimuth.x;
+    let sn = azimuth.y;
+    return vec3<f32>(c * d.x + sn * d.y, -sn * d.x + c * d.y, d.z);
+}
+
+// Rust: `BrdfSampler::sample` (table mode, glTF BRDF samplers): the set at
+// `(roughness, theta_o)` of the view `wo` (local frame, `z` = normal, any length)
+// and `metallic` (clamped into `[0, 1]`, NaN as 0; read by the tabulated prior,
+// warp 3, ignored by the mixture prior), turned about `z` to the view's azimuth.
+// Warp 3: `pdf` is the prior's and `weight` is `f cos / pdf`; the mixture prior:
+// pdf 0 and the dielectric's albedo as the weight.
+fn nuld_sample_brdf(wo: vec3<f32>, roughness: f32, metallic: f32, instance: u32, i: u32) -> NuldSample {
     let view = nuld_view_condition(wo, roughness);
-    return nuld_rotate(nuld_sample(view.cond, instance, i), view.azimuth);
+    return nuld_rotate(nuld_sample_metallic(view.cond, metallic, instance, i), view.azimuth);
+}
+
+// Rust: `BrdfSampler::sample_randomized` (the unbiased mode): `nuld_sample_brdf`
+// with the table's point shifted on the torus by `nuld_randomization_shift(seed)`
+// (`seed`: the pixel's random number).
+fn nuld_sample_brdf_randomized(wo: vec3<f32>, roughness: f32, metallic: f32, instance: u32, i: u32, seed: u32) -> NuldSample {
+    let view = nuld_view_condition(wo, roughness);
+    let s = nuld_sample_randomized_metallic(view.cond, metallic, instance, i, seed);
+    return nuld_rotate(s, view.azimuth);
 }
 
 // Rust: `BrdfNetwork::sample` (network mode): as
-// `nuld_sample_brdf` with `nuld_sample_network`.
-fn nuld_sample_brdf_network(wo: vec3<f32>, roughness: f32, instance: u32, i: u32) -> NuldSample {
+// `nuld_sample_brdf` with `nuld_sample_network_metallic`.
+fn nuld_sample_brdf_network(wo: vec3<f32>, roughness: f32, metallic: f32, instance: u32, i: u32) -> NuldSample {
     let view = nuld_view_condition(wo, roughness);
-    return nuld_rotate(nuld_sample_network(view.cond, instance, i), view.azimuth);
+    return nuld_rotate(nuld_sample_network_metallic(view.cond, metallic, instance, i), view.azimuth);
+}
+
+// Rust: `BrdfNetwork::sample_randomized`: the unbiased mode in network mode.
+fn nuld_sample_brdf_network_randomized(wo: vec3<f32>, roughness: f32, metallic: f32, instance: u32, i: u32, seed: u32) -> NuldSample {
+    let view = nuld_view_condition(wo, roughness);
+    let s = nuld_sample_network_randomized_metallic(view.cond, metallic, instance, i, seed);
+    return nuld_rotate(s, view.azimuth);
+}
+
+// Rust: `BrdfSampler::pdf` (both modes share the prior): the solid-angle density
+// of the sampler's prior at the unit `direction` (local frame) for the view `wo`,
+// `roughness` and `metallic` (multiple importance sampling); 0 below the horizon
+// and for the mixture prior.
+fn nuld_pdf_brdf(wo: vec3<f32>, roughness: f32, metallic: f32, direction: vec3<f32>) -> f32 {
+    let view = nuld_view_condition(wo, roughness);
+    return nuld_pdf_metallic(view.cond, metallic, nuld_unrotate(direction, view.azimuth));
+}
+
+// Rust: `BrdfSampler::albedo`: the directional albedo `A = integral of f cos` at the
+// view `wo`, `roughness` and `metallic` (`nuld_albedo`): the weight of the
+// fixed-instance estimator `(A / N) sum L(direction_i)`.
+fn nuld_albedo_brdf(wo: vec3<f32>, roughness: f32, metallic: f32) -> f32 {
+    let view = nuld_view_condition(wo, roughness);
+    return nuld_albedo(view.cond, metallic);
 }

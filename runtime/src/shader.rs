@@ -4,9 +4,14 @@
 //!
 //! [`WGSL`] is a library of functions, one per runtime function, each named
 //! `nuld_` + the Rust name (`nuld_sample` is [`ConditionalSampler::sample`],
-//! `nuld_sample_brdf` is `BrdfSampler::sample`,
+//! `nuld_sample_metallic` is [`ConditionalSampler::sample_metallic`],
+//! `nuld_sample_brdf(wo, roughness, metallic, instance, i)` is
+//! [`BrdfSampler::sample`], `nuld_pdf_brdf` is [`BrdfSampler::pdf`],
 //! `nuld_direction` is [`DirectionSet::direction`], ...), with a comment naming its
-//! Rust twin. It reads the blob from a storage buffer that the including shader
+//! Rust twin. Every point warp is there: the equal-area maps, the BRDF mixture,
+//! the environment tree and the tabulated BRDF prior with its metallic (warp 3:
+//! the prior's pdf, the weight `f cos / pdf` with the glTF BRDF, the albedo
+//! `nuld_albedo_brdf`). It reads the blob from a storage buffer that the including shader
 //! declares under the name [`BLOB_VARIABLE`], at any group and binding:
 //!
 //! ```text
@@ -24,14 +29,20 @@
 //! WGSL array access does, but its values mean nothing).
 //!
 //! Precision: the functions follow the runtime's `f32` order of operations and
-//! port libm's `acosf` (a driver's `acos` may be far less accurate); f16
-//! parameters are decoded exactly with integer operations. What remains is the
-//! driver's rounding of `sin`, `cos`, `sqrt`, division and `exp`, and its freedom
-//! to fuse a multiply and an add (`DirectionSet::direction` maps in `f64`, the
-//! shader in `f32`). `tests/tests/shader.rs` holds lavapipe to 8 `f32` ulps of 1.0
-//! in table mode and to `1e-4` in network mode.
+//! port libm's `acosf` and `atanf` (a driver's `acos` and `atan` may be far less
+//! accurate); f16 parameters are decoded exactly with integer operations. What
+//! remains is the driver's rounding of `sin`, `cos`, `sqrt`, division, `exp` and
+//! `atan` (an environment sampler's pdf of a given direction), and its freedom to
+//! fuse a multiply and an add
+//! (`DirectionSet::direction` maps in `f64`, the shader in `f32`).
+//! `tests/tests/shader.rs` holds lavapipe to 8 `f32` ulps of 1.0 in table mode
+//! and to `1e-4` in network mode, divided by the warp's local gain for the
+//! warps that magnify a rounding of the square point (its docs).
 //!
 //! [`ConditionalSampler::sample`]: crate::ConditionalSampler::sample
+//! [`ConditionalSampler::sample_metallic`]: crate::ConditionalSampler::sample_metallic
+//! [`BrdfSampler::sample`]: crate::BrdfSampler::sample
+//! [`BrdfSampler::pdf`]: crate::BrdfSampler::pdf
 //! [`DirectionSet::direction`]: crate::DirectionSet::direction
 
 use bytemuck::{Pod, Zeroable};
@@ -42,7 +53,8 @@ use bytemuck::{Pod, Zeroable};
 pub const WGSL: &str = include_str!("../shaders/nuld.wgsl");
 
 /// The sampling kernel (runtime/shaders/nuld_kernel.wgsl): bindings 0 (blob),
-/// 1 (output, one 16-byte `NuldSample` per sample: direction `xyz`, weight `w`) and
+/// 1 (output, one `NuldSample` of [`SAMPLE_STRIDE`] bytes per sample: direction
+/// `xyz`, weight, pdf) and
 /// 2 ([`KernelParams`] uniform) of group 0, and the compute entry point
 /// [`KERNEL_ENTRY_POINT`]. Valid WGSL only after [`WGSL`]: use [`kernel_wgsl`].
 pub const KERNEL_WGSL: &str = include_str!("../shaders/nuld_kernel.wgsl");
@@ -81,7 +93,10 @@ const KERNEL_SOURCE: &str = concat!(
     include_str!("../shaders/nuld_kernel.wgsl")
 );
 
-/// What the kernel computes per sample of a conditional blob ([`KernelParams::mode`]).
+/// What the kernel computes per sample of a conditional blob ([`KernelParams::mode`]),
+/// at the metallic `KernelParams::view[3]` (read by BRDF samplers on the tabulated
+/// prior, [`nuld_core::conditional::PointWarp::BrdfTable`]; the plain modes are the
+/// `_metallic` functions, `nuld_sample_metallic` for `nuld_sample` and so on).
 /// Point and direction set blobs ignore it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u32)]
@@ -102,9 +117,21 @@ pub enum KernelMode {
     /// `nuld_sample_network_randomized` with seed `e`
     /// ([`crate::NetworkSampler::sample_randomized`]).
     NetworkRandomized = 5,
-    /// `nuld_sample`, its pdf replaced by `nuld_pdf` at its direction
-    /// ([`crate::ConditionalSampler::pdf`]).
+    /// `nuld_sample_metallic`, its pdf replaced by `nuld_pdf_metallic` at its
+    /// direction ([`crate::ConditionalSampler::pdf_metallic`]) and its weight by
+    /// `nuld_albedo` ([`crate::ConditionalSampler::albedo`]; the weight itself
+    /// except for BRDF samplers on the tabulated prior).
     Pdf = 6,
+    /// `nuld_sample_brdf_randomized` at [`KernelParams::view`] with seed `e`
+    /// ([`crate::BrdfSampler::sample_randomized`]).
+    BrdfTableRandomized = 7,
+    /// `nuld_sample_brdf_network_randomized` with seed `e`
+    /// ([`crate::BrdfNetwork::sample_randomized`]).
+    BrdfNetworkRandomized = 8,
+    /// `nuld_sample_brdf`, its pdf replaced by `nuld_pdf_brdf` at its direction
+    /// ([`crate::BrdfSampler::pdf`]) and its weight by `nuld_albedo_brdf`
+    /// ([`crate::BrdfSampler::albedo`]).
+    BrdfPdf = 9,
 }
 
 /// The kernel's uniform (binding 2; WGSL `NuldKernelParams`, 64 bytes, the same
@@ -137,7 +164,8 @@ pub struct KernelParams {
     pub mode: u32,
     /// Zero (padding).
     pub reserved: u32,
-    /// The view `wo` (`xyz`, local frame, any length) of the BRDF modes; `w` unused.
+    /// The view `wo` (`xyz`, local frame, any length) of the BRDF modes, and the
+    /// metallic (`w`) of every conditional mode (0 from [`Self::new`]).
     pub view: [f32; 4],
 }
 
@@ -159,7 +187,7 @@ impl KernelParams {
 
     /// The range `cond_count` conditions from `cond_first` by `cond_step`, the
     /// instances and indices of the two ranges (empty ranges give no samples), in
-    /// `mode`, at the view `+z`.
+    /// `mode`, at the view `+z` and metallic 0.
     pub fn new(
         mode: KernelMode,
         cond_first: [f32; 2],

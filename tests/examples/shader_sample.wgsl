@@ -13,7 +13,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x % n;
     let wo = normalize(vec3<f32>(0.3, 0.4, 0.866)); // view, local frame, z = normal
     let roughness = 0.4;
-    let s = nuld_sample_brdf(wo, roughness, pixel, i); // table mode
-    // estimate of the pixel: s.weight / n * sum over i of L(s.direction)
+    let metallic = 0.0; // glTF's material parameters
+    let s = nuld_sample_brdf(wo, roughness, metallic, pixel, i); // table mode
+    // estimate of the pixel: 1 / n * sum over i of s.weight * L(s.direction)
     out[id.x] = vec4<f32>(s.direction, s.weight);
 }

@@ -1,15 +1,19 @@
 //! The WGSL sampler (`nuld_runtime::shader`) run by a real Vulkan driver through
 //! wgpu, against `nuld-runtime` on the CPU, over grids of (condition, instance,
-//! index): point and direction sets, a briefly trained and distilled BRDF sampler,
-//! and a random-content sampler with the shapes training does not use (SiLU, three
-//! layers, a lattice generator whose products overflow 32 bits).
+//! index): point and direction sets, a briefly trained and distilled BRDF sampler
+//! (on the tabulated prior, warp 3), and random-content samplers with the shapes
+//! training does not use (SiLU, three layers, a lattice generator whose products
+//! overflow 32 bits) on every point warp; the tabulated prior's samplers at
+//! metallic 0, 0.5 and 1, with the unbiased mode, the pdf of a direction and the
+//! albedo.
 //!
 //! On a machine without an adapter the tests print why (on stderr, shown with
 //! `--nocapture`) and pass, except under CI (the `CI` environment variable set),
 //! where they fail: CI installs lavapipe, the CPU Vulkan driver
 //! (`apt-get install mesa-vulkan-drivers libvulkan1`).
 //!
-//! Tolerances, in absolute terms on unit-vector components and weights:
+//! Tolerances, in absolute terms on unit-vector components and weights, relative
+//! on the pdf:
 //! * 2D point sets: exact;
 //! * directions and weights in table mode, at conditions and at BRDF views
 //!   (`BrdfSampler::sample`): [`TABLE_TOLERANCE`] = 8 f32 ulps of 1.0 (`8 * 2^-23`, 9.5e-7):
@@ -24,23 +28,37 @@
 //!   largest column norm): near the rim of the visible-normal disk a rounding of
 //!   the square point or of an intermediate moves the direction by up to a few
 //!   hundred times as much, for the runtime as for the shader. The raw maxima are
-//!   printed too.
+//!   printed too;
+//! * for the tabulated BRDF prior (warp 3) they apply to each part of the sample
+//!   divided by its own gain ([`brdf_table_gain`]): the direction's (the inverted
+//!   CDFs move the square point by a rounding over the density), the weight's
+//!   `f cos / pdf` (GGX at roughness 0.1 turns an ulp of `n.h` into up to `4
+//!   10^4` ulps of `f`) and the pdf's (the pdf of a direction reads its square
+//!   point through `sqrt(1 - h.z)`). The raw differences are the runtime's own
+//!   `f32` error's size: on lavapipe up to 6.4e-4 on a direction, 0.39 on a
+//!   weight (of a 5 x 5 prior's; 2.6e-2 on the trained sampler's, whose weights
+//!   reach 10 at roughness 0.1) and 2.2e-3 relative on a pdf, in network mode;
+//!   2.5e-4, 0.36 and 1.2e-3 in table mode. Divided by their gains the largest is
+//!   3.6e-7 in table mode (3 ulps of 1.0), 3.9e-7 in network mode.
 //!
 //! Each test prints the largest difference it measured.
 
 #[path = "../examples/shader_sample.rs"]
 mod shader_sample;
 
-use nuld_core::blob::Domain;
+use nuld_core::blob::{Domain, Layout, SectionTag};
+use nuld_core::brdf::{alpha, gltf_metallic_parts, view_direction_real};
+use nuld_core::brdf_prior::{half_vector_direction, half_vector_point, BrdfPrior, BrdfPriorInfo};
 use nuld_core::conditional::PointWarp;
 use nuld_core::conditional::{randomization_shift, torus_shift};
 use nuld_core::network::Activation;
-use nuld_runtime::glam::{DVec3, Vec2, Vec3};
+use nuld_runtime::glam::{DVec2, DVec3, Vec2, Vec3};
 use nuld_runtime::shader::SAMPLE_STRIDE;
 use nuld_runtime::shader::{kernel_wgsl, KernelMode, KernelParams, KERNEL_ENTRY_POINT};
 use nuld_runtime::{Blob, BrdfSampler, ConditionalSampler, Sample};
 use nuld_tests::{
-    as_envmap, conditional_parts, distilled_parts, fixture_tree, shape, sobol_blob, META,
+    as_envmap, conditional_parts, distilled_parts, fixture_tree, shape, small_brdf_prior,
+    sobol_blob, with_brdf_prior, META,
 };
 use shader_sample::Gpu;
 use std::sync::OnceLock;
@@ -145,17 +163,59 @@ fn sample_of(p: &KernelParams, e: u32) -> (Vec2, u32, u32) {
     (cond, p.instance_first + k, p.index_first + i)
 }
 
-/// Largest absolute difference of direction components and weight.
-/// The largest difference of direction components and weight, and the pdf's
-/// relative difference.
-fn gap(gpu: &GpuSample, cpu: Sample) -> f32 {
+/// The differences of a sample: the largest of the direction's components, the
+/// weight's, and the pdf's relative to the runtime's.
+#[derive(Clone, Copy, Debug, Default)]
+struct Gap {
+    direction: f32,
+    weight: f32,
+    pdf: f32,
+}
+
+impl Gap {
+    /// The largest of the three.
+    fn max(self) -> f32 {
+        self.direction.max(self.weight).max(self.pdf)
+    }
+
+    /// The largest of the three, each over its gain.
+    fn scaled(self, gain: Gain) -> f32 {
+        (self.direction / gain.direction)
+            .max(self.weight / gain.weight)
+            .max(self.pdf / gain.pdf)
+    }
+}
+
+/// How much a warp magnifies a rounding, per part of the sample ([`warp_gain`]):
+/// the factor on the tolerance of the direction's, the weight's and the pdf's
+/// difference.
+#[derive(Clone, Copy, Debug)]
+struct Gain {
+    direction: f32,
+    weight: f32,
+    pdf: f32,
+}
+
+impl Gain {
+    /// The same gain for every part.
+    fn all(g: f32) -> Self {
+        Self {
+            direction: g,
+            weight: g,
+            pdf: g,
+        }
+    }
+}
+
+/// The gap of the kernel's sample from the runtime's.
+fn gap(gpu: &GpuSample, cpu: Sample) -> Gap {
     let (g, more) = gpu;
     let d = Vec3::new(g[0], g[1], g[2]) - cpu.direction;
-    let pdf = (more[0] - cpu.pdf).abs() / cpu.pdf.max(f32::MIN_POSITIVE);
-    d.abs()
-        .max_element()
-        .max((g[3] - cpu.weight).abs())
-        .max(pdf)
+    Gap {
+        direction: d.abs().max_element(),
+        weight: (g[3] - cpu.weight).abs(),
+        pdf: (more[0] - cpu.pdf).abs() / cpu.pdf.max(f32::MIN_POSITIVE),
+    }
 }
 
 #[test]
@@ -194,7 +254,7 @@ fn shader_point_and_direction_sets_match_the_runtime() {
                     weight: 1.0,
                     pdf: 0.0,
                 };
-                worst = worst.max(gap(got, want));
+                worst = worst.max(gap(got, want).max());
             }
         }
         println!(
@@ -216,15 +276,28 @@ fn shader_point_and_direction_sets_match_the_runtime() {
 /// nears 1 (the rim of the visible-normal disk, where `sqrt(1 - p1^2 - p2^2)`
 /// cancels): there the same `f32` operations, rounded by another `sqrt`, `sin` or
 /// division, move the direction by far more than a few ulps (the runtime's own
-/// `f32` result is as far from the exact direction).
-fn warp_gain(cs: &ConditionalSampler, cond: Vec2, p: Vec2) -> f32 {
+/// `f32` result is as far from the exact direction). For the tabulated BRDF
+/// prior `prior` (the blob's, in `f64`) at `metallic`, one gain per part of the
+/// sample: [`brdf_table_gain`].
+fn warp_gain(
+    cs: &ConditionalSampler,
+    prior: Option<&BrdfPrior<'_, f64>>,
+    cond: Vec2,
+    metallic: f32,
+    p: Vec2,
+) -> Gain {
     let info = cs.info();
     let warp = info.point_warp().expect("a parsed blob's warp");
     if warp == PointWarp::EqualArea {
-        return 1.0;
+        return Gain::all(1.0);
     }
     // The clamped condition, as the runtime's tables and warp see it.
     let c = info.denormalize(info.normalize(cond.to_array()));
+    if warp == PointWarp::BrdfTable {
+        let prior = prior.expect("the prior of a warp-3 blob");
+        let cond = [c[0] as f64, c[1] as f64, metallic as f64];
+        return brdf_table_gain(prior, cond, p.as_dvec2().to_array());
+    }
     let fixture = fixture_tree();
     let tree = fixture.tree();
     let columns = warp.direction_differences(
@@ -239,7 +312,170 @@ fn warp_gain(cs: &ConditionalSampler, cond: Vec2, p: Vec2) -> f32 {
         .iter()
         .map(|d| DVec3::from_array(*d).length())
         .fold(0.0, f64::max);
-    1.0 + j as f32
+    Gain::all(1.0 + j as f32)
+}
+
+/// The gains of the tabulated BRDF prior's warp (warp 3) at the clamped
+/// condition `cond = [roughness, θo, metallic]` and primary point `u`, each
+/// `1 + J` in `f64` over the blob's tables widened (central differences of step
+/// `2^-20`, the largest over two axes):
+/// * the direction: `J` the length of its differences along `u`. The warp inverts
+///   the tables' CDFs, so a rounding of a CDF value moves the square point `p` by
+///   the rounding over the density, as a perturbation of `u` does;
+/// * the weight `f cos / pdf` and the pdf (compared relatively): along `u`, `f
+///   cos` and the pdf vary together, but a rounding moves `p` in any direction,
+///   by up to `1 + P` ulps (`P` the largest column norm of `dp/du`), and across
+///   the tables' cells the two do not follow each other: `J` the larger of their
+///   differences along `u` and those along `p` times `1 + P`;
+/// * both also along the direction (two tangents; the weight's `f cos` at the
+///   sample's pdf, the pdf of the direction) times the direction's gain: the
+///   half-vector map's own roundings (the reflection cancels at grazing views)
+///   move the direction but not `p`;
+/// * the weight also: `weight (specular / f) 4 c (1 - a^2) / t`, its change per
+///   unit of `c = n.h`: GGX's `D = a^2 / (pi t^2)` with `t = c^2 (a^2 - 1) + 1`
+///   cancels near the peak of a smooth lobe (`t` down to `a^2 = 10^-4` at
+///   roughness 0.1), so an ulp of `n.h` (another rounding of the view's `sin` and
+///   `cos`, of a normalization, a fused multiply-add) changes `f` by up to
+///   `4 10^4` ulps, for the runtime as for the shader;
+/// * the pdf also (the pdf of a given direction): the relative differences of
+///   the square's density `pdf 2 pi 4 (wo.h)` along the half vector's `h.z`: the
+///   pdf of a direction reads the half vector's square point through `r =
+///   sqrt(1 - h.z)`, which turns an ulp of `h.z`, from the normalization of `wo +
+///   wi`, into a radial step of `ulp / (4 r)` in the square near the normal (60
+///   ulps of the point where `1 - h.z` is 250 ulps), a step the solid-angle
+///   pdf's Jacobian `4 wo.h` does not take with it.
+///
+/// At a cell's edge the differences see the density's kink, at a point without
+/// direction (`(+z, 0)`) a jump.
+fn brdf_table_gain(prior: &BrdfPrior<'_, f64>, cond: [f64; 3], u: [f64; 2]) -> Gain {
+    let h = 1.0 / 1_048_576.0;
+    let wo = view_direction_real(cond[1]);
+    let wo3 = DVec3::from_array(wo);
+    let clamped = |q: [f64; 2]| q.map(|x| x.clamp(0.0, 1.0));
+    // What a sample of the light direction `wi` with pdf `pdf` holds, and its
+    // square point.
+    let sample = |wi: [f64; 3], pdf: f64| {
+        let f = gltf_metallic_parts(wo, wi, cond[0], cond[2]);
+        let weight = if pdf > 0.0 {
+            f.total() * wi[2] / pdf
+        } else {
+            0.0
+        };
+        let p = half_vector_point(wo, wi).map_or([0.5; 2], |(p, _)| p);
+        (DVec3::from_array(wi), weight, pdf, f, DVec2::from_array(p))
+    };
+    let by_u = |q: [f64; 2]| {
+        let (wi, pdf) = prior.sample(cond, clamped(q));
+        sample(wi, pdf)
+    };
+    let by_p = |q: [f64; 2]| match half_vector_direction(wo, clamped(q)) {
+        Some((wi, _)) => sample(wi, prior.pdf(cond, wi)),
+        None => sample([0.0, 0.0, 1.0], 0.0),
+    };
+    let (wi, weight, pdf, f, p) = by_u(u);
+    let relative = |d: f64| d / pdf.max(f64::MIN_POSITIVE);
+    // The largest differences of `at` along the two axes from `start`: of the
+    // direction, the weight, the pdf (relative) and the square point.
+    let differences = |at: &dyn Fn([f64; 2]) -> _, start: [f64; 2]| {
+        let mut most = [0.0f64; 4];
+        for axis in 0..2 {
+            let (mut lo, mut hi) = (start, start);
+            lo[axis] -= h;
+            hi[axis] += h;
+            let (d0, w0, p0, _, q0): (DVec3, f64, f64, _, DVec2) = at(lo);
+            let (d1, w1, p1, _, q1) = at(hi);
+            let parts = [
+                (d1 - d0).length(),
+                (w1 - w0).abs(),
+                relative((p1 - p0).abs()),
+                (q1 - q0).length(),
+            ];
+            for (m, d) in most.iter_mut().zip(parts) {
+                *m = m.max(d / (2.0 * h));
+            }
+        }
+        most
+    };
+    let [direction, weight_u, pdf_u, point] = differences(&by_u, u);
+    let [_, weight_p, pdf_p, _] = differences(&by_p, p.to_array());
+    let mut dweight = weight_u.max(weight_p * (1.0 + point));
+    let mut dpdf = pdf_u.max(pdf_p * (1.0 + point));
+    if pdf > 0.0 {
+        // The direction turned by `h` along two tangents: the pdf there, and the
+        // weight at the sample's pdf.
+        let t1 = wi.any_orthonormal_vector();
+        for t in [t1, wi.cross(t1)] {
+            let turned = |s: f64| (wi + s * h * t).normalize().to_array();
+            let pdf_at = |s: f64| prior.pdf(cond, turned(s));
+            let weight_at = |s: f64| sample(turned(s), pdf).1;
+            let along = |a: f64, b: f64| (a - b).abs() / (2.0 * h) * (1.0 + direction);
+            dpdf = dpdf.max(relative(along(pdf_at(1.0), pdf_at(-1.0))));
+            dweight = dweight.max(along(weight_at(1.0), weight_at(-1.0)));
+        }
+        // The square's density with the half vector's `h.z` moved by `eta`, its
+        // azimuth kept.
+        let hv = (wo3 + wi).normalize();
+        let planar = hv.truncate().length();
+        let eta = h.min(0.5 * (1.0 - hv.z));
+        if planar > 0.0 && eta > 0.0 {
+            let square_pdf_at = |s: f64| {
+                let z = hv.z + s * eta;
+                let k = (1.0 - z * z).max(0.0).sqrt() / planar;
+                let h2 = DVec3::new(hv.x * k, hv.y * k, z);
+                let c = wo3.dot(h2);
+                prior.pdf(cond, (2.0 * c * h2 - wo3).to_array()) * c
+            };
+            let d = (square_pdf_at(1.0) - square_pdf_at(-1.0)).abs() / (2.0 * eta);
+            dpdf = dpdf.max(relative(d / wo3.dot(hv)));
+        }
+        // GGX's conditioning in `c = n.h`.
+        let c = hv.z;
+        let a2 = alpha(cond[0]) * alpha(cond[0]);
+        let t = c * c * (a2 - 1.0) + 1.0;
+        let share = f.specular / f.total().max(f64::MIN_POSITIVE);
+        dweight = dweight.max(weight * share * 4.0 * c * (1.0 - a2) / t);
+    }
+    Gain {
+        direction: (1.0 + direction) as f32,
+        weight: (1.0 + dweight) as f32,
+        pdf: (1.0 + dpdf) as f32,
+    }
+}
+
+/// The blob's tabulated BRDF prior (warp 3) with its tables widened to `f64`:
+/// what [`brdf_table_gain`] differentiates. `None` for other blobs.
+struct WidePrior {
+    info: BrdfPriorInfo,
+    tables: [Vec<f64>; 4],
+}
+
+impl WidePrior {
+    fn of(bytes: &[u8]) -> Option<Self> {
+        let layout = Layout::read(bytes).ok()?;
+        let (_, info) = layout.section(SectionTag::BrdfPriorInfo).ok()?;
+        let info: BrdfPriorInfo = bytemuck::pod_read_unaligned(info);
+        let table = |tag| {
+            let (_, bytes) = layout.section(tag).expect("a warp-3 blob's prior section");
+            bytes
+                .chunks_exact(4)
+                .map(|c| f32::from_le_bytes(c.try_into().unwrap()) as f64)
+                .collect::<Vec<f64>>()
+        };
+        Some(Self {
+            info,
+            tables: [
+                table(SectionTag::BrdfPriorData),
+                table(SectionTag::BrdfPriorMarginal),
+                table(SectionTag::BrdfPriorConditional),
+                table(SectionTag::BrdfPriorMasses),
+            ],
+        })
+    }
+
+    fn prior(&self) -> BrdfPrior<'_, f64> {
+        let [data, marginal, conditional, masses] = &self.tables;
+        BrdfPrior::view(self.info, data, marginal, conditional, masses).expect("a parsed prior")
+    }
 }
 
 /// `theta_o` in degrees of a BRDF view `wo` (any length; zero, infinite or NaN:
@@ -253,33 +489,53 @@ fn view_theta_deg(wo: Vec3) -> f64 {
     (w.z / len).clamp(0.0, 1.0).acos().to_degrees()
 }
 
-/// The largest `|gpu - cpu| / gain` and the largest `|gpu - cpu|` of samples.
+/// The largest `|gpu - cpu| / gain` ([`Gap::max`]) and the largest `|gpu - cpu|`
+/// of samples, per part of the sample.
 #[derive(Default)]
 struct Worst {
     scaled: f32,
-    raw: f32,
+    raw: Gap,
 }
 
 impl Worst {
-    fn add(&mut self, gap: f32, gain: f32) {
-        self.scaled = self.scaled.max(gap / gain);
-        self.raw = self.raw.max(gap);
+    fn add(&mut self, gap: Gap, gain: Gain) {
+        self.scaled = self.scaled.max(gap.scaled(gain));
+        self.raw.direction = self.raw.direction.max(gap.direction);
+        self.raw.weight = self.raw.weight.max(gap.weight);
+        self.raw.pdf = self.raw.pdf.max(gap.pdf);
     }
 
     fn merge(&mut self, other: Worst) {
         self.scaled = self.scaled.max(other.scaled);
-        self.raw = self.raw.max(other.raw);
+        self.raw.direction = self.raw.direction.max(other.raw.direction);
+        self.raw.weight = self.raw.weight.max(other.raw.weight);
+        self.raw.pdf = self.raw.pdf.max(other.raw.pdf);
+    }
+
+    /// `scaled` and the raw maxima, for the report.
+    fn line(&self) -> String {
+        format!(
+            "{:.2e} (unscaled: direction {:.2e}, weight {:.2e}, pdf {:.2e} relative)",
+            self.scaled, self.raw.direction, self.raw.weight, self.raw.pdf
+        )
     }
 }
 
-/// The runtime's sample `(c, k, i)` of `p` in its mode (the BRDF modes at the view
-/// `p.view`, roughness `c.x`) and the warp's gain there ([`warp_gain`]). The BRDF
-/// modes' rotation to the view's azimuth keeps lengths: their gain is the set's at
-/// (roughness, theta_o).
-fn runtime_sample(cs: &ConditionalSampler, p: &KernelParams, e: u32) -> (Sample, f32) {
+/// The runtime's sample `(c, k, i)` of `p` in its mode at the metallic
+/// `p.view[3]` (the BRDF modes at the view `p.view`, roughness `c.x`) and the
+/// warp's gain there ([`warp_gain`]). The BRDF modes' rotation to the view's
+/// azimuth keeps lengths: their gain is the set's at (roughness, theta_o).
+fn runtime_sample(
+    cs: &ConditionalSampler,
+    prior: Option<&BrdfPrior<'_, f64>>,
+    p: &KernelParams,
+    e: u32,
+) -> (Sample, Gain) {
     let (c, k, i) = sample_of(p, e);
     let wo = Vec3::new(p.view[0], p.view[1], p.view[2]);
+    let m = p.view[3];
     let brdf_cond = || Vec2::new(c.x, view_theta_deg(wo) as f32);
+    let brdf = || BrdfSampler::try_from(*cs).unwrap();
     let mode = [
         KernelMode::Table,
         KernelMode::Network,
@@ -288,32 +544,36 @@ fn runtime_sample(cs: &ConditionalSampler, p: &KernelParams, e: u32) -> (Sample,
         KernelMode::TableRandomized,
         KernelMode::NetworkRandomized,
         KernelMode::Pdf,
+        KernelMode::BrdfTableRandomized,
+        KernelMode::BrdfNetworkRandomized,
+        KernelMode::BrdfPdf,
     ]
     .into_iter()
-    .find(|&m| m as u32 == p.mode)
+    .find(|&mode| mode as u32 == p.mode)
     .expect("a kernel mode");
     let shifted = |q: Vec2| Vec2::from(torus_shift(q.to_array(), randomization_shift(e)));
     let (want, cond, point) = match mode {
-        KernelMode::Table => (cs.sample(c, k, i), c, cs.square_point(c, k, i)),
+        KernelMode::Table => (cs.sample_metallic(c, m, k, i), c, cs.square_point(c, k, i)),
         KernelMode::Network => (
-            cs.network().sample(c, k, i),
+            cs.network().sample_metallic(c, m, k, i),
             c,
             cs.network().square_point(c, k, i),
         ),
         KernelMode::TableRandomized => (
-            cs.sample_randomized(c, k, i, e),
+            cs.sample_randomized_metallic(c, m, k, i, e),
             c,
             shifted(cs.square_point(c, k, i)),
         ),
         KernelMode::NetworkRandomized => (
-            cs.network().sample_randomized(c, k, i, e),
+            cs.network().sample_randomized_metallic(c, m, k, i, e),
             c,
             shifted(cs.network().square_point(c, k, i)),
         ),
         KernelMode::Pdf => {
-            let s = cs.sample(c, k, i);
+            let s = cs.sample_metallic(c, m, k, i);
             let s = Sample {
-                pdf: cs.pdf(c, s.direction),
+                pdf: cs.pdf_metallic(c, m, s.direction),
+                weight: cs.albedo(c, m),
                 ..s
             };
             (s, c, cs.square_point(c, k, i))
@@ -321,9 +581,7 @@ fn runtime_sample(cs: &ConditionalSampler, p: &KernelParams, e: u32) -> (Sample,
         KernelMode::BrdfTable => {
             let cond = brdf_cond();
             (
-                BrdfSampler::try_from(*cs)
-                    .unwrap()
-                    .sample(wo, c.x, 0.0, k, i),
+                brdf().sample(wo, c.x, m, k, i),
                 cond,
                 cs.square_point(cond, k, i),
             )
@@ -331,24 +589,53 @@ fn runtime_sample(cs: &ConditionalSampler, p: &KernelParams, e: u32) -> (Sample,
         KernelMode::BrdfNetwork => {
             let cond = brdf_cond();
             (
-                BrdfSampler::try_from(*cs)
-                    .unwrap()
-                    .network()
-                    .sample(wo, c.x, 0.0, k, i),
+                brdf().network().sample(wo, c.x, m, k, i),
                 cond,
                 cs.network().square_point(cond, k, i),
             )
         }
+        KernelMode::BrdfTableRandomized => {
+            let cond = brdf_cond();
+            (
+                brdf().sample_randomized(wo, c.x, m, k, i, e),
+                cond,
+                shifted(cs.square_point(cond, k, i)),
+            )
+        }
+        KernelMode::BrdfNetworkRandomized => {
+            let cond = brdf_cond();
+            (
+                brdf().network().sample_randomized(wo, c.x, m, k, i, e),
+                cond,
+                shifted(cs.network().square_point(cond, k, i)),
+            )
+        }
+        KernelMode::BrdfPdf => {
+            let cond = brdf_cond();
+            let s = brdf().sample(wo, c.x, m, k, i);
+            let s = Sample {
+                pdf: brdf().pdf(wo, c.x, m, s.direction),
+                weight: brdf().albedo(wo, c.x, m),
+                ..s
+            };
+            (s, cond, cs.square_point(cond, k, i))
+        }
     };
-    (want, warp_gain(cs, cond, point))
+    (want, warp_gain(cs, prior, cond, m, point))
 }
 
 /// The kernel's samples of `p` over `bytes` against the runtime's
 /// ([`runtime_sample`]).
-fn compare(kernel: &Kernel, bytes: &[u8], cs: &ConditionalSampler, p: &KernelParams) -> Worst {
+fn compare(
+    kernel: &Kernel,
+    bytes: &[u8],
+    cs: &ConditionalSampler,
+    prior: Option<&BrdfPrior<'_, f64>>,
+    p: &KernelParams,
+) -> Worst {
     let mut worst = Worst::default();
     for (e, got) in kernel.run(bytes, p).iter().enumerate() {
-        let (want, gain) = runtime_sample(cs, p, e as u32);
+        let (want, gain) = runtime_sample(cs, prior, p, e as u32);
         worst.add(gap(got, want), gain);
     }
     worst
@@ -356,41 +643,52 @@ fn compare(kernel: &Kernel, bytes: &[u8], cs: &ConditionalSampler, p: &KernelPar
 
 /// Compares the kernel with the runtime in table and network mode on a grid of
 /// conditions that runs past the blob's range on every side (clamping), instances
-/// and indices past the stored counts (wrapping), and on views for `BrdfSampler::sample`.
+/// and indices past the stored counts (wrapping), and on views for `BrdfSampler::sample`;
+/// for environment samplers and BRDF samplers on the tabulated prior also the
+/// unbiased mode and the pdf of a direction (and the albedo), the latter at
+/// metallic 0, 0.5 and 1.
 /// Each difference is divided by the warp's gain at the sample ([`warp_gain`]; 1
 /// for the equal-area maps) before it is held to the tolerance.
 fn check_conditional(kernel: &Kernel, bytes: &[u8], label: &str) {
     let cs: ConditionalSampler = Blob::parse(bytes).unwrap().conditional().unwrap();
     let info = *cs.info();
+    let table_prior = info.point_warp() == Some(PointWarp::BrdfTable);
+    let wide = WidePrior::of(bytes);
+    let prior = wide.as_ref().map(WidePrior::prior);
+    let prior = prior.as_ref();
+    // The metallic: read by the tabulated prior only.
+    let metallics: &[f32] = if table_prior {
+        &[0.0, 0.5, 1.0]
+    } else {
+        &[0.0]
+    };
     // Roughness 0 to 1.0625 by 1/16, theta_o -6 to 90 by 6 degrees.
-    let grid = |mode| {
-        KernelParams::new(
+    let grid = |mode, metallic| {
+        let mut p = KernelParams::new(
             mode,
             [0.0, -6.0],
             [0.0625, 6.0],
             [18, 17],
             0..cs.instances() + 2,
             0..cs.len() + 3,
-        )
+        );
+        p.view[3] = metallic;
+        p
     };
-    let mut worst_table = compare(kernel, bytes, &cs, &grid(KernelMode::Table));
-    let mut worst_network = compare(kernel, bytes, &cs, &grid(KernelMode::Network));
-    // The unbiased mode and the pdf of any direction: environment samplers'.
+    // The unbiased mode and the pdf of any direction: samplers with an exact prior.
     let env = cs.target() == nuld_core::conditional::ConditionalTarget::EnvmapNormal;
-    if env {
-        worst_table.merge(compare(
-            kernel,
-            bytes,
-            &cs,
-            &grid(KernelMode::TableRandomized),
-        ));
-        worst_table.merge(compare(kernel, bytes, &cs, &grid(KernelMode::Pdf)));
-        worst_network.merge(compare(
-            kernel,
-            bytes,
-            &cs,
-            &grid(KernelMode::NetworkRandomized),
-        ));
+    let exact = env || table_prior;
+    let mut worst_table = Worst::default();
+    let mut worst_network = Worst::default();
+    for &m in metallics {
+        let run = |mode| compare(kernel, bytes, &cs, prior, &grid(mode, m));
+        worst_table.merge(run(KernelMode::Table));
+        worst_network.merge(run(KernelMode::Network));
+        if exact {
+            worst_table.merge(run(KernelMode::TableRandomized));
+            worst_table.merge(run(KernelMode::Pdf));
+            worst_network.merge(run(KernelMode::NetworkRandomized));
+        }
     }
     // Views: generic, along z, grazing, below the horizon, zero, huge, tiny, NaN.
     let views = [
@@ -409,46 +707,60 @@ fn check_conditional(kernel: &Kernel, bytes: &[u8], label: &str) {
     let mut worst_view_network = Worst::default();
     // The BRDF views exist for BRDF samplers only (`Blob::brdf` refuses others).
     let brdf = cs.target() == nuld_core::conditional::ConditionalTarget::GltfBrdf;
+    let mut view_modes = vec![
+        (KernelMode::BrdfTable, false),
+        (KernelMode::BrdfNetwork, true),
+    ];
+    if table_prior {
+        view_modes.extend([
+            (KernelMode::BrdfTableRandomized, false),
+            (KernelMode::BrdfNetworkRandomized, true),
+            (KernelMode::BrdfPdf, false),
+        ]);
+    }
     for wo in views.into_iter().filter(|_| brdf) {
-        for (mode, worst) in [
-            (KernelMode::BrdfTable, &mut worst_view),
-            (KernelMode::BrdfNetwork, &mut worst_view_network),
-        ] {
-            let mut p = KernelParams::new(
-                mode,
-                [0.0, 0.0],
-                [0.0625, 0.0],
-                [18, 1],
-                0..cs.instances() + 1,
-                0..cs.len(),
-            );
-            p.view = [wo.x, wo.y, wo.z, 0.0];
-            worst.merge(compare(kernel, bytes, &cs, &p));
+        for &m in metallics {
+            for &(mode, network) in &view_modes {
+                let mut p = KernelParams::new(
+                    mode,
+                    [0.0, 0.0],
+                    [0.0625, 0.0],
+                    [18, 1],
+                    0..cs.instances() + 1,
+                    0..cs.len(),
+                );
+                p.view = [wo.x, wo.y, wo.z, m];
+                let worst = if network {
+                    &mut worst_view_network
+                } else {
+                    &mut worst_view
+                };
+                worst.merge(compare(kernel, bytes, &cs, prior, &p));
+            }
         }
     }
     // What is held to the tolerance is the difference over the warp's gain; the
-    // unscaled difference follows for reference (a mixture warp magnifies f32
-    // rounding of the square point by its gain, so it may exceed the tolerance).
+    // unscaled differences follow for reference (a warp magnifies f32 rounding
+    // of the square point by its gain, so they may exceed the tolerance).
     let views_line = if brdf {
         format!(
-            ", brdf views table {:.2e}, network {:.2e}",
-            worst_view.scaled, worst_view_network.scaled
+            "; brdf views: table {}, network {}",
+            worst_view.line(),
+            worst_view_network.line()
         )
     } else {
-        String::from(", no brdf views (an environment sampler)")
+        String::from("; no brdf views (an environment sampler)")
     };
     println!(
-        "shader {label} (n {}, hidden {:?}, activation {}, warp {}): max |gpu - cpu| / warp gain: \
-         table {:.2e} (tolerance {TABLE_TOLERANCE:.2e}), network {:.2e} (tolerance \
-         {NETWORK_TOLERANCE:.0e}){views_line}; unscaled max: table {:.2e}, network {:.2e}",
+        "shader {label} (n {}, hidden {:?}, activation {}, warp {}, metallic {metallics:?}): \
+         max |gpu - cpu| / warp gain: table {} (tolerance {TABLE_TOLERANCE:.2e}), \
+         network {} (tolerance {NETWORK_TOLERANCE:.0e}){views_line}",
         info.n,
         info.hidden,
         info.activation,
         info.warp,
-        worst_table.scaled,
-        worst_network.scaled,
-        worst_table.raw,
-        worst_network.raw,
+        worst_table.line(),
+        worst_network.line(),
     );
     for (what, worst, tolerance) in [
         ("table", &worst_table, TABLE_TOLERANCE),
@@ -482,7 +794,12 @@ fn shader_random_samplers_of_every_shape_match_the_runtime() {
         (33, &[20, 12], Activation::Silu, 7, 0),
     ];
     for (s, (n, hidden, act, g, slots)) in shapes.into_iter().enumerate() {
-        for warp in [PointWarp::EqualArea, PointWarp::BrdfMixture] {
+        let warps = [
+            PointWarp::EqualArea,
+            PointWarp::BrdfMixture,
+            PointWarp::BrdfTable,
+        ];
+        for warp in warps {
             let shape = shape(n, hidden, act, warp, slots);
             let mut parts = conditional_parts(shape, 2, [4, 3], s as u64);
             // A generator whose products `i g` overflow 32 bits: the shader's
@@ -494,6 +811,13 @@ fn shader_random_samplers_of_every_shape_match_the_runtime() {
                 parts = as_envmap(parts);
                 label = format!("random {s} {:?}", PointWarp::EnvmapTree);
             }
+            if warp == PointWarp::BrdfTable && s < 2 {
+                // The small prior (5 x 5 vertices: coarse tables, points that
+                // leak below the horizon); the last shape keeps the sampler's own
+                // prior (`BrdfPrior::shared`, as the distilled test).
+                parts = with_brdf_prior(parts, small_brdf_prior());
+                label = format!("random {s} {warp:?}, small prior");
+            }
             let bytes = parts.to_blob(&META).unwrap();
             check_conditional(kernel, bytes.as_slice(), &label);
         }
@@ -501,42 +825,44 @@ fn shader_random_samplers_of_every_shape_match_the_runtime() {
 }
 
 /// The README's shader (tests/examples/shader_sample.wgsl, run by the host code of
-/// tests/examples/shader_sample.rs) gives the runtime's `BrdfSampler::sample` samples. Its
+/// tests/examples/shader_sample.rs) gives the runtime's `BrdfSampler::sample` samples,
+/// on a blob of the equal-area warp and on one of the tabulated prior (warp 3). Its
 /// view is normalized by the driver's `normalize`, a few ulps from glam's, which the
 /// table interpolation carries through: within 1e-5.
 #[test]
 fn shader_readme_example_gives_the_runtime_samples() {
     let Some(kernel) = kernel() else { return };
-    let bytes = nuld_runtime::doc_example_conditional_blob();
-    let cs = Blob::parse(&bytes.0).unwrap().conditional().unwrap();
     let source = [
         nuld_runtime::shader::WGSL,
         include_str!("../examples/shader_sample.wgsl"),
     ]
     .concat();
     let pipeline = kernel.gpu.pipeline(&source, "main");
-    let count = 5 * cs.len();
-    let (out, _) = kernel.gpu.run(
-        &pipeline,
-        &bytes.0,
-        None,
-        count as u64,
-        [count.div_ceil(64), 1, 1],
-        1,
-    );
-    let wo = Vec3::new(0.3, 0.4, 0.866).normalize();
-    let mut worst = 0.0f32;
-    for (e, got) in out.iter().enumerate() {
-        let (pixel, i) = (e as u32 / cs.len(), e as u32 % cs.len());
-        // The README's shader writes direction and weight only: a zero pdf, as
-        // the BRDF sampler's.
-        worst = worst.max(gap(
-            &(*got, [0.0; 4]),
-            BrdfSampler::try_from(cs)
-                .unwrap()
-                .sample(wo, 0.4, 0.0, pixel, i),
-        ));
+    let conditional = nuld_runtime::doc_example_conditional_blob();
+    let table_prior = nuld_runtime::doc_example_brdf_blob();
+    for (label, bytes) in [
+        ("equal-area", &conditional.0[..]),
+        ("tabulated prior", &table_prior.0[..]),
+    ] {
+        let brdf = Blob::parse(bytes).unwrap().brdf().unwrap();
+        let count = 5 * brdf.len();
+        let (out, _) = kernel.gpu.run(
+            &pipeline,
+            bytes,
+            None,
+            count as u64,
+            [count.div_ceil(64), 1, 1],
+            1,
+        );
+        let wo = Vec3::new(0.3, 0.4, 0.866).normalize();
+        let mut worst = 0.0f32;
+        for (e, got) in out.iter().enumerate() {
+            let (pixel, i) = (e as u32 / brdf.len(), e as u32 % brdf.len());
+            // The README's shader writes direction and weight only.
+            let g = gap(&(*got, [0.0; 4]), brdf.sample(wo, 0.4, 0.0, pixel, i));
+            worst = worst.max(g.direction).max(g.weight);
+        }
+        println!("shader README example, {label}: max |gpu - cpu| {worst:.2e} (tolerance 1e-5)");
+        assert!(worst <= 1e-5, "{label}: {worst}");
     }
-    println!("shader README example: max |gpu - cpu| {worst:.2e} (tolerance 1e-5)");
-    assert!(worst <= 1e-5, "{worst}");
 }

@@ -11,9 +11,11 @@ use nuld_core::blob::{
     BlobKind, Domain, Header, PointSetInfo, SectionEntry, SectionTag, HEADER_LEN, MAX_SECTIONS,
     SECTION_ENTRY_LEN,
 };
-use nuld_core::brdf::{MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
+use nuld_core::brdf::{F0, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
+use nuld_core::brdf_prior::BrdfPriorInfo;
 use nuld_core::conditional::{ConditionalInfo, PointWarp, RANDOMIZE_SALTS};
 use nuld_core::envmap_tree::{node_count, TreeInfo, TOP_FLOOR, TOP_LEVELS};
+use nuld_core::marginal2d::MAX_BLEND;
 use nuld_core::network::{
     Activation, DOT_LANES, INPUTS, LATTICE_LOGIT_EPS, MAX_HIDDEN_LAYERS, MAX_WIDTH, OUTPUTS,
 };
@@ -146,7 +148,25 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
             SectionTag::EnvmapTreeNodes as u64,
         ),
         ("NULD_TAG_ENVMAP_TREE_TOP", SectionTag::EnvmapTreeTop as u64),
+        ("NULD_TAG_BRDF_PRIOR_INFO", SectionTag::BrdfPriorInfo as u64),
+        ("NULD_TAG_BRDF_PRIOR_DATA", SectionTag::BrdfPriorData as u64),
+        (
+            "NULD_TAG_BRDF_PRIOR_MARGINAL",
+            SectionTag::BrdfPriorMarginal as u64,
+        ),
+        (
+            "NULD_TAG_BRDF_PRIOR_CONDITIONAL",
+            SectionTag::BrdfPriorConditional as u64,
+        ),
+        (
+            "NULD_TAG_BRDF_PRIOR_MASSES",
+            SectionTag::BrdfPriorMasses as u64,
+        ),
         ("NULD_WARP_ENVMAP_TREE", PointWarp::EnvmapTree as u64),
+        ("NULD_WARP_BRDF_TABLE", PointWarp::BrdfTable as u64),
+        ("NULD_PRIOR_INFO_GRID", at!(BrdfPriorInfo, grid)),
+        ("NULD_PRIOR_INFO_SIZE", at!(BrdfPriorInfo, size)),
+        ("NULD_MAX_BLEND", MAX_BLEND as u64),
         ("NULD_TREE_INFO_LEVELS", at!(TreeInfo, levels)),
         ("NULD_TREE_INFO_GRID", at!(TreeInfo, grid)),
         ("NULD_TREE_TOP_LEVELS", TOP_LEVELS as u64),
@@ -182,6 +202,13 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_MIN_ROUGHNESS", f(MIN_ROUGHNESS as f32)),
         ("NULD_MAX_ROUGHNESS", f(MAX_ROUGHNESS as f32)),
         ("NULD_MAX_THETA_O_DEG", f(MAX_THETA_O_DEG as f32)),
+        (
+            "NULD_ROUGHNESS_SPAN",
+            f((MAX_ROUGHNESS - MIN_ROUGHNESS) as f32),
+        ),
+        ("NULD_F0", f(F0 as f32)),
+        ("NULD_ONE_MINUS_F0", f((1.0 - F0) as f32)),
+        ("NULD_FRAC_4_PI", f((4.0 / core::f64::consts::PI) as f32)),
         ("NULD_LATTICE_LOGIT_EPS", f(LATTICE_LOGIT_EPS as f32)),
         ("NULD_UNORM16_SCALE", f(1.0 / UNORM16_CELLS as f32)),
         ("NULD_INSTANCE_UNIT", f((1.0f64 / 16_777_216.0) as f32)),
@@ -194,6 +221,20 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_ACOS_P_S1", libm_literal("-4.2743422091e-02")),
         ("NULD_ACOS_P_S2", libm_literal("-8.6563630030e-03")),
         ("NULD_ACOS_Q_S1", libm_literal("-7.0662963390e-01")),
+        // libm's atanf (FreeBSD s_atanf.c), likewise.
+        ("NULD_ATAN_HI_0", 0x3eed_6338),
+        ("NULD_ATAN_HI_1", 0x3f49_0fda),
+        ("NULD_ATAN_HI_2", 0x3f7b_985e),
+        ("NULD_ATAN_HI_3", 0x3fc9_0fda),
+        ("NULD_ATAN_LO_0", 0x31ac_3769),
+        ("NULD_ATAN_LO_1", 0x3322_2168),
+        ("NULD_ATAN_LO_2", 0x3314_0fb4),
+        ("NULD_ATAN_LO_3", 0x33a2_2168),
+        ("NULD_ATAN_T0", libm_literal("3.3333328366e-01")),
+        ("NULD_ATAN_T1", libm_literal("-1.9999158382e-01")),
+        ("NULD_ATAN_T2", libm_literal("1.4253635705e-01")),
+        ("NULD_ATAN_T3", libm_literal("-1.0648017377e-01")),
+        ("NULD_ATAN_T4", libm_literal("6.1687607318e-02")),
         ("NULD_F16_SUBNORMAL", f(f16_decode_finite(1))),
         ("NULD_WORKGROUP_SIZE", KERNEL_WORKGROUP_SIZE as u64),
         ("NULD_MODE_TABLE", KernelMode::Table as u64),
@@ -209,6 +250,15 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
             KernelMode::NetworkRandomized as u64,
         ),
         ("NULD_MODE_PDF", KernelMode::Pdf as u64),
+        (
+            "NULD_MODE_BRDF_TABLE_RANDOMIZED",
+            KernelMode::BrdfTableRandomized as u64,
+        ),
+        (
+            "NULD_MODE_BRDF_NETWORK_RANDOMIZED",
+            KernelMode::BrdfNetworkRandomized as u64,
+        ),
+        ("NULD_MODE_BRDF_PDF", KernelMode::BrdfPdf as u64),
     ];
     constants.extend(info_fields().map(|(constant, _, offset)| (constant, offset)));
     constants

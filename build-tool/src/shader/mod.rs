@@ -288,6 +288,13 @@ mod tests {
             "nuld_sample_network",
             "nuld_sample_brdf",
             "nuld_sample_brdf_network",
+            "nuld_sample_brdf_randomized",
+            "nuld_sample_brdf_network_randomized",
+            "nuld_pdf_brdf",
+            "nuld_albedo_brdf",
+            "nuld_sample_metallic",
+            "nuld_pdf_metallic",
+            "nuld_albedo",
             "nuld_weight",
         ] {
             assert!(
