@@ -36,11 +36,12 @@ impl Camera {
     }
 
     /// The evaluation's view of [`super::scene::Scene::spheres_on_ground`]: from
-    /// `(0, -11, 3.5)` towards `(0, 0, 0.8)`, 45° vertical field of view.
+    /// `(0, -10, 7)` towards `(0, 0, 1.2)`, 45° vertical field of view, high
+    /// enough to see the back row (the metals) over the front row.
     pub fn evaluation(width: u32, height: u32) -> Self {
         Self::new(
-            DVec3::new(0.0, -11.0, 3.5),
-            DVec3::new(0.0, 0.0, 0.8),
+            DVec3::new(0.0, -10.0, 7.0),
+            DVec3::new(0.0, 0.0, 1.2),
             45.0,
             width,
             height,

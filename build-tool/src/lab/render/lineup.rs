@@ -8,6 +8,7 @@ use super::mis::MisSampler;
 use super::nuld_sampler::{NuldBlobError, NuldMode, NuldSampler};
 use super::primary::{Generator, PrimaryPoints};
 use super::sampler::{DirectionSampler, ShadingPoint, Technique};
+use super::scene::Material;
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -15,10 +16,12 @@ use std::sync::Arc;
 /// environment sampler serves its own rows and the MIS ones).
 pub type Shared<'a> = Arc<dyn DirectionSampler + 'a>;
 
-/// The BRDF sampler names in table order.
-pub const BRDF_SAMPLERS: [&str; 6] = [
+/// The BRDF sampler names in table order: ours (fixed instances in both modes,
+/// and the unbiased mode), then the generators through the mixture warp.
+pub const BRDF_SAMPLERS: [&str; 7] = [
     "nuld-table",
     "nuld-network",
+    "nuld-unbiased",
     "owen-sobol",
     "random",
     "sot",
@@ -135,6 +138,9 @@ pub fn samplers<'a>(
                     all.push(Arc::new(NuldSampler::new(blob, NuldMode::Table)?));
                     let network = NuldSampler::new(blob, NuldMode::Network)?;
                     all.push(Arc::new(network.decoded(weights)));
+                    all.push(Arc::new(
+                        NuldSampler::new(blob, NuldMode::Table)?.unbiased(),
+                    ));
                 }
                 for g in [
                     Generator::OwenSobol,
@@ -150,7 +156,7 @@ pub fn samplers<'a>(
                 let probe = ShadingPoint {
                     frame: Frame::new(DVec3::Z),
                     wo: DVec3::Z,
-                    roughness: 0.5,
+                    material: Material::dielectric(0.5),
                 };
                 for s in &envmaps {
                     let mis = MisSampler::new(s.clone(), brdf(Generator::OwenSobol), &probe);
@@ -174,7 +180,7 @@ mod tests {
         let map = tiny_map(&dir);
         let env = Environment::from_file(&map).unwrap();
         let env_blob = tiny_envmap_blob(4, &map);
-        let lobes = LobeTable::new(&[0.5]);
+        let lobes = LobeTable::new(&[Material::dielectric(0.5), Material::metal(0.5)]);
         let mut weights = Default::default();
         let all = samplers(
             &Technique::ALL,

@@ -1,13 +1,13 @@
 //! The rendering evaluation of paper Fig. 8 (`build-tool render`): a small,
 //! physically based renderer whose only job is to compare samplers.
 //!
-//! Spheres of the glTF BRDF at roughnesses 0.1 to 1 on a ground plane
-//! ([`scene`]), a pinhole camera ([`camera`]), lit only by an environment map
+//! Spheres of the glTF metallic-roughness BRDF at roughnesses 0.1 to 1, a row
+//! of dielectrics and a row of metals, on a ground plane ([`scene`]), a pinhole camera ([`camera`]), lit only by an environment map
 //! ([`environment`]); direct lighting with visibility by ray casting, one
 //! estimator per pixel ([`integrator`]). Every sampler implements one trait
 //! ([`sampler::DirectionSampler`], returning [`sampler::Sample`]s):
-//! * BRDF sampling: ours in table and network mode ([`nuld_sampler`], through
-//!   `nuld-runtime` on the blob bytes only), and Owen-Sobol, random, SOT and GBN
+//! * BRDF sampling: ours in table, network and unbiased mode ([`nuld_sampler`],
+//!   through `nuld-runtime` on the blob bytes only), and Owen-Sobol, random, SOT and GBN
 //!   points ([`primary`]) through the renderer's mixture warp ([`brdf_warp`]);
 //! * environment sampling: ours in table, network and unbiased mode; Owen-Sobol,
 //!   Halton, random, SOT and GBN points through the product warp of `L cos` that

@@ -9,11 +9,13 @@
 //! same bits as the zero-copy f16 path, faster), as a CPU renderer would.
 //!
 //! * BRDF sampling: [`BrdfSampler::sample`] (table mode) or
-//!   [`BrdfNetwork::sample`] (network mode) at the local view direction, the
-//!   roughness and the metallic, or their unbiased mode
-//!   ([`BrdfSampler::sample_randomized`]): the unbiased mode weighs by the
-//!   sample's own `f cos / pdf`, a fixed instance by the albedo
-//!   ([`BrdfSampler::albedo`]; its set follows the target `f cos / A`, as below);
+//!   [`BrdfNetwork::sample`] (network mode) at the local view direction and the
+//!   surface's roughness and metallic, or their unbiased mode
+//!   ([`BrdfSampler::sample_randomized`], `nuld-unbiased`, the pixel key's low 32
+//!   bits as its random number): the unbiased mode weighs by the sample's own
+//!   `f cos / pdf` and knows its pdf ([`BrdfSampler::pdf`]), a fixed instance
+//!   weighs by the albedo at the material ([`BrdfSampler::albedo`]; its set
+//!   follows the target `f cos / A`, as below) and has no pdf;
 //! * environment sampling: [`EnvmapSampler::sample`] or
 //!   [`EnvmapNetwork::sample`] at the world normal, or their unbiased mode
 //!   ([`EnvmapSampler::sample_randomized`], `nuld-unbiased`, the pixel key's low
@@ -176,11 +178,13 @@ impl<'a> NuldSampler<'a> {
         kind.map_or(self, |kind| Self { kind, ..self })
     }
 
-    /// The environment sampler in its unbiased mode (a random torus shift per
-    /// pixel, module docs); a BRDF sampler is returned as it is (it has none yet).
+    /// The sampler in its unbiased mode (a random torus shift per pixel, the
+    /// pixel key's low 32 bits; module docs).
     pub fn unbiased(self) -> Self {
-        let randomized = matches!(self.kind, Kind::Envmap(..) | Kind::EnvmapNetwork(..));
-        Self { randomized, ..self }
+        Self {
+            randomized: true,
+            ..self
+        }
     }
 
     /// Points per set `N` of the blob.
@@ -217,7 +221,8 @@ impl DirectionSampler for NuldSampler<'_> {
         out.clear();
         let k = key.instance();
         let normal = at.frame.to_world(DVec3::Z).as_vec3();
-        let (wo, r, m) = (at.wo.as_vec3(), at.roughness as f32, 0.0);
+        let m = at.material;
+        let (wo, r, m) = (at.wo.as_vec3(), m.roughness as f32, m.metallic as f32);
         match self.kind {
             Kind::Brdf(t) => out.extend((0..n).map(|i| {
                 let s = match self.randomized {
@@ -253,7 +258,15 @@ impl DirectionSampler for NuldSampler<'_> {
     fn pdf(&self, at: &ShadingPoint, l: DVec3) -> Option<f64> {
         let normal = at.frame.normal().as_vec3();
         let prior = match self.kind {
-            Kind::Brdf(_) | Kind::BrdfNetwork(_) => return None,
+            Kind::Brdf(_) | Kind::BrdfNetwork(_) if !self.randomized => return None,
+            Kind::Brdf(_) | Kind::BrdfNetwork(_) => {
+                let m = at.material;
+                let (wo, local) = (at.wo.as_vec3(), at.frame.to_local(l).as_vec3());
+                let (r, m) = (m.roughness as f32, m.metallic as f32);
+                let pdf =
+                    BrdfSampler::try_from(self.sampler).map_or(0.0, |t| t.pdf(wo, r, m, local));
+                return Some(pdf as f64);
+            }
             Kind::Envmap(t, env) => (t.pdf(normal, l.as_vec3()), env),
             Kind::EnvmapNetwork(t, env) => (t.pdf(normal, l.as_vec3()), env),
         };
@@ -270,28 +283,28 @@ impl DirectionSampler for NuldSampler<'_> {
 
 impl NuldSampler<'_> {
     /// A BRDF sample in the world frame weighted by the density it follows
-    /// (module docs): the runtime's weight `f cos / pdf` in the unbiased mode;
-    /// the albedo `A` for a fixed instance, whose set follows the target
-    /// `f cos / A` (the weight of blobs of the earlier mixture prior in either
-    /// mode, whose samples carry no pdf). The runtime's directions are unit to
-    /// f32 rounding; used as they come.
+    /// (module docs): the runtime's weight `f cos / pdf` and its pdf in the
+    /// unbiased mode; the albedo `A` at the material for a fixed instance, whose
+    /// set follows the target `f cos / A` (the weight of blobs of the earlier
+    /// mixture prior in either mode, whose samples carry no pdf), and no pdf.
+    /// The unbiased mode keeps the runtime's weight even where its pdf is 0 (a
+    /// sample the prior's table leaks past the horizon: weight 0, which keeps
+    /// the estimate unbiased; the albedo there would add the leaked mass). The
+    /// runtime's directions are unit to f32 rounding; used as they come.
     fn brdf_sample(
         &self,
         at: &ShadingPoint,
         s: nuld_runtime::Sample,
         (wo, roughness, metallic): (nuld_runtime::glam::Vec3, f32, f32),
     ) -> Sample {
-        let weight = match (
-            self.randomized && s.pdf > 0.0,
-            BrdfSampler::try_from(self.sampler),
-        ) {
+        let weight = match (self.randomized, BrdfSampler::try_from(self.sampler)) {
             (false, Ok(t)) => t.albedo(wo, roughness, metallic),
             _ => s.weight,
         };
         Sample {
             direction: at.frame.to_world(s.direction.as_dvec3()),
             weight: weight as f64,
-            pdf: 0.0,
+            pdf: if self.randomized { s.pdf as f64 } else { 0.0 },
         }
     }
 
@@ -343,67 +356,99 @@ mod tests {
 
     /// Ours is the runtime and nothing else: on the same blob bytes, the samples
     /// equal direct `nuld_runtime` calls bit for bit (local frame = world frame
-    /// for the normal `+z`), network mode on decoded weights included.
+    /// for the normal `+z`), network mode on decoded weights included, at the
+    /// shading point's roughness and metallic (dielectric, metal, half-metal),
+    /// fixed instances and the unbiased mode alike.
     #[test]
     fn samples_are_the_runtimes_bit_for_bit() {
+        use crate::lab::render::scene::Material;
         let blob = tiny_blob(8);
         let cs = Blob::parse(blob.as_slice()).unwrap().brdf().unwrap();
-        for (mode, name) in [
-            (NuldMode::Table, "nuld-table"),
-            (NuldMode::Network, "nuld-network"),
+        let key = PixelKey(0x1234_5678_9abc_def0);
+        let (k, scramble) = (key.instance(), key.scramble());
+        let mut unbiased_checked = 0;
+        for (mode, unbiased, name) in [
+            (NuldMode::Table, false, "nuld-table"),
+            (NuldMode::Network, false, "nuld-network"),
+            (NuldMode::Table, true, "nuld-unbiased"),
+            (NuldMode::Network, true, "nuld-network-unbiased"),
         ] {
             // Network mode on decoded weights, compared below with the runtime's
             // zero-copy f16 path.
             let mut weights = Vec::new();
-            let ours = NuldSampler::new(blob.as_slice(), mode)
+            let mut ours = NuldSampler::new(blob.as_slice(), mode)
                 .unwrap()
                 .decoded(&mut weights);
-            assert_eq!((ours.name(), ours.len()), (name, 8));
-            let wo = Vec3::new(0.3, -0.4, 0.7).normalize();
-            let at = ShadingPoint {
-                frame: Frame::new(DVec3::Z),
-                wo: DVec3::new(wo.x as f64, wo.y as f64, wo.z as f64),
-                roughness: 0.4f32 as f64,
-            };
-            let key = PixelKey(0x1234_5678_9abc_def0);
-            let mut out = Vec::new();
-            ours.samples(&at, key, 8, &mut out);
-            for (i, s) in out.iter().enumerate() {
-                let want = match mode {
-                    NuldMode::Table => cs.sample(wo, 0.4, 0.0, key.instance(), i as u32),
-                    NuldMode::Network => {
-                        cs.network().sample(wo, 0.4, 0.0, key.instance(), i as u32)
-                    }
-                };
-                let got = s.direction.as_vec3();
-                assert_eq!(
-                    got.to_array().map(f32::to_bits),
-                    want.direction.to_array().map(f32::to_bits)
-                );
-                // A fixed instance weighs by the albedo (module docs).
-                assert_eq!(s.weight, cs.albedo(wo, 0.4, 0.0) as f64);
+            if unbiased {
+                ours = ours.unbiased();
             }
-            // At a tilted normal the world directions are the runtime's local ones
-            // carried by the frame: back in the local frame they agree to rounding,
-            // and they lie above the surface.
-            let n = DVec3::new(-0.5, 0.3, 0.2).normalize();
-            let tilted = ShadingPoint {
-                frame: Frame::new(n),
-                ..at
-            };
-            ours.samples(&tilted, key, 8, &mut out);
-            for (i, s) in out.iter().enumerate() {
-                let want = match mode {
-                    NuldMode::Table => cs.sample(wo, 0.4, 0.0, key.instance(), i as u32),
-                    NuldMode::Network => {
-                        cs.network().sample(wo, 0.4, 0.0, key.instance(), i as u32)
+            assert_eq!((ours.name(), ours.len()), (name, 8));
+            assert_eq!(ours.technique(), Technique::Brdf);
+            for metallic in [0.0f32, 1.0, 0.5] {
+                let r = 0.4f32;
+                let want = |wo: Vec3, i: u32| match (mode, unbiased) {
+                    (NuldMode::Table, false) => cs.sample(wo, r, metallic, k, i),
+                    (NuldMode::Network, false) => cs.network().sample(wo, r, metallic, k, i),
+                    (NuldMode::Table, true) => {
+                        cs.sample_randomized(wo, r, metallic, k, i, scramble)
                     }
+                    (NuldMode::Network, true) => cs
+                        .network()
+                        .sample_randomized(wo, r, metallic, k, i, scramble),
                 };
-                let local = tilted.frame.to_local(s.direction);
-                assert!((local - want.direction.as_dvec3()).length() < 1e-12);
-                assert!(s.direction.dot(n) >= 0.0);
+                let wo = Vec3::new(0.3, -0.4, 0.7).normalize();
+                let at = ShadingPoint {
+                    frame: Frame::new(DVec3::Z),
+                    wo: DVec3::new(wo.x as f64, wo.y as f64, wo.z as f64),
+                    material: Material {
+                        roughness: r as f64,
+                        metallic: metallic as f64,
+                    },
+                };
+                let mut out = Vec::new();
+                ours.samples(&at, key, 8, &mut out);
+                for (i, s) in out.iter().enumerate() {
+                    let want = want(wo, i as u32);
+                    let got = s.direction.as_vec3();
+                    assert_eq!(
+                        got.to_array().map(f32::to_bits),
+                        want.direction.to_array().map(f32::to_bits)
+                    );
+                    if unbiased {
+                        // The unbiased mode weighs by the sample's own f cos / pdf
+                        // (0 where the prior leaks, pdf 0) and knows its pdf, for
+                        // any direction.
+                        assert_eq!((s.weight, s.pdf), (want.weight as f64, want.pdf as f64));
+                        let pdf = cs.pdf(wo, r, metallic, want.direction) as f64;
+                        assert_eq!(ours.pdf(&at, s.direction), Some(pdf));
+                        unbiased_checked += (want.pdf > 0.0) as usize;
+                    } else {
+                        // A fixed instance weighs by the albedo at the material
+                        // (module docs) and has no pdf.
+                        assert_eq!(s.weight, cs.albedo(wo, r, metallic) as f64);
+                        assert_eq!((s.pdf, ours.pdf(&at, s.direction)), (0.0, None));
+                    }
+                }
+                // At a tilted normal the world directions are the runtime's local
+                // ones carried by the frame: back in the local frame they agree to
+                // rounding, and they lie above the surface.
+                let n = DVec3::new(-0.5, 0.3, 0.2).normalize();
+                let tilted = ShadingPoint {
+                    frame: Frame::new(n),
+                    ..at
+                };
+                ours.samples(&tilted, key, 8, &mut out);
+                for (i, s) in out.iter().enumerate() {
+                    let local = tilted.frame.to_local(s.direction);
+                    assert!((local - want(wo, i as u32).direction.as_dvec3()).length() < 1e-12);
+                    assert!(s.direction.dot(n) >= 0.0);
+                }
             }
         }
+        // The metal's albedo is not the dielectric's: the metallic is read.
+        let wo = Vec3::new(0.3, -0.4, 0.7).normalize();
+        assert!((cs.albedo(wo, 0.4, 1.0) - cs.albedo(wo, 0.4, 0.0)).abs() > 1e-3);
+        assert!(unbiased_checked > 30, "{unbiased_checked}");
     }
 
     /// Ours for the environment is the runtime's `EnvmapSampler::sample` (or
@@ -428,7 +473,7 @@ mod tests {
         let at = ShadingPoint {
             frame: Frame::new(n),
             wo: DVec3::new(0.4, 0.1, 0.8).normalize(),
-            roughness: 0.3,
+            material: crate::lab::render::scene::Material::dielectric(0.3),
         };
         let key = PixelKey(0x0fed_cba9_8765_4321);
         let (mut checked, mut compared) = (0, 0);

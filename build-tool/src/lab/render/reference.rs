@@ -1,5 +1,6 @@
 //! The reference image: direct lighting at many samples per pixel, combining BRDF
-//! sampling (the mixture warp of random points) and environment sampling (the
+//! sampling (the mixture warp of random points at the material's lobe
+//! probability) and environment sampling (the
 //! product warp of `L cos` at the normal, [`super::environment`], of random
 //! points) by multiple importance sampling with the balance heuristic (Veach
 //! 1997, §9.2.2). The product warp puts the environment's samples where the
@@ -121,13 +122,13 @@ fn pixel(setup: &Setup<'_>, lobes: &LobeTable, m: u32, seed: u64, x: u32, y: u32
         Primary::Surface { position, at } => (position, at),
     };
     let mut g = rng(seed, REFERENCE_STREAM + setup.camera.pixel_index(x, y));
-    let a = alpha(at.roughness);
-    let p_s = lobes.lobe_probability(at.roughness, at.theta_o_deg());
+    let a = alpha(at.material.roughness);
+    let p_s = lobes.lobe_probability(at.material, at.theta_o_deg());
     let normal = at.frame.normal();
     // g(l) / (p_b + p_e)(l) for a world direction l.
     let term = |l: DVec3| {
         let local = at.frame.to_local(l);
-        let f_cos = nuld_core::brdf::cosine_weighted(at.wo, local, at.roughness);
+        let f_cos = at.material.cosine_weighted(at.wo, local);
         if f_cos <= 0.0 {
             return 0.0;
         }
@@ -165,9 +166,8 @@ mod tests {
     use crate::density::image::LuminanceImage;
     use crate::lab::render::camera::Camera;
     use crate::lab::render::environment::Environment;
-    use crate::lab::render::scene::{Scene, Sphere};
-    use crate::sphere::brdf_albedo::directional_albedo;
-    use nuld_core::brdf::BrdfModel;
+    use crate::lab::render::scene::{Material, Scene, Sphere};
+    use crate::sphere::brdf_albedo::directional_albedo_metallic;
 
     /// A sky: a smooth gradient and a sun of 2 x 1 pixels holding most of the light.
     fn sun_map() -> Environment {
@@ -224,7 +224,7 @@ mod tests {
             camera: &camera,
             env: &env,
         };
-        let lobes = LobeTable::new(&scene.roughnesses());
+        let lobes = LobeTable::new(&scene.materials());
         let a = Reference::render(&setup, &lobes, 256, 1, &|| {});
         let b = Reference::render(&setup, &lobes, 256, 2, &|| {});
         let (mean, mean_sq, k) = z_stats(&a.image.values, &a.stderr, &b.image.values, &b.stderr);
@@ -234,47 +234,51 @@ mod tests {
             "z: mean {mean}, mean square {mean_sq}"
         );
 
+        // The white furnace, for the dielectric and the metal.
         let white = Environment::constant(1.0).unwrap();
-        let roughness = 0.4;
-        let ball = Scene {
-            spheres: vec![Sphere {
-                center: glam::DVec3::ZERO,
-                radius: 1.0,
-                roughness,
-            }],
-            ground_roughness: None,
-        };
-        let cam = Camera::new(
-            glam::DVec3::new(0.0, -4.0, 0.0),
-            glam::DVec3::ZERO,
-            32.0,
-            16,
-            16,
-        );
-        let setup = Setup {
-            scene: &ball,
-            camera: &cam,
-            env: &white,
-        };
-        let r = Reference::render(&setup, &LobeTable::new(&[roughness]), 256, 3, &|| {});
-        let mut exact = Vec::new();
-        for y in 0..16 {
-            for x in 0..16 {
-                exact.push(match setup.primary(x, y) {
-                    Primary::Surface { at, .. } => {
-                        directional_albedo(BrdfModel::Gltf, roughness, at.theta_o_deg().min(89.0))
-                            .total()
-                    }
-                    Primary::Background(l) => l,
-                });
+        for material in [Material::dielectric(0.4), Material::metal(0.4)] {
+            let ball = Scene {
+                spheres: vec![Sphere {
+                    center: glam::DVec3::ZERO,
+                    radius: 1.0,
+                    material,
+                }],
+                ground: None,
+            };
+            let cam = Camera::new(
+                glam::DVec3::new(0.0, -4.0, 0.0),
+                glam::DVec3::ZERO,
+                32.0,
+                16,
+                16,
+            );
+            let setup = Setup {
+                scene: &ball,
+                camera: &cam,
+                env: &white,
+            };
+            let r = Reference::render(&setup, &LobeTable::new(&[material]), 256, 3, &|| {});
+            let mut exact = Vec::new();
+            for y in 0..16 {
+                for x in 0..16 {
+                    exact.push(match setup.primary(x, y) {
+                        Primary::Surface { at, .. } => directional_albedo_metallic(
+                            material.roughness,
+                            at.theta_o_deg().min(89.0),
+                            material.metallic,
+                        )
+                        .total(),
+                        Primary::Background(l) => l,
+                    });
+                }
             }
+            let zero = vec![0.0; exact.len()];
+            let (mean, mean_sq, k) = z_stats(&r.image.values, &r.stderr, &exact, &zero);
+            assert!(
+                k > 100 && mean.abs() < 4.0 / (k as f64).sqrt() && mean_sq < 1.6,
+                "furnace z at {material:?}: mean {mean}, mean square {mean_sq}"
+            );
         }
-        let zero = vec![0.0; exact.len()];
-        let (mean, mean_sq, k) = z_stats(&r.image.values, &r.stderr, &exact, &zero);
-        assert!(
-            k > 100 && mean.abs() < 4.0 / (k as f64).sqrt() && mean_sq < 1.6,
-            "furnace z: mean {mean}, mean square {mean_sq}"
-        );
     }
 
     #[test]

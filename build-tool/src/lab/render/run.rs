@@ -183,7 +183,7 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
         camera: &camera,
         env: &env,
     };
-    let lobes = LobeTable::new(&scene.roughnesses());
+    let lobes = LobeTable::new(&scene.materials());
 
     // The reference, cached by everything it depends on.
     let key = content_hash(

@@ -7,13 +7,16 @@
 //! `I ≈ (1/n) Σ w_i L(l_i) V(x, l_i)`, where `L` is the map's radiance and `V` the
 //! visibility. The weight carries what the sampler knows of the rest:
 //! * BRDF sampling: `w = f(wo, l) cos / p(l)` for the renderer's warp, and the
-//!   stored albedo `A(roughness, theta_o)` for ours (`∫ L f cos ≈ (A/n) Σ L(l_i)`);
+//!   stored albedo `A(roughness, theta_o, metallic)` for ours' fixed instances
+//!   (`∫ L f cos ≈ (A/n) Σ L(l_i)`), the runtime's `f cos / pdf` for ours'
+//!   unbiased mode;
 //! * environment sampling: `w = f(wo, l) cos / pdf_env(l)`, ours included (its
 //!   exact pdf);
 //! * multiple importance sampling ([`super::mis`]): `2n` samples, `n` of each
 //!   technique, each weight times its power-heuristic weight.
 
 use super::frame::Frame;
+use super::scene::Material;
 use crate::seeding::{derive_seed, mix64};
 use glam::DVec3;
 
@@ -27,7 +30,7 @@ pub struct Sample {
     pub weight: f64,
     /// Solid-angle density of the sampler's warp at `direction` (per steradian),
     /// what [`DirectionSampler::pdf`] returns there; 0 where the sampler knows
-    /// none (ours for the BRDF).
+    /// none (ours' fixed instances for the BRDF).
     pub pdf: f64,
 }
 
@@ -38,15 +41,17 @@ pub struct ShadingPoint {
     pub frame: Frame,
     /// Unit view direction (towards the camera) in the local frame, `z > 0`.
     pub wo: DVec3,
-    /// glTF roughness of the surface.
-    pub roughness: f64,
+    /// The surface's material: glTF roughness and metallic.
+    pub material: Material,
 }
 
 impl ShadingPoint {
-    /// The cosine-weighted glTF BRDF `f(wo, l) max(n.l, 0)` for the world
-    /// direction `l` ([`nuld_core::brdf::cosine_weighted`]).
+    /// The cosine-weighted glTF metallic-roughness BRDF `f(wo, l) max(n.l, 0)`
+    /// for the world direction `l` ([`Material::cosine_weighted`],
+    /// `nuld_core::brdf::gltf_metallic`).
     pub fn cosine_weighted(&self, l: DVec3) -> f64 {
-        nuld_core::brdf::cosine_weighted(self.wo, self.frame.to_local(l), self.roughness)
+        self.material
+            .cosine_weighted(self.wo, self.frame.to_local(l))
     }
 
     /// `θo` in degrees, the view angle of the BRDF's condition.
@@ -135,7 +140,7 @@ pub trait DirectionSampler: Send + Sync {
 
     /// The solid-angle density with which the sampler's warp at `at` produces the
     /// world direction `l` (0 where it never does), for multiple importance
-    /// sampling; `None` when the sampler cannot say (ours for the BRDF, whose
-    /// samples carry no pdf).
+    /// sampling; `None` when the sampler cannot say (ours' fixed instances for
+    /// the BRDF, whose samples carry no pdf).
     fn pdf(&self, at: &ShadingPoint, l: DVec3) -> Option<f64>;
 }

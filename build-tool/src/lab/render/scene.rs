@@ -1,9 +1,11 @@
 //! The test scene of the rendering evaluation (paper Fig. 8): spheres of the glTF
-//! BRDF at several roughnesses on a ground plane, and ray casting against them.
+//! BRDF at several roughnesses, dielectric and metal, on a ground plane, and ray
+//! casting against them.
 //!
 //! World frame: `+z` up (the environment map's convention), the ground is the plane
-//! `z = 0`, every sphere rests on it. Every surface uses the glTF 2.0 BRDF of
-//! [`nuld_core::brdf`] (metallic 0, base colour 1) at its own roughness.
+//! `z = 0`, every sphere rests on it. Every surface uses the glTF 2.0
+//! metallic-roughness BRDF of [`nuld_core::brdf`] (base colour 1) at its own
+//! [`Material`]: roughness and metallic.
 
 use glam::DVec3;
 
@@ -21,15 +23,56 @@ pub struct Ray {
     pub direction: DVec3,
 }
 
-/// A sphere of the glTF BRDF at `roughness`.
+/// A surface's glTF metallic-roughness material, base colour 1: the BRDF
+/// `nuld_core::brdf::gltf_metallic` at its roughness and metallic.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material {
+    /// glTF roughness in `[0.1, 1]`.
+    pub roughness: f64,
+    /// glTF metallic in `[0, 1]`: 0 the dielectric, 1 the metal.
+    pub metallic: f64,
+}
+
+impl Material {
+    /// The dielectric (metallic 0) of `roughness`.
+    pub const fn dielectric(roughness: f64) -> Self {
+        Self {
+            roughness,
+            metallic: 0.0,
+        }
+    }
+
+    /// The metal (metallic 1) of `roughness`.
+    pub const fn metal(roughness: f64) -> Self {
+        Self {
+            roughness,
+            metallic: 1.0,
+        }
+    }
+
+    /// `f(wo, l) max(n.l, 0)` for unit local directions (`z` = the normal):
+    /// `nuld_core::brdf::gltf_metallic` times the cosine, bit for bit
+    /// `nuld_core::brdf::cosine_weighted` for the dielectric.
+    pub fn cosine_weighted(&self, wo: DVec3, l: DVec3) -> f64 {
+        let f = nuld_core::brdf::gltf_metallic(
+            wo.to_array(),
+            l.to_array(),
+            self.roughness,
+            self.metallic,
+        );
+        f * l.z.max(0.0)
+    }
+}
+
+/// A sphere of a [`Material`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sphere {
     /// Centre.
     pub center: DVec3,
     /// Radius, `> 0`.
     pub radius: f64,
-    /// glTF roughness in `[0.1, 1]`.
-    pub roughness: f64,
+    /// Its material.
+    pub material: Material,
 }
 
 /// The closest intersection of a ray with the scene.
@@ -41,69 +84,86 @@ pub struct Hit {
     pub position: DVec3,
     /// Unit geometric normal, facing the side the ray came from.
     pub normal: DVec3,
-    /// The surface's glTF roughness.
-    pub roughness: f64,
+    /// The surface's material.
+    pub material: Material,
 }
 
-/// Spheres on the ground plane `z = 0` (an infinite plane of roughness
-/// `ground_roughness`; `None`: no ground).
+/// Spheres on the ground plane `z = 0` (an infinite plane of material `ground`;
+/// `None`: no ground).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
     /// The spheres.
     pub spheres: Vec<Sphere>,
-    /// The ground plane's glTF roughness, `None` for no ground.
-    pub ground_roughness: Option<f64>,
+    /// The ground plane's material, `None` for no ground.
+    pub ground: Option<Material>,
 }
 
 /// Roughnesses of the default scene's spheres, left to right: the condition range
 /// of the BRDF sampler, `[0.1, 1]`, from near-mirror to fully rough.
 pub const SPHERE_ROUGHNESS: [f64; 5] = [0.1, 0.25, 0.4, 0.7, 1.0];
 
+/// The default scene's ground: a rough dielectric.
+pub const GROUND: Material = Material::dielectric(0.8);
+
+/// `y` of the default scene's front row (dielectrics) and back row (metals).
+pub const ROWS_Y: [f64; 2] = [-1.3, 1.3];
+
 impl Scene {
-    /// The scene of the evaluation: five unit spheres in a row along `x`, spaced
-    /// 2.3 apart, with the roughnesses [`SPHERE_ROUGHNESS`], on a ground of
-    /// roughness 0.8.
+    /// The scene of the evaluation: two rows of five unit spheres along `x`,
+    /// spaced 2.3 apart, with the roughnesses [`SPHERE_ROUGHNESS`] left to right:
+    /// dielectrics in front (`y = -1.3`), metals behind them (`y = 1.3`), on a
+    /// dielectric ground of roughness 0.8 ([`GROUND`]).
     pub fn spheres_on_ground() -> Self {
-        let spheres = SPHERE_ROUGHNESS
-            .iter()
-            .enumerate()
-            .map(|(k, &roughness)| Sphere {
-                center: DVec3::new(2.3 * (k as f64 - 2.0), 0.0, 1.0),
-                radius: 1.0,
-                roughness,
-            })
+        let row = |y: f64, material: fn(f64) -> Material| {
+            SPHERE_ROUGHNESS
+                .iter()
+                .enumerate()
+                .map(move |(k, &roughness)| Sphere {
+                    center: DVec3::new(2.3 * (k as f64 - 2.0), y, 1.0),
+                    radius: 1.0,
+                    material: material(roughness),
+                })
+        };
+        let spheres = row(ROWS_Y[0], Material::dielectric)
+            .chain(row(ROWS_Y[1], Material::metal))
             .collect();
         Self {
             spheres,
-            ground_roughness: Some(0.8),
+            ground: Some(GROUND),
         }
     }
 
-    /// Every roughness in the scene: the spheres', then the ground's (what a
-    /// renderer tabulates its per-material lobe probabilities for).
-    pub fn roughnesses(&self) -> Vec<f64> {
-        let spheres = self.spheres.iter().map(|s| s.roughness);
-        spheres.chain(self.ground_roughness).collect()
+    /// Every material in the scene, each once: the spheres' in order, then the
+    /// ground's (what a renderer tabulates its per-material lobe probabilities
+    /// for).
+    pub fn materials(&self) -> Vec<Material> {
+        let mut all: Vec<Material> = Vec::new();
+        for m in self.spheres.iter().map(|s| s.material).chain(self.ground) {
+            if !all.contains(&m) {
+                all.push(m);
+            }
+        }
+        all
     }
 
     /// The closest hit of `ray` with `t > 0`, if any. `O(spheres)`.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        let mut best: Option<(f64, DVec3, f64)> = None;
+        let mut best: Option<(f64, DVec3, Material)> = None;
         for s in &self.spheres {
             if let Some(t) = sphere_distance(s, ray) {
                 if best.is_none_or(|(b, _, _)| t < b) {
                     let n = (ray.origin + t * ray.direction - s.center) / s.radius;
-                    best = Some((t, n, s.roughness));
+                    best = Some((t, n, s.material));
                 }
             }
         }
-        if let (Some(roughness), Some(t)) = (self.ground_roughness, plane_distance(ray)) {
+        if let (Some(material), Some(t)) = (self.ground, plane_distance(ray)) {
             if best.is_none_or(|(b, _, _)| t < b) {
                 let n = DVec3::new(0.0, 0.0, if ray.origin.z >= 0.0 { 1.0 } else { -1.0 });
-                best = Some((t, n, roughness));
+                best = Some((t, n, material));
             }
         }
-        best.map(|(t, normal, roughness)| {
+        best.map(|(t, normal, material)| {
             let normal = if normal.dot(ray.direction) > 0.0 {
                 -normal
             } else {
@@ -113,7 +173,7 @@ impl Scene {
                 t,
                 position: ray.origin + t * ray.direction,
                 normal: normal.normalize(),
-                roughness,
+                material,
             }
         })
     }
@@ -121,7 +181,7 @@ impl Scene {
     /// Whether anything blocks `ray` (a shadow ray towards the environment, which
     /// is infinitely far). `O(spheres)`.
     pub fn occluded(&self, ray: &Ray) -> bool {
-        (self.ground_roughness.is_some() && plane_distance(ray).is_some())
+        (self.ground.is_some() && plane_distance(ray).is_some())
             || self
                 .spheres
                 .iter()
@@ -164,31 +224,45 @@ mod tests {
     #[test]
     fn rays_hit_the_nearest_surface_with_outward_normals() {
         let scene = Scene::spheres_on_ground();
-        // Straight down onto the middle sphere's top: t = 10 - 2.
-        let down = Ray {
-            origin: DVec3::new(0.0, 0.0, 10.0),
+        let [front, back] = ROWS_Y;
+        // Straight down onto the middle front sphere's top: t = 10 - 2, the
+        // dielectric of the middle roughness.
+        let down = |x: f64, y: f64| Ray {
+            origin: DVec3::new(x, y, 10.0),
             direction: DVec3::NEG_Z,
         };
-        let hit = scene.intersect(&down).unwrap();
+        let hit = scene.intersect(&down(0.0, front)).unwrap();
         assert!((hit.t - 8.0).abs() < 1e-12);
         assert!((hit.normal - DVec3::Z).length() < 1e-12);
-        assert_eq!(hit.roughness, SPHERE_ROUGHNESS[2]);
-        // Between two spheres the ground is hit.
-        let gap = Ray {
-            origin: DVec3::new(1.15, 0.0, 10.0),
-            direction: DVec3::NEG_Z,
-        };
-        let hit = scene.intersect(&gap).unwrap();
-        assert!((hit.t - 10.0).abs() < 1e-12 && hit.roughness == 0.8);
-        assert_eq!(scene.roughnesses(), [0.1, 0.25, 0.4, 0.7, 1.0, 0.8]);
+        assert_eq!(hit.material, Material::dielectric(SPHERE_ROUGHNESS[2]));
+        // Behind it, the metal of the same roughness; the rightmost metal is the
+        // roughest.
+        let hit = scene.intersect(&down(0.0, back)).unwrap();
+        assert!((hit.t - 8.0).abs() < 1e-12);
+        assert_eq!(hit.material, Material::metal(SPHERE_ROUGHNESS[2]));
+        let hit = scene.intersect(&down(4.6, back)).unwrap();
+        assert_eq!(hit.material, Material::metal(1.0));
+        // Between two spheres, and between the rows, the ground is hit.
+        for gap in [down(1.15, front), down(0.0, 0.0)] {
+            let hit = scene.intersect(&gap).unwrap();
+            assert!((hit.t - 10.0).abs() < 1e-12 && hit.material == GROUND);
+        }
+        let gap = down(1.15, front);
+        let roughness = [0.1, 0.25, 0.4, 0.7, 1.0];
+        let want: Vec<Material> = (roughness.map(Material::dielectric).into_iter())
+            .chain(roughness.map(Material::metal))
+            .chain([GROUND])
+            .collect();
+        assert_eq!(scene.materials(), want);
         let floating = Scene {
-            ground_roughness: None,
+            ground: None,
             ..scene.clone()
         };
         assert!(floating.intersect(&gap).is_none() && !floating.occluded(&gap));
-        // Sideways into the leftmost sphere from far left: its surface at x = -5.6.
+        // Sideways into the leftmost front sphere from far left: its surface at
+        // x = -5.6.
         let side = Ray {
-            origin: DVec3::new(-20.0, 0.0, 1.0),
+            origin: DVec3::new(-20.0, front, 1.0),
             direction: DVec3::X,
         };
         let hit = scene.intersect(&side).unwrap();
@@ -204,11 +278,32 @@ mod tests {
             origin: DVec3::new(0.0, 5.0, 3.0),
             direction: DVec3::NEG_Z
         }));
-        // From a sphere's side towards its neighbour: blocked.
+        // From a sphere's side towards its neighbour: blocked; from a front
+        // sphere's back towards the metal behind it: blocked.
         let towards = Ray {
-            origin: DVec3::new(-1.0 - RAY_EPSILON, 0.0, 1.0),
+            origin: DVec3::new(-1.0 - RAY_EPSILON, front, 1.0),
             direction: DVec3::NEG_X,
         };
         assert!(scene.occluded(&towards));
+        let behind = Ray {
+            origin: DVec3::new(0.0, front + 1.0 + RAY_EPSILON, 1.0),
+            direction: DVec3::Y,
+        };
+        assert!(scene.occluded(&behind));
+    }
+
+    /// The material's `f cos` is the metallic-roughness BRDF's, the dielectric's
+    /// bit for bit as before.
+    #[test]
+    fn materials_evaluate_the_metallic_brdf() {
+        let wo = DVec3::new(0.6, 0.0, 0.8);
+        let l = DVec3::new(-0.28, 0.0, 0.96);
+        let d = Material::dielectric(0.3).cosine_weighted(wo, l);
+        assert_eq!(d, nuld_core::brdf::cosine_weighted(wo, l, 0.3));
+        let m = Material::metal(0.3).cosine_weighted(wo, l);
+        let want = nuld_core::brdf::gltf_metallic(wo.to_array(), l.to_array(), 0.3, 1.0) * l.z;
+        assert_eq!(m, want);
+        assert!(m != d && m > 0.0);
+        assert_eq!(Material::metal(0.3).cosine_weighted(wo, -l), 0.0);
     }
 }
