@@ -1,0 +1,93 @@
+//! Where the BRDF samplers' bias sits in the render scene: the mean signed error
+//! of `render`'s BRDF images split by surface (dielectric spheres, metal spheres,
+//! ground), `cargo run --release -p nuld-build-tool --example
+//! render_bias_by_surface -- MAP N=BLOB...` (e.g. `16=brdf-n16/brdf.nuld`).
+//!
+//! The images are `render`'s own at 160 x 120 pixels (the same samplers, seeds 0
+//! to 3, so bit for bit those of `render --size 160x120 --seeds 4`): `nuld-table`,
+//! `nuld-unbiased` and `owen-sobol` at `N` spp with the blob of `N`. The
+//! reference is the renderer's (1024 + 1024 samples per pixel, seed 7): its mean
+//! over a surface class of thousands of pixels is known to about 1e-4.
+use nuld_build_tool::lab::render::brdf_warp::LobeTable;
+use nuld_build_tool::lab::render::camera::Camera;
+use nuld_build_tool::lab::render::environment::Environment;
+use nuld_build_tool::lab::render::integrator::{Primary, Setup};
+use nuld_build_tool::lab::render::lineup;
+use nuld_build_tool::lab::render::reference::Reference;
+use nuld_build_tool::lab::render::sampler::Technique;
+use nuld_build_tool::lab::render::scene::Scene;
+use nuld_build_tool::pointset::AlignedBytes;
+use std::path::Path;
+
+/// The surface classes, in print order.
+const CLASSES: [&str; 3] = ["dielectric spheres", "metal spheres", "ground"];
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if args.len() < 3 {
+        eprintln!("usage: render_bias_by_surface MAP N=BLOB...");
+        std::process::exit(2);
+    }
+    let env = Environment::from_file(Path::new(&args[1])).unwrap();
+    let scene = Scene::spheres_on_ground();
+    let camera = Camera::evaluation(160, 120);
+    let setup = Setup {
+        scene: &scene,
+        camera: &camera,
+        env: &env,
+    };
+    let lobes = LobeTable::new(&scene.materials());
+    let reference = Reference::render(&setup, &lobes, 1024, 7, &|| {});
+    // Each pixel's class: the ground is the plane z = 0, the spheres' material
+    // tells the rest.
+    let class: Vec<Option<usize>> = (0..camera.height())
+        .flat_map(|y| (0..camera.width()).map(move |x| (x, y)))
+        .map(|(x, y)| match setup.primary(x, y) {
+            Primary::Surface { position, .. } if position.z < 1e-9 => Some(2),
+            Primary::Surface { at, .. } => Some(usize::from(at.material.metallic > 0.5)),
+            Primary::Background(_) => None,
+        })
+        .collect();
+    for arg in &args[2..] {
+        let (n, path) = arg.split_once('=').expect("N=BLOB");
+        let n: u32 = n.parse().expect("N a sample count");
+        let blob = AlignedBytes::read(Path::new(path)).unwrap();
+        for name in ["nuld-table", "nuld-unbiased", "owen-sobol"] {
+            // Per class: sum of errors, sum of reference values, pixels.
+            let mut sums = [[0.0f64; 3]; 3];
+            for seed in 0..4u64 {
+                let mut weights = Default::default();
+                let samplers = lineup::samplers(
+                    &[Technique::Brdf],
+                    Some(blob.as_slice()),
+                    None,
+                    n,
+                    seed,
+                    &lobes,
+                    &env,
+                    &mut weights,
+                )
+                .unwrap();
+                let s = samplers.iter().find(|s| s.name() == name).unwrap();
+                let img = setup.render(s.as_ref(), n, seed, &|| {});
+                for (i, c) in class.iter().enumerate() {
+                    if let Some(c) = *c {
+                        sums[c][0] += img.values[i] - reference.image.values[i];
+                        sums[c][1] += reference.image.values[i];
+                        sums[c][2] += 1.0;
+                    }
+                }
+            }
+            let parts: Vec<String> = CLASSES
+                .iter()
+                .zip(sums)
+                .map(|(label, [e, r, k])| {
+                    format!("{label} {:+.2e} of {:.3} ({} px)", e / k, r / k, k / 4.0)
+                })
+                .collect();
+            let total =
+                sums.iter().map(|c| c[0]).sum::<f64>() / sums.iter().map(|c| c[2]).sum::<f64>();
+            println!("{n} spp {name}: image {total:+.2e}; {}", parts.join("; "));
+        }
+    }
+}
