@@ -87,7 +87,7 @@ fn blob(bytes: &AlignedBytes) -> Blob<'_> {
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let shape_of = |warp| shape(64, &[32, 32], Activation::Relu, warp, 64);
     let brdf_bytes =
-        conditional_parts(shape_of(PointWarp::BrdfMixture), 16, [10, 9], 2).to_blob(&META)?;
+        conditional_parts(shape_of(PointWarp::BrdfTable), 16, [10, 9], 2).to_blob(&META)?;
     let env_bytes = as_envmap(conditional_parts(
         shape_of(PointWarp::EnvmapTree),
         16,
