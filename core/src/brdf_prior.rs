@@ -182,6 +182,27 @@ pub fn half_vector_point<T: Real>(wo: [T; 3], wi: [T; 3]) -> Option<([T; 2], T)>
     (h[2] > T::ZERO && c > T::ZERO).then(|| (hemisphere_to_square_real(h), T::of(4.0) * c))
 }
 
+/// The blend at `cond = [roughness, θo in degrees, metallic]` (clamped,
+/// [`unit_condition`]) on a node grid `grid` whose node `k` has mass
+/// `masses[k]`: the multilinear weights of the (up to 8) nodes around it times
+/// their masses, so that a warp over the normalized tables samples the
+/// interpolated unnormalized target (module docs). A node past `masses` weighs
+/// 0. The one blend of [`BrdfPrior::blend`] and the build tool's priors.
+#[inline]
+pub fn mass_weighted_blend<T: Real>(grid: [u32; 3], masses: &[T], cond: [T; 3]) -> Blend<T> {
+    let multilinear = Blend::multilinear(&unit_condition(cond), &grid);
+    let mut pairs = [(0u32, T::ZERO); MAX_BLEND];
+    let mut len = 0;
+    for (node, w) in multilinear.pairs() {
+        let mass = masses.get(node as usize).copied().unwrap_or(T::ZERO);
+        if let Some(slot) = pairs.get_mut(len) {
+            *slot = (node, w * mass);
+            len += 1;
+        }
+    }
+    Blend::from_pairs(&pairs[..len])
+}
+
 /// The tabulated BRDF prior over borrowed tables (module docs): node tables as
 /// [`crate::marginal2d::tabulate`] writes them and each node's mass.
 #[derive(Clone, Copy, Debug)]
@@ -202,9 +223,7 @@ impl<'a, T: Real> BrdfPrior<'a, T> {
         conditional: &'a [T],
         masses: &'a [T],
     ) -> Result<Self, Marginal2DError> {
-        let shape = info.shape().ok_or(Marginal2DError::Shape)?;
-        let warp = Marginal2D::new(shape, data, marginal, conditional)?;
-        Self::with_masses(info, warp, masses, true)
+        Self::build(info, [data, marginal, conditional], masses, true)
     }
 
     /// The prior over tables that [`Self::new`] has checked before: shape and
@@ -216,18 +235,22 @@ impl<'a, T: Real> BrdfPrior<'a, T> {
         conditional: &'a [T],
         masses: &'a [T],
     ) -> Result<Self, Marginal2DError> {
-        let shape = info.shape().ok_or(Marginal2DError::Shape)?;
-        let warp = Marginal2D::view(shape, data, marginal, conditional)?;
-        Self::with_masses(info, warp, masses, false)
+        Self::build(info, [data, marginal, conditional], masses, false)
     }
 
-    fn with_masses(
+    /// [`Self::new`] (`check`: every value) or [`Self::view`] (lengths only).
+    fn build(
         info: BrdfPriorInfo,
-        warp: Marginal2D<'a, T>,
+        [data, marginal, conditional]: [&'a [T]; 3],
         masses: &'a [T],
         check: bool,
     ) -> Result<Self, Marginal2DError> {
-        let nodes = info.nodes().ok_or(Marginal2DError::Shape)?;
+        let shape = info.shape().ok_or(Marginal2DError::Shape)?;
+        let warp = match check {
+            true => Marginal2D::new(shape, data, marginal, conditional)?,
+            false => Marginal2D::view(shape, data, marginal, conditional)?,
+        };
+        let nodes = shape.nodes;
         if masses.len() != nodes as usize {
             return Err(Marginal2DError::Length {
                 slice: 3,
@@ -258,17 +281,7 @@ impl<'a, T: Real> BrdfPrior<'a, T> {
     /// interpolated unnormalized target (module docs).
     #[inline]
     pub fn blend(&self, cond: [T; 3]) -> Blend<T> {
-        let multilinear = Blend::multilinear(&unit_condition(cond), &self.grid);
-        let mut pairs = [(0u32, T::ZERO); MAX_BLEND];
-        let mut len = 0;
-        for (node, w) in multilinear.pairs() {
-            let mass = self.masses.get(node as usize).copied().unwrap_or(T::ZERO);
-            if let Some(slot) = pairs.get_mut(len) {
-                *slot = (node, w * mass);
-                len += 1;
-            }
-        }
-        Blend::from_pairs(&pairs[..len])
+        mass_weighted_blend(self.grid, self.masses, cond)
     }
 
     /// The light direction of primary sample `u` in `[0,1]^2` (clamped) for the

@@ -233,6 +233,36 @@ pub fn tabulate<T: Real>(
     marginal: &mut [T],
     conditional: &mut [T],
 ) -> Result<(), Marginal2DError> {
+    tabulate_into(shape, data, marginal, conditional, None)
+}
+
+/// [`tabulate`], and each node's mass before normalization (the integral of its
+/// bilinear interpolant, what the tables are divided by) written to `masses`,
+/// one per node (a length error names it as slice 3).
+pub fn tabulate_with_masses<T: Real>(
+    shape: Marginal2DShape,
+    data: &mut [T],
+    marginal: &mut [T],
+    conditional: &mut [T],
+    masses: &mut [T],
+) -> Result<(), Marginal2DError> {
+    if masses.len() != shape.nodes as usize {
+        return Err(Marginal2DError::Length {
+            slice: 3,
+            expected: shape.nodes as u64,
+            got: masses.len() as u64,
+        });
+    }
+    tabulate_into(shape, data, marginal, conditional, Some(masses))
+}
+
+fn tabulate_into<T: Real>(
+    shape: Marginal2DShape,
+    data: &mut [T],
+    marginal: &mut [T],
+    conditional: &mut [T],
+    mut masses: Option<&mut [T]>,
+) -> Result<(), Marginal2DError> {
     check_lengths(shape, data.len(), marginal.len(), conditional.len())?;
     if let Some(index) = data.iter().position(|&v| !(v >= T::ZERO && v.is_finite())) {
         return Err(Marginal2DError::BadValue {
@@ -263,6 +293,9 @@ pub fn tabulate<T: Real>(
         let total = marginal[m + ny - 1];
         if !(total > T::ZERO && total.is_finite()) {
             return Err(Marginal2DError::NoMass { node: k as u32 });
+        }
+        if let Some(slot) = masses.as_deref_mut().and_then(|m| m.get_mut(k)) {
+            *slot = total;
         }
         let inv = T::ONE / total;
         for v in &mut data[table..table + nx * ny] {

@@ -311,7 +311,7 @@ pub fn doc_example_conditional_blob() -> Aligned<[u8; 400]> {
 pub fn doc_example_brdf_blob() -> Aligned<[u8; 1776]> {
     use nuld_core::brdf::{gltf_metallic, view_direction_real};
     use nuld_core::brdf_prior::{half_vector_direction, node_condition, BrdfPriorInfo};
-    use nuld_core::marginal2d::tabulate;
+    use nuld_core::marginal2d::tabulate_with_masses;
     let (info, params, table, _) =
         doc_example_parts(ConditionalTarget::GltfBrdf, [0.1, 0.0], [1.0, 89.0]);
     let info = ConditionalInfo {
@@ -334,20 +334,20 @@ pub fn doc_example_brdf_blob() -> Aligned<[u8; 1776]> {
             }
         }
     }
-    // Each node's trapezoid mass, which `tabulate` divides by.
-    let mut masses = [0.0f32; 8];
-    for (mass, table) in masses.iter_mut().zip(data.chunks(16)) {
-        let w = |i: usize| if i == 0 || i == 3 { 0.5 } else { 1.0 };
-        *mass = (0..16).map(|v| w(v % 4) * w(v / 4) * table[v]).sum::<f32>() / 9.0;
-    }
-    let (mut marginal, mut conditional) = ([0.0f32; 32], [0.0f32; 128]);
+    let (mut marginal, mut conditional, mut masses) = ([0.0f32; 32], [0.0f32; 128], [0.0f32; 8]);
     let shape = prior
         .shape()
         .unwrap_or(nuld_core::marginal2d::Marginal2DShape {
             size: [4, 4],
             nodes: 8,
         });
-    let _ = tabulate(shape, &mut data, &mut marginal, &mut conditional);
+    let _ = tabulate_with_masses(
+        shape,
+        &mut data,
+        &mut marginal,
+        &mut conditional,
+        &mut masses,
+    );
     let meta = [
         3, b'd', b'o', b'c', 7, b'b', b'r', b'd', b'f', b'-', b'd', b'o', 0,
     ];

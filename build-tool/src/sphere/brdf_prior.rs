@@ -28,9 +28,9 @@ use super::envmap_prior::tabulated;
 use glam::{DVec2, DVec3};
 use nuld_core::brdf::{gltf_metallic, view_direction};
 use nuld_core::brdf_prior::{
-    half_vector_direction, half_vector_point, node_condition, unit_condition, BrdfPriorInfo,
+    half_vector_direction, half_vector_point, mass_weighted_blend, node_condition, BrdfPriorInfo,
 };
-use nuld_core::marginal2d::{Blend, Marginal2D, Marginal2DError, Marginal2DShape, MAX_BLEND};
+use nuld_core::marginal2d::{Blend, Marginal2D, Marginal2DError, Marginal2DShape};
 use nuld_core::sphere::{hemisphere_to_square, square_to_hemisphere};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -108,26 +108,13 @@ pub struct BrdfPrior {
     pub marginal: Vec<f32>,
     /// Conditional CDFs.
     pub conditional: Vec<f32>,
-    /// Each node's mass before normalization (the trapezoid rule of
-    /// [`nuld_core::marginal2d::tabulate`] in `f64`): the blend's weights are
+    /// Each node's mass before normalization
+    /// ([`nuld_core::marginal2d::tabulate_with_masses`]): the blend's weights are
     /// multiplied by them ([`nuld_core::brdf_prior::BrdfPrior::blend`]).
     pub masses: Vec<f32>,
     /// The four tables widened to `f64` (data, marginal, conditional, masses):
     /// the trainer warps in `f64` ([`Self::core_f64`]) for its differences.
     wide: [Vec<f64>; 4],
-}
-
-/// The trapezoid mass of an `s x s` table on `[0,1]^2` (what
-/// [`nuld_core::marginal2d::tabulate`] divides by).
-fn trapezoid_mass(table: &[f32], s: usize) -> f64 {
-    let weight = |i: usize| if i == 0 || i == s - 1 { 0.5 } else { 1.0 };
-    let mut sum = 0.0;
-    for j in 0..s {
-        for i in 0..s {
-            sum += weight(i) * weight(j) * table[j * s + i] as f64;
-        }
-    }
-    sum / ((s - 1) * (s - 1)) as f64
 }
 
 impl BrdfPrior {
@@ -181,8 +168,7 @@ impl BrdfPrior {
                 out
             })
             .collect();
-        let masses = tables.iter().map(|t| trapezoid_mass(t, s) as f32).collect();
-        let [data, marginal, conditional] = tabulated(shape, &tables)?;
+        let ([data, marginal, conditional], masses) = tabulated(shape, &tables)?;
         let widen = |v: &Vec<f32>| v.iter().map(|&x| x as f64).collect();
         let wide = [
             widen(&data),
@@ -278,14 +264,7 @@ impl BrdfPrior {
     /// multilinear weights times the nodes' masses, as
     /// [`nuld_core::brdf_prior::BrdfPrior::blend`] (in both spaces).
     pub fn blend(&self, condition: [f64; 3]) -> Blend<f32> {
-        let unit = unit_condition(condition).map(|x| x as f32);
-        let multilinear = Blend::multilinear(&unit, &self.grid);
-        let pairs: Vec<(u32, f32)> = multilinear
-            .pairs()
-            .map(|(node, w)| (node, w * self.masses[node as usize]))
-            .collect();
-        debug_assert!(pairs.len() <= MAX_BLEND);
-        Blend::from_pairs(&pairs)
+        mass_weighted_blend(self.grid, &self.masses, condition.map(|x| x as f32))
     }
 
     /// The light direction at primary sample `u` for `condition`, and its

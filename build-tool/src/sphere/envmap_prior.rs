@@ -18,7 +18,9 @@
 use super::envmap::EnvmapDensity;
 use super::target::DirectionDensity;
 use glam::{DVec2, DVec3};
-use nuld_core::marginal2d::{tabulate, Blend, Marginal2D, Marginal2DError, Marginal2DShape};
+use nuld_core::marginal2d::{
+    tabulate_with_masses, Blend, Marginal2D, Marginal2DError, Marginal2DShape,
+};
 use nuld_core::sphere::{sphere_to_square, square_to_sphere, wrap_octahedral};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -88,7 +90,7 @@ impl EnvmapPrior {
                 }
             })
             .collect();
-        let [data, marginal, conditional] = tabulated(shape, &tables)?;
+        let ([data, marginal, conditional], _) = tabulated(shape, &tables)?;
         Ok(Self {
             grid,
             shape,
@@ -132,16 +134,24 @@ impl EnvmapPrior {
 
 /// The node tables `tables` (each `nx ny` vertex values) of a warp of `shape`
 /// normalized, with their cumulative tables: `[data, marginal, conditional]` as
-/// [`Marginal2D::new`] reads them ([`tabulate`]).
+/// [`Marginal2D::new`] reads them, and each node's mass before normalization
+/// ([`tabulate_with_masses`]).
 pub(crate) fn tabulated(
     shape: Marginal2DShape,
     tables: &[Vec<f32>],
-) -> Result<[Vec<f32>; 3], Marginal2DError> {
+) -> Result<([Vec<f32>; 3], Vec<f32>), Marginal2DError> {
     let mut data = tables.concat();
     let mut marginal = vec![0.0; shape.marginal_len().ok_or(Marginal2DError::Shape)?];
     let mut conditional = vec![0.0; data.len()];
-    tabulate(shape, &mut data, &mut marginal, &mut conditional)?;
-    Ok([data, marginal, conditional])
+    let mut masses = vec![0.0; shape.nodes as usize];
+    tabulate_with_masses(
+        shape,
+        &mut data,
+        &mut marginal,
+        &mut conditional,
+        &mut masses,
+    )?;
+    Ok(([data, marginal, conditional], masses))
 }
 
 /// Per table vertex, the mean of `value(direction, L)` over its `k x k`

@@ -2,7 +2,7 @@ extern crate std;
 
 use super::*;
 use crate::brdf::{gltf_metallic, view_direction_real};
-use crate::marginal2d::tabulate;
+use crate::marginal2d::tabulate_with_masses;
 use crate::sphere::hemisphere_to_square;
 use crate::test_rng::Rng;
 use std::vec;
@@ -62,18 +62,22 @@ impl Tables {
         let raw = data.clone();
         let mut marginal = vec![0.0; shape.marginal_len().unwrap()];
         let mut conditional = vec![0.0; shape.data_len().unwrap()];
-        tabulate(shape, &mut data, &mut marginal, &mut conditional).unwrap();
-        // Each node's mass: raw over normalized at its largest vertex.
-        let masses = (0..shape.nodes as usize)
-            .map(|k| {
-                let block = k * s * s..(k + 1) * s * s;
-                let at = block
-                    .clone()
-                    .max_by(|&a, &b| raw[a].total_cmp(&raw[b]))
-                    .unwrap();
-                raw[at] / data[at]
-            })
-            .collect();
+        let mut masses = vec![0.0; shape.nodes as usize];
+        tabulate_with_masses(
+            shape,
+            &mut data,
+            &mut marginal,
+            &mut conditional,
+            &mut masses,
+        )
+        .unwrap();
+        // Each node's mass is what its table was divided by: raw over
+        // normalized at its largest vertex.
+        for (k, mass) in masses.iter().enumerate() {
+            let block = k * s * s..(k + 1) * s * s;
+            let at = block.max_by(|&a, &b| raw[a].total_cmp(&raw[b])).unwrap();
+            assert!((raw[at] / data[at] / mass - 1.0).abs() < 1e-12, "node {k}");
+        }
         Self {
             info,
             data,
