@@ -60,7 +60,7 @@ const NULD_TAG_WEIGHT_TABLE: u32 = 6u;
 const NULD_TAG_ENVMAP_TREE_INFO: u32 = 7u;
 const NULD_TAG_ENVMAP_TREE_NODES: u32 = 8u;
 const NULD_TAG_ENVMAP_TREE_TOP: u32 = 9u;
-const NULD_TAG_BRDF_PRIOR_INFO: u32 = 10u;
+const NULD_TAG_BRDF_PRIOR_INFO: u32 = 15u;
 const NULD_TAG_BRDF_PRIOR_DATA: u32 = 11u;
 const NULD_TAG_BRDF_PRIOR_MARGINAL: u32 = 12u;
 const NULD_TAG_BRDF_PRIOR_CONDITIONAL: u32 = 13u;
@@ -1550,18 +1550,32 @@ fn nuld_hemisphere_to_square(d: vec3<f32>) -> vec2<f32> {
 
 // Rust: `half_vector_direction` and `half_vector_point` (core/src/brdf_prior.rs):
 // a light direction `w` (or a square point `w.xy`) and the Jacobian
-// `jac = |dwi/dh| = 4 wo.h`; `jac = 0` where Rust has `None`.
+// `jac = |dwi/dh'| = 4 (wo.h) k^2 / L^3` of the stretched half vector `h'`;
+// `jac = 0` where Rust has `None`.
 struct NuldHalfVector {
     w: vec3<f32>,
     jac: f32,
 }
 
+// Rust: `stretch`: the half-vector square's stretch `k = roughness^(1/4)` at the
+// clamped roughness.
+fn nuld_stretch(roughness: f32) -> f32 {
+    return sqrt(sqrt(nuld_clamp_roughness(roughness)));
+}
+
 // Rust: `half_vector_direction`: the light direction `wi = 2 (wo.h) h - wo` of
-// the half vector `h` of the square point `p` (divided by its length, as
-// `normalized`), for the unit view `wo`; none where `wo.h <= 0` or `wi.z <= 0`.
-fn nuld_half_vector_direction(wo: vec3<f32>, p: vec2<f32>) -> NuldHalfVector {
+// the half vector `h = (k h'.x, k h'.y, h'.z) / L` of the square point `p`
+// (`h'` its hemisphere direction), for the unit view `wo`; none where
+// `wo.h <= 0` or `wi.z <= 0`.
+fn nuld_half_vector_direction(wo: vec3<f32>, p: vec2<f32>, k: f32) -> NuldHalfVector {
     let missing = NuldHalfVector(vec3<f32>(0.0, 0.0, 1.0), 0.0);
-    let h = nuld_square_to_hemisphere(p);
+    let s = nuld_square_to_hemisphere(p);
+    let sv = vec3<f32>(k * s.x, k * s.y, s.z);
+    let sl = sqrt(sv.x * sv.x + sv.y * sv.y + sv.z * sv.z);
+    if !(sl > 0.0) {
+        return missing;
+    }
+    let h = vec3<f32>(sv.x / sl, sv.y / sl, sv.z / sl);
     let c = wo.x * h.x + wo.y * h.y + wo.z * h.z;
     if !(c > 0.0) {
         return missing;
@@ -1573,15 +1587,17 @@ fn nuld_half_vector_direction(wo: vec3<f32>, p: vec2<f32>) -> NuldHalfVector {
         return missing;
     }
     let wi = vec3<f32>(v.x / len, v.y / len, v.z / len);
-    if !(wi.z > 0.0) {
+    let jac = 4.0 * c * k * k / (sl * sl * sl);
+    if !(wi.z > 0.0 && nuld_is_finite(jac)) {
         return missing;
     }
-    return NuldHalfVector(wi, 4.0 * c);
+    return NuldHalfVector(wi, jac);
 }
 
-// Rust: `half_vector_point`: the square point (in `w.xy`) of the half vector
-// `h = (wo + wi) / |wo + wi|`; none where `wi.z <= 0`, `h.z <= 0` or `wo.h <= 0`.
-fn nuld_half_vector_point(wo: vec3<f32>, wi: vec3<f32>) -> NuldHalfVector {
+// Rust: `half_vector_point`: the square point (in `w.xy`) of the stretched half
+// vector `h' = (h.x / k, h.y / k, h.z) / L'` of `h = (wo + wi) / |wo + wi|`;
+// none where `wi.z <= 0`, `h.z <= 0` or `wo.h <= 0`.
+fn nuld_half_vector_point(wo: vec3<f32>, wi: vec3<f32>, k: f32) -> NuldHalfVector {
     let missing = NuldHalfVector(vec3<f32>(0.5, 0.5, 0.0), 0.0);
     if !(wi.z > 0.0) {
         return missing;
@@ -1596,7 +1612,17 @@ fn nuld_half_vector_point(wo: vec3<f32>, wi: vec3<f32>) -> NuldHalfVector {
     if !(h.z > 0.0 && c > 0.0) {
         return missing;
     }
-    return NuldHalfVector(vec3<f32>(nuld_hemisphere_to_square(h), 0.0), 4.0 * c);
+    let sv = vec3<f32>(h.x / k, h.y / k, h.z);
+    let sl = sqrt(sv.x * sv.x + sv.y * sv.y + sv.z * sv.z);
+    if !(sl > 0.0 && nuld_is_finite(sl)) {
+        return missing;
+    }
+    let s = vec3<f32>(sv.x / sl, sv.y / sl, sv.z / sl);
+    let jac = 4.0 * c * k * k * sl * sl * sl;
+    if !nuld_is_finite(jac) {
+        return missing;
+    }
+    return NuldHalfVector(vec3<f32>(nuld_hemisphere_to_square(s), 0.0), jac);
 }
 
 // Rust: `BrdfPrior::sample`: the light direction of primary sample `u` for the
@@ -1606,7 +1632,7 @@ fn nuld_half_vector_point(wo: vec3<f32>, wi: vec3<f32>) -> NuldHalfVector {
 fn nuld_brdf_prior_sample(pr: NuldBrdfPrior, cond: vec3<f32>, u: vec2<f32>) -> NuldTreeSample {
     let wo = nuld_view_direction(cond.y);
     let s = nuld_marginal_sample(pr, nuld_brdf_blend(pr, cond), u);
-    let hv = nuld_half_vector_direction(wo, s.p);
+    let hv = nuld_half_vector_direction(wo, s.p, nuld_stretch(cond.x));
     if hv.jac > 0.0 {
         return NuldTreeSample(hv.w, s.pdf / (2.0 * NULD_PI * hv.jac));
     }
@@ -1618,7 +1644,7 @@ fn nuld_brdf_prior_sample(pr: NuldBrdfPrior, cond: vec3<f32>, u: vec2<f32>) -> N
 // nothing.
 fn nuld_brdf_prior_pdf(pr: NuldBrdfPrior, cond: vec3<f32>, wi: vec3<f32>) -> f32 {
     let wo = nuld_view_direction(cond.y);
-    let hv = nuld_half_vector_point(wo, wi);
+    let hv = nuld_half_vector_point(wo, wi, nuld_stretch(cond.x));
     if hv.jac > 0.0 {
         return nuld_marginal_pdf(pr, nuld_brdf_blend(pr, cond), hv.w.xy) / (2.0 * NULD_PI * hv.jac);
     }

@@ -310,7 +310,7 @@ pub fn doc_example_conditional_blob() -> Aligned<[u8; 400]> {
 #[doc(hidden)]
 pub fn doc_example_brdf_blob() -> Aligned<[u8; 1776]> {
     use nuld_core::brdf::{gltf_metallic, view_direction_real};
-    use nuld_core::brdf_prior::{half_vector_direction, node_condition, BrdfPriorInfo};
+    use nuld_core::brdf_prior::{half_vector_direction, node_condition, stretch, BrdfPriorInfo};
     use nuld_core::marginal2d::tabulate_with_masses;
     let (info, params, table, _) =
         doc_example_parts(ConditionalTarget::GltfBrdf, [0.1, 0.0], [1.0, 89.0]);
@@ -329,7 +329,7 @@ pub fn doc_example_brdf_blob() -> Aligned<[u8; 1776]> {
         let wo = view_direction_real(t);
         for (v, value) in table.iter_mut().enumerate() {
             let p = [(v % 4) as f32 / 3.0, (v / 4) as f32 / 3.0];
-            if let Some((wi, jac)) = half_vector_direction(wo, p) {
+            if let Some((wi, jac)) = half_vector_direction(wo, p, stretch(r)) {
                 *value = gltf_metallic(wo, wi, r, m) * wi[2] * jac;
             }
         }
@@ -496,6 +496,34 @@ mod tests {
         let brdf = Blob::parse(&bytes.0).unwrap().brdf().unwrap();
         let s = brdf.sample(glam::Vec3::new(0.3, 0.1, 0.9), 0.5, 0.5, 1, 1);
         assert!(s.pdf > 0.0 && s.weight > 0.0);
+    }
+
+    /// A blob of the earlier, unstretched prior (its info under tag 10, the
+    /// checksum sound) is refused with the advice to bake it again.
+    #[test]
+    fn a_brdf_blob_of_the_unstretched_prior_is_refused() {
+        use nuld_core::blob::{
+            checksum, SectionTag, CHECKSUM_OFFSET, HEADER_LEN, SECTION_ENTRY_LEN,
+        };
+        let mut bytes = doc_example_brdf_blob();
+        let b = &mut bytes.0;
+        let count = u32::from_le_bytes(b[40..44].try_into().unwrap()) as usize;
+        let row = (0..count)
+            .map(|k| HEADER_LEN + k * SECTION_ENTRY_LEN)
+            .find(|&at| {
+                u32::from_le_bytes(b[at..at + 4].try_into().unwrap())
+                    == SectionTag::BrdfPriorInfo as u32
+            })
+            .unwrap();
+        b[row..row + 4].copy_from_slice(&10u32.to_le_bytes());
+        let sum = checksum(b);
+        b[CHECKSUM_OFFSET..CHECKSUM_OFFSET + 8].copy_from_slice(&sum.to_le_bytes());
+        let err = Blob::parse(b).unwrap_err();
+        assert_eq!(
+            err,
+            BlobError::Conditional(nuld_core::blob::ConditionalError::BrdfPriorUnstretched)
+        );
+        assert!(std::format!("{err}").contains("bake it again with `build-tool bake --brdf`"));
     }
 
     #[test]

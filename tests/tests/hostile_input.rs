@@ -654,7 +654,7 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
         })
 }
 
-/// The BRDF prior's sections (core/FORMAT.md, tags 10-14), checked from the raw
+/// The BRDF prior's sections (core/FORMAT.md, tags 11-15), checked from the raw
 /// bytes: a 16-byte info of three grid counts of 2 to 256 and a size `S` of 2 to
 /// 4096; `nodes S^2` data and conditional CDF values and `nodes S` marginal CDF
 /// values, all finite `f32 >= 0`, each row of `S` CDF values non-decreasing,

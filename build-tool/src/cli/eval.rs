@@ -119,7 +119,8 @@ pub struct EvalArgs {
     #[arg(long, value_delimiter = ',', default_value = "10x12x3", value_parser = condition_grid)]
     pub brdf_grids: Vec<[u32; 3]>,
     /// brdf-prior: table spaces, `direction` (the light direction's equal-area
-    /// square) and `half-vector` (the half vector's).
+    /// square), `half-vector` (the half vector's, its slopes stretched as the
+    /// blob's prior does) and `half-vector:P` (slopes divided by roughness^(P/100)).
     #[arg(long, value_delimiter = ',', default_value = "direction,half-vector", value_parser = prior_space)]
     pub spaces: Vec<crate::sphere::brdf_prior::PriorSpace>,
     /// envmap-prior: depths of the hierarchical product warp (`2^L` leaves per
@@ -258,13 +259,13 @@ fn condition_grid(s: &str) -> Result<[u32; 3], String> {
     v.try_into().map_err(|_| bad())
 }
 
-/// `direction` or `half-vector`.
+/// `direction`, `half-vector` or `half-vector:P`.
 fn prior_space(s: &str) -> Result<crate::sphere::brdf_prior::PriorSpace, String> {
-    use crate::sphere::brdf_prior::PriorSpace;
-    [PriorSpace::Direction, PriorSpace::HalfVector]
-        .into_iter()
-        .find(|p| p.name() == s.trim())
-        .ok_or_else(|| format!("{s:?} is not a table space: direction or half-vector"))
+    crate::sphere::brdf_prior::PriorSpace::parse(s).ok_or_else(|| {
+        format!(
+            "{s:?} is not a table space: direction, half-vector or half-vector:P (P in 0..=400)"
+        )
+    })
 }
 
 /// `build-tool eval brdf-prior`: measures, writes, prints.

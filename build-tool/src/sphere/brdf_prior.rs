@@ -11,10 +11,12 @@
 //!   ([`nuld_core::brdf_prior`]).
 //! * **Space** ([`PriorSpace`]): the square of the tables is the hemisphere's
 //!   equal-area square of either the light direction `wi` itself, or of the half
-//!   vector `h`, with `wi = reflect(wo, h) = 2 (wo.h) h - wo`. In half-vector space
-//!   the specular peak sits at `h = n` for every view, so tables of neighbouring
-//!   `θo` agree where the lobe is; the density there is the direction's times
-//!   `|dwi/dh| = 4 |wo.h|` (0 where `wo.h <= 0` or `wi` is below the horizon).
+//!   vector `h`, with `wi = reflect(wo, h) = 2 (wo.h) h - wo`, its slopes
+//!   stretched by a power of the roughness (the blob's: `roughness^(1/4)`,
+//!   [`nuld_core::brdf_prior::stretch`]). In half-vector space the specular peak
+//!   sits at `h = n` for every view, so tables of neighbouring `θo` agree where
+//!   the lobe is; the density there is the direction's times the Jacobian
+//!   `|dwi/dω_h'|` (0 where `wo.h <= 0` or `wi` is below the horizon).
 //! * **Tables**: `S x S` vertices; vertex `(i, j)` holds the mean of the density
 //!   over `k x k` points of its dual cell clipped to the square (`k` from
 //!   [`SUPERSAMPLED_AXIS`]), so a lobe narrower than the vertex spacing still
@@ -28,7 +30,8 @@ use super::envmap_prior::tabulated;
 use glam::{DVec2, DVec3};
 use nuld_core::brdf::{gltf_metallic, view_direction};
 use nuld_core::brdf_prior::{
-    half_vector_direction, half_vector_point, mass_weighted_blend, node_condition, BrdfPriorInfo,
+    half_vector_direction, half_vector_point, mass_weighted_blend, node_condition, stretch,
+    stretch_with, BrdfPriorInfo,
 };
 use nuld_core::marginal2d::{Blend, Marginal2D, Marginal2DError, Marginal2DShape};
 use nuld_core::sphere::{hemisphere_to_square, square_to_hemisphere};
@@ -54,41 +57,82 @@ pub const PRIOR_SIZE: u32 = 96;
 pub enum PriorSpace {
     /// The equal-area square of the light direction `wi`.
     Direction,
-    /// The equal-area square of the half vector `h`
-    /// ([`nuld_core::brdf_prior::half_vector_direction`]): the blob's prior.
-    HalfVector,
+    /// The equal-area square of the half vector `h`, its slopes divided by
+    /// `roughness^p` with `p` the hundredths held here
+    /// ([`nuld_core::brdf_prior::half_vector_direction`]); the blob's prior is
+    /// [`Self::HALF_VECTOR`].
+    HalfVector {
+        /// The stretch's exponent in hundredths (0: the plain half vector).
+        stretch_percent: u32,
+    },
 }
 
 impl PriorSpace {
-    /// `direction` or `half-vector`.
-    pub fn name(self) -> &'static str {
+    /// The blob's space: the half vector under [`nuld_core::brdf_prior::stretch`].
+    pub const HALF_VECTOR: Self = Self::HalfVector {
+        stretch_percent: (nuld_core::brdf_prior::STRETCH_POWER * 100.0) as u32,
+    };
+
+    /// `direction`, `half-vector` (the blob's) or `half-vector:P` (the stretch's
+    /// exponent `P` in hundredths).
+    pub fn name(self) -> String {
         match self {
-            Self::Direction => "direction",
-            Self::HalfVector => "half-vector",
+            Self::Direction => "direction".into(),
+            s if s == Self::HALF_VECTOR => "half-vector".into(),
+            Self::HalfVector { stretch_percent } => format!("half-vector:{stretch_percent}"),
         }
     }
 
-    /// The light direction of the square point `p` for the view `wo`, and
-    /// `|dwi/dω_p|`, the solid angle of `wi` per solid angle of the table's own
-    /// direction (1 for [`Self::Direction`]); `None` below the horizon.
-    fn direction(self, wo: DVec3, p: DVec2) -> Option<(DVec3, f64)> {
+    /// The space named `name` ([`Self::name`]).
+    pub fn parse(name: &str) -> Option<Self> {
+        match name.trim() {
+            "direction" => Some(Self::Direction),
+            "half-vector" => Some(Self::HALF_VECTOR),
+            other => {
+                let p = other.strip_prefix("half-vector:")?.parse().ok()?;
+                (p <= 400).then_some(Self::HalfVector { stretch_percent: p })
+            }
+        }
+    }
+
+    /// The stretch `k` at `roughness` (1 for [`Self::Direction`]).
+    fn stretch(self, roughness: f64) -> f64 {
+        match self {
+            Self::Direction => 1.0,
+            // The blob's stretch to the bit.
+            s if s == Self::HALF_VECTOR => stretch(roughness),
+            Self::HalfVector { stretch_percent } => {
+                stretch_with(roughness, stretch_percent as f64 / 100.0)
+            }
+        }
+    }
+
+    /// The light direction of the square point `p` for the view `wo` at
+    /// `roughness`, and `|dwi/dω_p|`, the solid angle of `wi` per solid angle of
+    /// the table's own direction (1 for [`Self::Direction`]); `None` below the
+    /// horizon.
+    fn direction(self, wo: DVec3, roughness: f64, p: DVec2) -> Option<(DVec3, f64)> {
         match self {
             Self::Direction => {
                 let d = square_to_hemisphere(p);
                 (d.z > 0.0).then_some((d, 1.0))
             }
-            Self::HalfVector => half_vector_direction(wo.to_array(), p.to_array())
-                .map(|(wi, jac)| (DVec3::from_array(wi), jac)),
+            Self::HalfVector { .. } => {
+                half_vector_direction(wo.to_array(), p.to_array(), self.stretch(roughness))
+                    .map(|(wi, jac)| (DVec3::from_array(wi), jac))
+            }
         }
     }
 
-    /// The square point of the light direction `wi` for `wo` and the same
-    /// Jacobian; `None` where no table point maps to `wi`.
-    fn point(self, wo: DVec3, wi: DVec3) -> Option<(DVec2, f64)> {
+    /// The square point of the light direction `wi` for `wo` at `roughness` and
+    /// the same Jacobian; `None` where no table point maps to `wi`.
+    fn point(self, wo: DVec3, roughness: f64, wi: DVec3) -> Option<(DVec2, f64)> {
         match self {
             Self::Direction => (wi.z > 0.0).then(|| (hemisphere_to_square(wi), 1.0)),
-            Self::HalfVector => half_vector_point(wo.to_array(), wi.to_array())
-                .map(|(p, jac)| (DVec2::from_array(p), jac)),
+            Self::HalfVector { .. } => {
+                half_vector_point(wo.to_array(), wi.to_array(), self.stretch(roughness))
+                    .map(|(p, jac)| (DVec2::from_array(p), jac))
+            }
         }
     }
 }
@@ -155,7 +199,7 @@ impl BrdfPrior {
                                         .clamp(0.0, 1.0)
                                 };
                                 let p = DVec2::new(at(i, a), at(j, b));
-                                if let Some((wi, jac)) = space.direction(wo, p) {
+                                if let Some((wi, jac)) = space.direction(wo, r, p) {
                                     sum += gltf_metallic(wo.to_array(), wi.to_array(), r, m)
                                         * wi.z
                                         * jac;
@@ -195,7 +239,7 @@ impl BrdfPrior {
         PRIOR
             .get_or_init(|| {
                 std::sync::Arc::new(
-                    Self::new(PRIOR_GRID, PRIOR_SIZE, PriorSpace::HalfVector)
+                    Self::new(PRIOR_GRID, PRIOR_SIZE, PriorSpace::HALF_VECTOR)
                         .expect("the BRDF has mass at every node"),
                 )
             })
@@ -205,7 +249,7 @@ impl BrdfPrior {
     /// [`Self::core`] over the tables widened to `f64` (the same values; the
     /// warp's arithmetic in `f64`).
     pub fn core_f64(&self) -> Option<nuld_core::brdf_prior::BrdfPrior<'_, f64>> {
-        (self.space == PriorSpace::HalfVector).then(|| {
+        (self.space == PriorSpace::HALF_VECTOR).then(|| {
             let [data, marginal, conditional, masses] = &self.wide;
             nuld_core::brdf_prior::BrdfPrior::view(self.info(), data, marginal, conditional, masses)
                 .expect("tables written by tabulate")
@@ -248,7 +292,7 @@ impl BrdfPrior {
     /// The runtime's prior over these tables (half-vector tables only; `None`
     /// for direction ones): the one implementation every sampler draws from.
     pub fn core(&self) -> Option<nuld_core::brdf_prior::BrdfPrior<'_, f32>> {
-        (self.space == PriorSpace::HalfVector).then(|| {
+        (self.space == PriorSpace::HALF_VECTOR).then(|| {
             nuld_core::brdf_prior::BrdfPrior::view(
                 self.info(),
                 &self.data,
@@ -280,7 +324,7 @@ impl BrdfPrior {
         let wo = view_direction(condition[1]);
         let (p, pdf) = warp.sample([u.x as f32, u.y as f32], &self.blend(condition));
         let p = DVec2::new(p[0] as f64, p[1] as f64);
-        match self.space.direction(wo, p) {
+        match self.space.direction(wo, condition[0], p) {
             Some((wi, jac)) => (wi, pdf as f64 / (2.0 * PI * jac)),
             None => (DVec3::Z, 0.0),
         }
@@ -289,7 +333,7 @@ impl BrdfPrior {
     /// The solid-angle pdf of [`Self::sample`] at the unit direction `wi`.
     pub fn pdf(&self, warp: &Marginal2D<'_, f32>, condition: [f64; 3], wi: DVec3) -> f64 {
         let wo = view_direction(condition[1]);
-        match self.space.point(wo, wi) {
+        match self.space.point(wo, condition[0], wi) {
             Some((p, jac)) => {
                 let pdf = warp.pdf([p.x as f32, p.y as f32], &self.blend(condition));
                 pdf as f64 / (2.0 * PI * jac)
@@ -317,7 +361,7 @@ mod tests {
     /// tables approximate; and `pdf` returns the samples' pdf.
     #[test]
     fn the_estimate_with_the_priors_pdf_is_the_albedo() {
-        for space in [PriorSpace::Direction, PriorSpace::HalfVector] {
+        for space in [PriorSpace::Direction, PriorSpace::HALF_VECTOR] {
             let prior = BrdfPrior::new([3, 4, 2], 32, space).unwrap();
             assert_eq!(prior.state_bytes(), 4 * 24 * (2 * 32 * 32 + 32 + 1));
             let warp = prior.warp();
@@ -365,7 +409,7 @@ mod tests {
         assert_eq!(BrdfPrior::node_condition(grid, 23), [1.0, 89.0, 1.0]);
         let [r, t, m] = BrdfPrior::node_condition(grid, 1 + 3 * (2 + 4));
         assert!((r - 0.55).abs() < 1e-12 && (t - 178.0 / 3.0).abs() < 1e-12 && m == 1.0);
-        let prior = BrdfPrior::new(grid, 8, PriorSpace::HalfVector).unwrap();
+        let prior = BrdfPrior::new(grid, 8, PriorSpace::HALF_VECTOR).unwrap();
         let b = prior.blend([r, t, m]);
         let pairs: Vec<(u32, f32)> = b.pairs().filter(|p| p.1 > 1e-6).collect();
         assert_eq!(pairs.len(), 1);

@@ -472,6 +472,9 @@ pub enum ConditionalError {
     /// The tree's levels, counts or values are refused
     /// ([`crate::envmap_tree::EnvmapTree::new`]).
     Tree(crate::quadtree::QuadtreeError),
+    /// A BRDF sampler whose prior's tables are of an earlier format (the plain
+    /// half-vector square, [`SectionTag::BrdfPriorInfoUnstretched`]).
+    BrdfPriorUnstretched,
     /// The [`SectionTag::BrdfPriorInfo`] section is not one
     /// [`crate::brdf_prior::BrdfPriorInfo`] long.
     BrdfPriorInfoSize {
@@ -594,6 +597,10 @@ impl core::fmt::Display for ConditionalError {
                 write!(f, "blob environment tree top weights are {e} bytes each, not 4")
             }
             Self::Tree(e) => write!(f, "blob environment tree: {e}"),
+            Self::BrdfPriorUnstretched => write!(
+                f,
+                "BRDF sampler of an earlier format (its prior's tables unstretched): bake it again with `build-tool bake --brdf`"
+            ),
             Self::BrdfPriorInfoSize { got, expected } => write!(
                 f,
                 "blob BRDF prior info section is {got} bytes, not {expected}"

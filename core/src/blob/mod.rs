@@ -138,10 +138,10 @@ pub enum SectionTag {
     /// The environment prior's top-level weights, `f32` (`elem_size` 4),
     /// `[normal][node]` ([`crate::envmap_tree::top_len`]).
     EnvmapTreeTop = 9,
-    /// One [`crate::brdf_prior::BrdfPriorInfo`] (16 bytes): the BRDF prior's
-    /// condition grid and table size (samplers with
-    /// [`crate::conditional::PointWarp::BrdfTable`]).
-    BrdfPriorInfo = 10,
+    /// The info of an earlier BRDF prior, whose tables lived in the plain
+    /// half-vector square: no longer read; a blob with it and without
+    /// [`Self::BrdfPriorInfo`] is refused with the advice to bake it again.
+    BrdfPriorInfoUnstretched = 10,
     /// The BRDF prior's normalized vertex values, `f32` (`elem_size` 4),
     /// `[node][row][column]` ([`crate::marginal2d::tabulate`]).
     BrdfPriorData = 11,
@@ -151,6 +151,11 @@ pub enum SectionTag {
     BrdfPriorConditional = 13,
     /// The BRDF prior's node masses before normalization, `f32`, one per node.
     BrdfPriorMasses = 14,
+    /// One [`crate::brdf_prior::BrdfPriorInfo`] (16 bytes): the BRDF prior's
+    /// condition grid and table size (samplers with
+    /// [`crate::conditional::PointWarp::BrdfTable`]); its tables live in the
+    /// stretched half-vector square ([`crate::brdf_prior::stretch`]).
+    BrdfPriorInfo = 15,
 }
 
 /// Contents of the [`SectionTag::PointSetInfo`] section.

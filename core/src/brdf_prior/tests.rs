@@ -52,7 +52,7 @@ impl Tables {
             for j in 0..s {
                 for i in 0..s {
                     let p = [i as f64 / (s - 1) as f64, j as f64 / (s - 1) as f64];
-                    data.push(match half_vector_direction(wo, p) {
+                    data.push(match half_vector_direction(wo, p, stretch(r)) {
                         Some((wi, jac)) => gltf_metallic(wo, wi, r, m) * wi[2] * jac,
                         None => 0.0,
                     });
@@ -121,23 +121,66 @@ fn the_real_hemisphere_inverse_is_the_f64_one() {
 fn the_half_vector_maps_invert_each_other_and_mirror_the_view() {
     let mut g = Rng(5);
     let wo = view_direction_real(50.0f64);
-    let mut hits = 0;
-    for _ in 0..10_000 {
-        let p = [g.next(), g.next()];
-        let Some((wi, jac)) = half_vector_direction(wo, p) else {
-            continue;
-        };
-        hits += 1;
-        let h = square_to_hemisphere_real(p);
-        // wi and wo make equal angles with h, in the plane of both.
-        assert!((dot(wi, h) - dot(wo, h)).abs() < 1e-12);
-        assert!((jac - 4.0 * dot(wo, h)).abs() < 1e-12);
-        let (q, back) = half_vector_point(wo, wi).unwrap();
-        assert!((q[0] - p[0]).abs() < 1e-9 && (q[1] - p[1]).abs() < 1e-9);
-        assert!((back - jac).abs() < 1e-9);
+    for k in [1.0, stretch(0.1), 0.3] {
+        let mut hits = 0;
+        for _ in 0..10_000 {
+            let p = [g.next(), g.next()];
+            let Some((wi, jac)) = half_vector_direction(wo, p, k) else {
+                continue;
+            };
+            hits += 1;
+            let s = square_to_hemisphere_real(p);
+            let h = normalized([k * s[0], k * s[1], s[2]]).unwrap();
+            // wi and wo make equal angles with h, in the plane of both.
+            assert!((dot(wi, h) - dot(wo, h)).abs() < 1e-12);
+            if k == 1.0 {
+                assert!((jac - 4.0 * dot(wo, h)).abs() < 1e-12);
+            }
+            let (q, back) = half_vector_point(wo, wi, k).unwrap();
+            assert!((q[0] - p[0]).abs() < 1e-9 && (q[1] - p[1]).abs() < 1e-9);
+            assert!((back - jac).abs() < 1e-9 * jac);
+        }
+        assert!(hits > 2_500, "{hits}");
+        assert!(half_vector_point(wo, [0.0, 0.0, -1.0], k).is_none());
     }
-    assert!(hits > 2_500, "{hits}");
-    assert!(half_vector_point(wo, [0.0, 0.0, -1.0]).is_none());
+}
+
+/// The Jacobian against the solid angle it claims: the square is `2π`
+/// steradians of `h'`, so over uniform square points `2π |dwi/dω_h'| g(wi)`
+/// averages `∫ g dwi` over the directions reached, which are the whole upper
+/// hemisphere (each `wi` has one half vector); `g = cos`: `π`.
+#[test]
+fn the_stretched_jacobian_integrates_the_hemisphere() {
+    let mut g = Rng(17);
+    for (k, theta) in [
+        (1.0, 30.0),
+        (stretch(0.1), 60.0),
+        (0.3, 80.0),
+        (stretch(0.5), 5.0),
+    ] {
+        let wo = view_direction_real(theta);
+        let count = 1 << 18;
+        let (mut sum, mut sum2) = (0.0, 0.0);
+        for _ in 0..count {
+            let p = [g.next(), g.next()];
+            if let Some((wi, jac)) = half_vector_direction(wo, p, k) {
+                let y = 2.0 * core::f64::consts::PI * jac * wi[2];
+                sum += y;
+                sum2 += y * y;
+            }
+        }
+        let mean = sum / count as f64;
+        let se = ((sum2 / count as f64 - mean * mean) / count as f64).sqrt();
+        let pi = core::f64::consts::PI;
+        assert!(
+            (mean - pi).abs() < 4.0 * se + 1e-3,
+            "k {k}, θo {theta}: {mean} (se {se})"
+        );
+    }
+    assert_eq!(stretch(1.0f64), 1.0);
+    assert!((stretch(0.1296f64) - 0.6).abs() < 1e-15 && stretch(f64::NAN) == stretch(0.1));
+    assert_eq!(stretch(0.01f64), stretch(0.1));
+    assert!((stretch_with(0.3f64, 0.25) - stretch(0.3f64)).abs() < 1e-15);
 }
 
 /// Over the prior's own samples, `(1/M) Σ f cos / pdf` is the albedo of the
@@ -195,7 +238,7 @@ fn two_metallic_nodes_blend_into_the_target_at_any_metallic() {
         let mut ratios = Vec::new();
         for (i, j) in [(16, 16), (18, 16), (21, 17), (17, 13), (19, 19)] {
             let p = [i as f64 / (size - 1) as f64, j as f64 / (size - 1) as f64];
-            let Some((wi, jac)) = half_vector_direction(wo, p) else {
+            let Some((wi, jac)) = half_vector_direction(wo, p, stretch(r)) else {
                 continue;
             };
             let target = gltf_metallic(wo, wi, r, m) * wi[2] * jac;

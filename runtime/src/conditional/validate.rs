@@ -239,6 +239,11 @@ fn tree_view<'a>(layout: &Layout<'a>) -> Result<EnvmapTree<'a>, BlobError> {
 /// The BRDF prior's five sections: with `check`, every value read once
 /// ([`BrdfPrior::new`], `O(nodes size^2)`); without, counts only (`O(1)`).
 fn brdf_prior<'a>(layout: &Layout<'a>, check: bool) -> Result<BrdfPrior<'a, f32>, BlobError> {
+    if layout.section(SectionTag::BrdfPriorInfo).is_err()
+        && layout.section(SectionTag::BrdfPriorInfoUnstretched).is_ok()
+    {
+        return Err(ConditionalError::BrdfPriorUnstretched.into());
+    }
     let info: BrdfPriorInfo = record(layout, SectionTag::BrdfPriorInfo, |got, expected| {
         ConditionalError::BrdfPriorInfoSize { got, expected }
     })?;

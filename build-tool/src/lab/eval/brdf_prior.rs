@@ -46,7 +46,7 @@ impl Default for BrdfPriorSettings {
         Self {
             grids: vec![[10, 12, 3]],
             sizes: vec![32, 64, 128],
-            spaces: vec![PriorSpace::Direction, PriorSpace::HalfVector],
+            spaces: vec![PriorSpace::Direction, PriorSpace::HALF_VECTOR],
             n: 64,
             conditions: 16,
             instances: 8,
@@ -60,7 +60,7 @@ impl Default for BrdfPriorSettings {
 #[derive(Clone, Debug, Serialize)]
 pub struct BrdfPriorRow {
     /// `mixture` (the VNDF/cosine warp) or the table space's name.
-    pub kind: &'static str,
+    pub kind: String,
     /// Condition nodes per axis (0 for the mixture).
     pub grid: [u32; 3],
     /// Table vertices per axis (0 for the mixture).
@@ -129,7 +129,7 @@ pub fn evaluate(
     let mut rows = Vec::new();
     let (owen_sobol, lattice) = score(&judges, &judging, &|t: &BrdfTarget, u| t.sample(u));
     rows.push(BrdfPriorRow {
-        kind: "mixture",
+        kind: "mixture".into(),
         grid: [0; 3],
         size: 0,
         state_bytes: 0,
@@ -201,7 +201,7 @@ mod tests {
         let s = BrdfPriorSettings {
             grids: vec![[2, 3, 2]],
             sizes: vec![8, 16],
-            spaces: vec![PriorSpace::Direction, PriorSpace::HalfVector],
+            spaces: vec![PriorSpace::Direction, PriorSpace::HALF_VECTOR],
             n: 16,
             conditions: 4,
             instances: 2,
