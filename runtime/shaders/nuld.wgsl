@@ -1084,6 +1084,15 @@ fn nuld_torus_shift(p: vec2<f32>, shift: vec2<f32>) -> vec2<f32> {
     return out;
 }
 
+// Rust: `randomized_point`: the unbiased mode's primary point, lattice point `i`
+// (mod `n`) shifted on the torus by instance `instance`'s offset, then by
+// `nuld_randomization_shift(seed)`.
+fn nuld_randomized_point(info: NuldConditionalInfo, instance: u32, i: u32, seed: u32) -> vec2<f32> {
+    let l = nuld_lattice_point(i, info.n, info.lattice_generator);
+    let at_instance = nuld_torus_shift(l, nuld_instance_offset(instance));
+    return nuld_torus_shift(at_instance, nuld_randomization_shift(seed));
+}
+
 // ---- The glTF BRDF with metallic (core/src/brdf.rs) ----------------------------
 
 // Rust: `clamp_roughness`: `roughness` clamped into `[0.1, 1]`, NaN as 0.1.
@@ -1682,8 +1691,9 @@ fn nuld_sample_metallic(cond: vec2<f32>, metallic: f32, instance: u32, i: u32) -
     return nuld_mapped(cs, nuld_square_point_of(cs, u, instance, i), u, metallic);
 }
 
-// Rust: `ConditionalSampler::sample_randomized` (table mode, the unbiased mode):
-// the table's point shifted on the torus by `nuld_randomization_shift(seed)`.
+// Rust: `ConditionalSampler::sample_randomized` (the unbiased mode): the blob's
+// lattice point shifted by the instance's offset and `seed`'s random vector
+// (`nuld_randomized_point`) through the prior; no table or network read.
 fn nuld_sample_randomized(cond: vec2<f32>, instance: u32, i: u32, seed: u32) -> NuldSample {
     return nuld_sample_randomized_metallic(cond, 0.0, instance, i, seed);
 }
@@ -1693,8 +1703,7 @@ fn nuld_sample_randomized(cond: vec2<f32>, instance: u32, i: u32, seed: u32) -> 
 fn nuld_sample_randomized_metallic(cond: vec2<f32>, metallic: f32, instance: u32, i: u32, seed: u32) -> NuldSample {
     let cs = nuld_conditional();
     let u = nuld_normalize(cs.info, cond);
-    let p = nuld_square_point_of(cs, u, instance, i);
-    return nuld_mapped(cs, nuld_torus_shift(p, nuld_randomization_shift(seed)), u, metallic);
+    return nuld_mapped(cs, nuld_randomized_point(cs.info, instance, i, seed), u, metallic);
 }
 
 // Rust: `NetworkSampler::sample` (network mode): as `nuld_sample`;
@@ -1710,18 +1719,16 @@ fn nuld_sample_network_metallic(cond: vec2<f32>, metallic: f32, instance: u32, i
     return nuld_mapped(cs, nuld_network_square_point_of(cs, u, instance, i), u, metallic);
 }
 
-// Rust: `NetworkSampler::sample_randomized`: the unbiased mode in network mode.
+// Rust: `NetworkSampler::sample_randomized`: the unbiased mode, the same samples
+// as `nuld_sample_randomized` (the network is not evaluated).
 fn nuld_sample_network_randomized(cond: vec2<f32>, instance: u32, i: u32, seed: u32) -> NuldSample {
     return nuld_sample_network_randomized_metallic(cond, 0.0, instance, i, seed);
 }
 
-// Rust: `NetworkSampler::sample_randomized_metallic`: the unbiased mode in network
-// mode at metallic `metallic`.
+// Rust: `NetworkSampler::sample_randomized_metallic`: as
+// `nuld_sample_randomized_metallic`.
 fn nuld_sample_network_randomized_metallic(cond: vec2<f32>, metallic: f32, instance: u32, i: u32, seed: u32) -> NuldSample {
-    let cs = nuld_conditional();
-    let u = nuld_normalize(cs.info, cond);
-    let p = nuld_network_square_point_of(cs, u, instance, i);
-    return nuld_mapped(cs, nuld_torus_shift(p, nuld_randomization_shift(seed)), u, metallic);
+    return nuld_sample_randomized_metallic(cond, metallic, instance, i, seed);
 }
 
 // Rust: `ConditionalSampler::pdf`: the prior's solid-angle pdf at the unit
@@ -1915,8 +1922,8 @@ fn nuld_sample_brdf(wo: vec3<f32>, roughness: f32, metallic: f32, instance: u32,
 }
 
 // Rust: `BrdfSampler::sample_randomized` (the unbiased mode): `nuld_sample_brdf`
-// with the table's point shifted on the torus by `nuld_randomization_shift(seed)`
-// (`seed`: the pixel's random number).
+// with the randomly shifted lattice point of `nuld_randomized_point` (`seed`: the
+// pixel's random number).
 fn nuld_sample_brdf_randomized(wo: vec3<f32>, roughness: f32, metallic: f32, instance: u32, i: u32, seed: u32) -> NuldSample {
     let view = nuld_view_condition(wo, roughness);
     let s = nuld_sample_randomized_metallic(view.cond, metallic, instance, i, seed);

@@ -104,13 +104,12 @@ fn nuld_kernel_conditional(p: NuldKernelParams, c: vec2<f32>, instance: u32, ind
     let cs = nuld_conditional();
     let u = nuld_normalize(cs.info, view.cond);
     var point: vec2<f32>;
-    if network {
+    if randomized {
+        point = nuld_randomized_point(cs.info, instance, index, e);
+    } else if network {
         point = nuld_network_square_point_of(cs, u, instance, index);
     } else {
         point = nuld_square_point_of(cs, u, instance, index);
-    }
-    if randomized {
-        point = nuld_torus_shift(point, nuld_randomization_shift(e));
     }
     var out = nuld_mapped(cs, point, u, metallic);
     if brdf {

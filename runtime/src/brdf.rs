@@ -150,11 +150,14 @@ impl<'a> BrdfSampler<'a> {
         rotate(self.0.sample_metallic(cond, metallic, instance, i), azimuth)
     }
 
-    /// The unbiased mode: [`Self::sample`] with the primary point shifted on the
-    /// torus by a random vector drawn from `seed` (the pixel's random number,
-    /// [`nuld_core::conditional::randomization_shift`]), so that each sample is
-    /// distributed exactly as its [`Sample::pdf`] and `L weight` is unbiased
-    /// whatever the table learned. O(1), never panics.
+    /// The unbiased mode: the blob's rank-1 lattice point `i`, shifted on the
+    /// torus by the instance's offset and by a random vector drawn from `seed`
+    /// (the pixel's random number,
+    /// [`nuld_core::conditional::randomized_point`]), through the prior, so
+    /// that each sample is distributed exactly as its [`Sample::pdf`] and
+    /// `L weight` is unbiased. The learned points are not read: a random
+    /// shift undoes their refinement, a lattice keeps its structure. O(1),
+    /// never panics.
     ///
     /// ```
     /// # let bytes = nuld_runtime::doc_example_brdf_blob();
@@ -255,7 +258,8 @@ impl<'a> BrdfNetwork<'a> {
         rotate(self.0.sample_metallic(cond, metallic, instance, i), azimuth)
     }
 
-    /// The unbiased mode in network mode ([`BrdfSampler::sample_randomized`]).
+    /// The unbiased mode ([`BrdfSampler::sample_randomized`], the same samples;
+    /// the network is not evaluated).
     #[inline]
     pub fn sample_randomized(
         &self,

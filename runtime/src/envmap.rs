@@ -95,11 +95,14 @@ impl<'a> EnvmapSampler<'a> {
         self.0.sample(normal_condition(normal), instance, i)
     }
 
-    /// The unbiased mode: [`Self::sample`] with the primary point shifted on the
-    /// torus by a random vector drawn from `seed` (the pixel's random number,
-    /// [`nuld_core::conditional::randomization_shift`]), so that each sample is
-    /// distributed exactly as its [`Sample::pdf`] and `L f cos / pdf` is unbiased
-    /// whatever the table learned. O(1), never panics.
+    /// The unbiased mode: the blob's rank-1 lattice point `i`, shifted on the
+    /// torus by the instance's offset and by a random vector drawn from `seed`
+    /// (the pixel's random number,
+    /// [`nuld_core::conditional::randomized_point`]), through the prior, so
+    /// that each sample is distributed exactly as its [`Sample::pdf`] and
+    /// `L f cos / pdf` is unbiased. The learned points are not read: a random
+    /// shift undoes their refinement, a lattice keeps its structure. O(1),
+    /// never panics.
     ///
     /// ```
     /// # let bytes = nuld_runtime::doc_example_envmap_blob();
@@ -171,7 +174,8 @@ impl<'a> EnvmapNetwork<'a> {
         self.0.sample(normal_condition(normal), instance, i)
     }
 
-    /// The unbiased mode in network mode ([`EnvmapSampler::sample_randomized`]).
+    /// The unbiased mode ([`EnvmapSampler::sample_randomized`], the same
+    /// samples; the network is not evaluated).
     #[inline]
     pub fn sample_randomized(&self, normal: Vec3, instance: u32, i: u32, seed: u32) -> Sample {
         self.0

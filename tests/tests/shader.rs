@@ -51,8 +51,8 @@ use nuld_core::brdf::{alpha, gltf_metallic_parts, view_direction_real};
 use nuld_core::brdf_prior::{
     half_vector_direction, half_vector_point, stretch, BrdfPrior, BrdfPriorInfo,
 };
+use nuld_core::conditional::randomized_point;
 use nuld_core::conditional::PointWarp;
-use nuld_core::conditional::{randomization_shift, torus_shift};
 use nuld_core::network::Activation;
 use nuld_runtime::glam::{DVec2, DVec3, Vec2, Vec3};
 use nuld_runtime::shader::SAMPLE_STRIDE;
@@ -558,7 +558,8 @@ fn runtime_sample(
     .into_iter()
     .find(|&mode| mode as u32 == p.mode)
     .expect("a kernel mode");
-    let shifted = |q: Vec2| Vec2::from(torus_shift(q.to_array(), randomization_shift(e)));
+    let info = cs.info();
+    let randomized = || Vec2::from(randomized_point(info.n, info.lattice_generator, k, i, e));
     let (want, cond, point) = match mode {
         KernelMode::Table => (cs.sample_metallic(c, m, k, i), c, cs.square_point(c, k, i)),
         KernelMode::Network => (
@@ -569,12 +570,12 @@ fn runtime_sample(
         KernelMode::TableRandomized => (
             cs.sample_randomized_metallic(c, m, k, i, e),
             c,
-            shifted(cs.square_point(c, k, i)),
+            randomized(),
         ),
         KernelMode::NetworkRandomized => (
             cs.network().sample_randomized_metallic(c, m, k, i, e),
             c,
-            shifted(cs.network().square_point(c, k, i)),
+            randomized(),
         ),
         KernelMode::Pdf => {
             let s = cs.sample_metallic(c, m, k, i);
@@ -606,7 +607,7 @@ fn runtime_sample(
             (
                 brdf().sample_randomized(wo, c.x, m, k, i, e),
                 cond,
-                shifted(cs.square_point(cond, k, i)),
+                randomized(),
             )
         }
         KernelMode::BrdfNetworkRandomized => {
@@ -614,7 +615,7 @@ fn runtime_sample(
             (
                 brdf().network().sample_randomized(wo, c.x, m, k, i, e),
                 cond,
-                shifted(cs.network().square_point(cond, k, i)),
+                randomized(),
             )
         }
         KernelMode::BrdfPdf => {

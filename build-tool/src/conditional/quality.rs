@@ -28,7 +28,7 @@ use crate::train::target::{EnvmapTarget, LoadedTarget};
 use anyhow::Result;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
-use nuld_core::conditional::{randomization_shift, torus_shift, ConditionalTarget, PointWarp};
+use nuld_core::conditional::{randomized_point, ConditionalTarget, PointWarp};
 use nuld_core::envmap_tree::EnvmapTree as CoreTree;
 use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
@@ -99,9 +99,9 @@ pub struct ConditionQuality {
     pub baseline: f64,
     /// `ours / baseline`.
     pub ratio: f64,
-    /// The unbiased mode's sets (each instance's points shifted on the torus by
-    /// `randomization_shift(k)` before the warp) over the baseline: mean over the
-    /// instances.
+    /// The unbiased mode's sets (instance `k`'s randomly shifted lattice,
+    /// `nuld_core::conditional::randomized_point` with seed `k`) over the
+    /// baseline: mean over the instances.
     pub randomized_ratio: f64,
     /// `D_cap,2` of the union of instances over `ours`.
     pub union_ratio: f64,
@@ -156,8 +156,8 @@ type How<'a> = (
 
 /// Instance `k`'s directions at the condition `cond` (blob units; `unit` its
 /// normalized form, the network's input) on `domain` through `warp` (and its
-/// environment tree); in the unbiased mode (`randomized`) each point shifted on
-/// the torus by `randomization_shift(k)` first.
+/// environment tree); in the unbiased mode (`randomized`) the runtime's
+/// points instead, `randomized_point(n, g, k, i, k)` (seed `k`).
 fn directions_at(
     params: &Params,
     unit: [f64; 2],
@@ -166,13 +166,13 @@ fn directions_at(
     p_s: f64,
     (k, randomized): (u32, bool),
 ) -> Vec<DVec3> {
-    let shift = randomization_shift(k).map(f64::from);
-    (0..params.shape.n())
+    let (n, g) = (params.shape.n(), params.shape.lattice_generator());
+    (0..n)
         .map(|i| {
-            let mut s = params.square_point(unit, k, i);
-            if randomized {
-                s = torus_shift(s, shift);
-            }
+            let s = match randomized {
+                true => randomized_point(n, g, k, i, k).map(f64::from),
+                false => params.square_point(unit, k, i),
+            };
             match (warp, brdf) {
                 (PointWarp::BrdfTable, Some((prior, m))) => {
                     brdf_table_direction(prior, [cond[0], cond[1], m], DVec2::from(s)).0

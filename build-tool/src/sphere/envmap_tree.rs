@@ -226,8 +226,8 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
-    /// The unbiased mode on a map: a set of 64 shifted-lattice points moved on the
-    /// torus by `randomization_shift(seed)` and warped at one normal; over 4096
+    /// The unbiased mode on a map: the 64 points of `randomized_point` (instance
+    /// 3, the pixel's `seed`) warped at one normal; over 4096
     /// seeds the mean of `(1/N) Σ g / pdf` is `∫ g` within 3 standard errors, for
     /// `g = L cos` and for `g = L cos f` (`f` the glTF BRDF at roughness 0.3, the
     /// view 40° from the normal), both integrals by an independent midpoint rule on
@@ -235,8 +235,7 @@ mod tests {
     /// octahedral square point.
     #[test]
     fn the_unbiased_mode_is_unbiased_for_the_light_and_for_light_times_a_brdf() {
-        use nuld_core::conditional::{randomization_shift, torus_shift};
-        use nuld_core::network::shifted_lattice_point;
+        use nuld_core::conditional::randomized_point;
         let dir = std::env::temp_dir().join(format!("nuld-tree-unbiased-{}", std::process::id()));
         let map = EnvmapDensity::from_file_filtered(tiny_map(&dir), Domain::Sphere).unwrap();
         let tree = EnvmapTree::new(&map, 7, 9).unwrap();
@@ -261,9 +260,6 @@ mod tests {
         };
         let exact = |g: &(dyn Fn(DVec3) -> f64 + Sync)| sphere_integral(2048, g);
         let n_points = 64u32;
-        let set: Vec<[f32; 2]> = (0..n_points)
-            .map(|i| shifted_lattice_point::<f32>(i, n_points, 19, [0.3, 0.7]))
-            .collect();
         for (name, g) in [
             ("L cos", &g_light as &(dyn Fn(DVec3) -> f64 + Sync)),
             ("L cos f", &g_brdf),
@@ -272,10 +268,10 @@ mod tests {
             let estimates: Vec<f64> = (0..4096u32)
                 .into_par_iter()
                 .map(|seed| {
-                    let shift = randomization_shift(seed);
-                    set.iter()
-                        .map(|&p| {
-                            let (d, pdf) = core.sample_square(q, torus_shift(p, shift));
+                    (0..n_points)
+                        .map(|i| {
+                            let p = randomized_point(n_points, 19, 3, i, seed);
+                            let (d, pdf) = core.sample_square(q, p);
                             let d = DVec3::from_array(d.map(f64::from));
                             if pdf > 0.0 {
                                 g(d) / pdf as f64

@@ -426,10 +426,12 @@ int32_t nuld_brdf_sample(const struct NuldBlob *blob,
                          struct NuldSample *out);
 
 /**
- * The **unbiased mode** of `nuld_brdf_sample`: the set's primary point shifted
- * on the torus by a random vector drawn from `seed` (one random number per
- * pixel), so that every sample is distributed exactly as its `pdf`. The
- * runtime's `BrdfSampler::sample_randomized`.
+ * The **unbiased mode** of `nuld_brdf_sample`: the blob's lattice point
+ * `index` shifted on the torus by the instance's offset and by a random vector
+ * drawn from `seed` (one random number per pixel), through the prior, so that
+ * every sample is distributed exactly as its `pdf`; `mode` is checked but both
+ * modes give the same samples (no table or network is read). The runtime's
+ * `BrdfSampler::sample_randomized`.
  *
  * # Safety
  * As `nuld_brdf_sample`.
@@ -483,10 +485,12 @@ int32_t nuld_envmap_sample(const struct NuldBlob *blob,
                            struct NuldSample *out);
 
 /**
- * The **unbiased mode** of `nuld_envmap_sample`: the set's primary point shifted
- * on the torus by a random vector drawn from `seed` (one random number per
- * pixel), so that every sample is distributed exactly as its `pdf` and
- * L f cos / pdf is unbiased. The runtime's `EnvmapSampler::sample_randomized`.
+ * The **unbiased mode** of `nuld_envmap_sample`: the blob's lattice point
+ * `index` shifted on the torus by the instance's offset and by a random vector
+ * drawn from `seed` (one random number per pixel), through the prior, so that
+ * every sample is distributed exactly as its `pdf` and L f cos / pdf is
+ * unbiased; both modes give the same samples. The runtime's
+ * `EnvmapSampler::sample_randomized`.
  *
  * # Safety
  * As `nuld_envmap_sample`.

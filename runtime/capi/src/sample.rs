@@ -178,10 +178,12 @@ pub unsafe extern "C" fn nuld_brdf_sample(
     status(unsafe { brdf_sample(blob, mode, wo, material, (instance, index), None, out) })
 }
 
-/// The **unbiased mode** of `nuld_brdf_sample`: the set's primary point shifted
-/// on the torus by a random vector drawn from `seed` (one random number per
-/// pixel), so that every sample is distributed exactly as its `pdf`. The
-/// runtime's `BrdfSampler::sample_randomized`.
+/// The **unbiased mode** of `nuld_brdf_sample`: the blob's lattice point
+/// `index` shifted on the torus by the instance's offset and by a random vector
+/// drawn from `seed` (one random number per pixel), through the prior, so that
+/// every sample is distributed exactly as its `pdf`; `mode` is checked but both
+/// modes give the same samples (no table or network is read). The runtime's
+/// `BrdfSampler::sample_randomized`.
 ///
 /// # Safety
 /// As `nuld_brdf_sample`.
@@ -282,10 +284,12 @@ pub unsafe extern "C" fn nuld_envmap_sample(
     status(unsafe { envmap_sample(blob, mode, normal, instance, index, None, out) })
 }
 
-/// The **unbiased mode** of `nuld_envmap_sample`: the set's primary point shifted
-/// on the torus by a random vector drawn from `seed` (one random number per
-/// pixel), so that every sample is distributed exactly as its `pdf` and
-/// L f cos / pdf is unbiased. The runtime's `EnvmapSampler::sample_randomized`.
+/// The **unbiased mode** of `nuld_envmap_sample`: the blob's lattice point
+/// `index` shifted on the torus by the instance's offset and by a random vector
+/// drawn from `seed` (one random number per pixel), through the prior, so that
+/// every sample is distributed exactly as its `pdf` and L f cos / pdf is
+/// unbiased; both modes give the same samples. The runtime's
+/// `EnvmapSampler::sample_randomized`.
 ///
 /// # Safety
 /// As `nuld_envmap_sample`.

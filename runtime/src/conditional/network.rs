@@ -76,9 +76,9 @@ impl<'a> NetworkSampler<'a> {
             .mapped(self.0.network_square_point_at(u, instance, i), u, metallic)
     }
 
-    /// The unbiased mode in network mode: as
-    /// [`ConditionalSampler::sample_randomized`], the network's point shifted on the
-    /// torus by `randomization_shift(seed)` before the warp.
+    /// The unbiased mode, the same samples as
+    /// [`ConditionalSampler::sample_randomized`] (a randomly shifted lattice
+    /// through the prior; the network is not evaluated).
     #[inline]
     pub fn sample_randomized(&self, cond: Vec2, instance: u32, i: u32, seed: u32) -> Sample {
         self.sample_randomized_metallic(cond, 0.0, instance, i, seed)
@@ -94,9 +94,8 @@ impl<'a> NetworkSampler<'a> {
         i: u32,
         seed: u32,
     ) -> Sample {
-        let u = self.0.info().normalize(cond.to_array());
-        let p = self.0.network_square_point_at(u, instance, i);
-        self.0.randomized(p, u, metallic, seed)
+        self.0
+            .sample_randomized_metallic(cond, metallic, instance, i, seed)
     }
 
     /// The prior's pdf at `direction` ([`ConditionalSampler::pdf`]; the same

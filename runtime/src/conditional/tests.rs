@@ -9,7 +9,7 @@ use nuld_core::conditional::{randomization_shift, sections, torus_shift};
 use nuld_core::envmap_tree::{
     build, node_count, top_len, top_normal, top_row, EnvmapTree, NodeRecord, TreeInfo,
 };
-use nuld_core::network::Activation;
+use nuld_core::network::{instance_offset, lattice_point, Activation};
 use nuld_core::quadtree::QuadtreeError;
 use nuld_core::quantize::{f16_decode_finite, f16_encode};
 use std::vec::Vec;
@@ -293,8 +293,10 @@ fn envmap_tables_interpolate_primary_points_and_warp_them_through_the_tree() {
     assert_eq!((got.direction.to_array(), got.pdf), (want, pdf));
     assert!((got.direction.length() - 1.0).abs() < 1e-6);
     assert_eq!(got.weight, cs.weight(Vec2::from(u)));
-    // The unbiased mode: the same point shifted on the torus, then warped.
-    let shifted = torus_shift(point, randomization_shift(77));
+    // The unbiased mode: the blob's lattice point 3, shifted by instance 1's
+    // offset and then by seed 77's vector, warped; the network is not read.
+    let l = lattice_point::<f32>(3, info.n, info.lattice_generator);
+    let shifted = torus_shift(torus_shift(l, instance_offset(1)), randomization_shift(77));
     let r = cs.sample_randomized(Vec2::from(u), 1, 3, 77);
     assert_eq!(
         (r.direction.to_array(), r.pdf),
@@ -302,6 +304,7 @@ fn envmap_tables_interpolate_primary_points_and_warp_them_through_the_tree() {
     );
     assert_ne!(r.direction, got.direction);
     let net = cs.network().sample_randomized(Vec2::from(u), 1, 3, 77);
+    assert_eq!(net, r);
     assert!((cs.pdf(Vec2::from(u), net.direction) - net.pdf).abs() <= 1e-5 * net.pdf);
     // A normal is read through the octahedral map, at any length; degenerate
     // normals read as +z.

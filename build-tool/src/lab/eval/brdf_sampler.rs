@@ -4,8 +4,8 @@
 //! exact inverse CDF), so that a trained blob and its untrained prior read on one
 //! scale:
 //!
-//! * **modes**: the runtime's table mode, network mode and unbiased mode (table
-//!   mode's points shifted by `randomization_shift(k)` for instance `k`), `k` over
+//! * **modes**: the runtime's table mode, network mode and unbiased mode (the
+//!   randomly shifted lattice of `randomized_point`, seed `k` for instance `k`), `k` over
 //!   the judge's instances, the view in the xz-plane; mean and worst ratio, and
 //!   the mean per metallic;
 //! * **union**: cap L2 of the union of 64 table-mode instances over the mean of
