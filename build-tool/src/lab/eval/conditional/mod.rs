@@ -1,26 +1,32 @@
 //! Quality report of a conditional BRDF sampler (paper §4) on held-out conditions:
 //! `build-tool eval conditional`.
 //!
-//! At each condition `(roughness, theta_o)` of a held-out grid the target is the
-//! glTF BRDF's `q(l) = f cos / A` ([`BrdfTarget`]); every sampler under test (a
+//! At each condition `(roughness, theta_o, metallic)`, a held-out
+//! `(roughness, theta_o)` grid crossed with a list of metallic values, the target is
+//! the glTF metallic-roughness BRDF's `q(l) = f cos / A` ([`BrdfTarget::metallic`]);
+//! every sampler under test (a
 //! [`ConditionalSets`]: table mode, network mode) and three references give sets
 //! of the sampler's `N` directions:
 //!
 //! * **exact**: Owen-scrambled Sobol points warped by the exact tabulated inverse
 //!   CDF of `q` ([`TabulatedWarp`]), one scramble per instance;
 //! * **mixture**: the same points warped the way a renderer does
-//!   ([`BrdfTarget::sample`]: GGX VNDF with probability `A_spec / A`, else cosine);
+//!   ([`BrdfTarget::sample`]: GGX VNDF with probability `A_spec / A` of the
+//!   metallic's BRDF, else cosine);
 //! * **direct**: one set optimized for this one condition by the direction
 //!   optimizer ([`optimize_directions_scheduled`], paper §3.5), at a few
-//!   conditions (it costs about a minute each at `N = 64`).
+//!   `(roughness, theta_o)` for the dielectric and for the metal
+//!   ([`DIRECT_METALLIC`]; 5000 epochs cost about 17 s each at `N = 64` on 2
+//!   cores, most of a full run).
 //!
 //! Each set is scored by its cap L2 discrepancy (paper Eq. 9, theta-uniform random
 //! caps, with its Monte Carlo standard error; [`MeasuredCaps`]) and by the largest
 //! local discrepancy found ([`cap_star_estimate_screened`], a lower bound of the cap
 //! star discrepancy). The target's cap measures are computed once per condition
 //! and shared by every set. Scores are means over `instances` instances; ratios are
-//! the sampler's mean over a reference's mean. [`diversity()`] measures whether the
-//! instances are different sets.
+//! the sampler's mean over a reference's mean, summarized over all conditions and
+//! per metallic value. [`diversity()`] measures whether the instances are
+//! different sets.
 //!
 //! Deterministic for a seed whatever the thread count: every random stream is
 //! `derive_seed` of the run seed, the condition's index and a fixed stream number,
@@ -58,6 +64,15 @@ pub const HELD_OUT_THETA_DEG: [f64; 5] = [4.0, 26.0, 45.0, 63.0, 85.0];
 /// directly: the anti-diagonal, from the sharpest lobe (roughness 0.13 at 85
 /// degrees) to the broadest (0.85 at 4 degrees).
 pub const DIRECT_CONDITIONS: [usize; 5] = [4, 8, 12, 16, 20];
+/// Metallic values judged unless asked otherwise (`--metallic`): the dielectric
+/// and the metal, the ends of glTF's metallic and the values with direct
+/// optimization, and the half blend between them (25 conditions more without
+/// direct optimization: about a fifth of the run).
+pub const DEFAULT_METALLIC: [f64; 3] = [0.0, 0.5, 1.0];
+/// Metallic values whose conditions get direct optimization, where listed: the
+/// dielectric and the metal, each its own material's reference (a blend in
+/// between is a mixture of the two BRDFs).
+pub const DIRECT_METALLIC: [f64; 2] = [0.0, 1.0];
 
 /// The held-out grid, roughness-major: condition `5 i + j` is
 /// `(HELD_OUT_ROUGHNESS[i], HELD_OUT_THETA_DEG[j])`.
@@ -68,14 +83,37 @@ pub fn held_out_conditions() -> Vec<[f64; 2]> {
         .collect()
 }
 
+/// `pairs` of `[roughness, theta_o_deg]` crossed with `metallic`, metallic-major:
+/// condition `k * pairs.len() + i` is `[pairs[i][0], pairs[i][1], metallic[k]]`
+/// (so with metallic 0 first, the first `pairs.len()` conditions are the
+/// dielectric's, at the pairs' own indices).
+pub fn cross_metallic(pairs: &[[f64; 2]], metallic: &[f64]) -> Vec<[f64; 3]> {
+    metallic
+        .iter()
+        .flat_map(|&m| pairs.iter().map(move |&[r, t]| [r, t, m]))
+        .collect()
+}
+
+/// Indices into [`cross_metallic`]`(pairs, metallic)` (`pairs` of them per
+/// metallic value) of the pairs `direct_pairs` at each metallic value of
+/// [`DIRECT_METALLIC`] that `metallic` lists, in the list's order.
+pub fn direct_indices(pairs: usize, direct_pairs: &[usize], metallic: &[f64]) -> Vec<usize> {
+    metallic
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| DIRECT_METALLIC.contains(m))
+        .flat_map(|(k, _)| direct_pairs.iter().map(move |&i| k * pairs + i))
+        .collect()
+}
+
 /// Base seed of the report.
 pub const CONDITIONAL_SEED: u64 = 0xC0_4D17;
 
 /// What a report run evaluates and how hard it looks.
 #[derive(Clone, Debug, Serialize)]
 pub struct ConditionalSettings {
-    /// Conditions `[roughness, theta_o_deg]`.
-    pub conditions: Vec<[f64; 2]>,
+    /// Conditions `[roughness, theta_o_deg, metallic]`.
+    pub conditions: Vec<[f64; 3]>,
     /// Instances scored per (condition, method); scores are their means.
     pub instances: usize,
     /// Instances whose union and pairs measure [`diversity()`] (at least 2).
@@ -103,20 +141,22 @@ pub struct ConditionalSettings {
 }
 
 impl ConditionalSettings {
-    /// The full report: the 5x5 held-out grid, 8 instances, 64 for diversity, 4096
-    /// cap L2 caps, 20000 search caps with 8 refined over 8 rounds, direct
-    /// optimization (5000 epochs) at [`DIRECT_CONDITIONS`], a 1024-square
-    /// tabulation with 2x2 midpoints per cell.
-    pub fn full() -> Self {
+    /// The full report: the 5x5 held-out grid crossed with `metallic`
+    /// ([`cross_metallic`]), 8 instances, 64 for diversity, 4096 cap L2 caps, 20000
+    /// search caps with 8 refined over 8 rounds, direct optimization (5000 epochs)
+    /// at [`DIRECT_CONDITIONS`] for each metallic of [`DIRECT_METALLIC`] listed, a
+    /// 1024-square tabulation with 2x2 midpoints per cell.
+    pub fn full(metallic: &[f64]) -> Self {
+        let pairs = held_out_conditions();
         Self {
-            conditions: held_out_conditions(),
+            conditions: cross_metallic(&pairs, metallic),
             instances: 8,
             union_instances: 64,
             cap_l2_caps: 4096,
             cap_star_caps: 20_000,
             cap_star_refine: 8,
             cap_star_rounds: 8,
-            direct: DIRECT_CONDITIONS.to_vec(),
+            direct: direct_indices(pairs.len(), &DIRECT_CONDITIONS, metallic),
             direct_epochs: 5000,
             tabulation: 1024,
             tabulation_subsamples: 2,
@@ -125,35 +165,41 @@ impl ConditionalSettings {
         }
     }
 
-    /// The `--quick` settings: three conditions of the grid (the sharpest, the
-    /// middle, the broadest), 8 instances, 16 for diversity, 512 / 500 caps, 2
-    /// refined over 3 rounds, direct optimization (100 epochs) at the sharpest, a
-    /// 512-square tabulation.
-    pub fn quick() -> Self {
+    /// The `--quick` settings: three `(roughness, theta_o)` of the grid (the
+    /// sharpest, the middle, the broadest) crossed with `metallic`, 8 instances, 16
+    /// for diversity, 512 / 500 caps, 2 refined over 3 rounds, direct optimization
+    /// (100 epochs) at the sharpest for each metallic of [`DIRECT_METALLIC`]
+    /// listed, a 512-square tabulation.
+    pub fn quick(metallic: &[f64]) -> Self {
         let all = held_out_conditions();
+        let pairs = [all[4], all[12], all[20]];
         Self {
-            conditions: vec![all[4], all[12], all[20]],
+            conditions: cross_metallic(&pairs, metallic),
             union_instances: 16,
             cap_l2_caps: 512,
             cap_star_caps: 500,
             cap_star_refine: 2,
             cap_star_rounds: 3,
-            direct: vec![0],
+            direct: direct_indices(pairs.len(), &[0], metallic),
             direct_epochs: 100,
             tabulation: 512,
             quick: true,
-            ..Self::full()
+            ..Self::full(metallic)
         }
     }
 
-    /// Checks the settings: conditions in range, at least one instance, two for
-    /// diversity, positive effort, direct indices in range.
+    /// Checks the settings: conditions in range and distinct, at least one
+    /// instance, two for diversity, positive effort, direct indices in range.
     pub fn validate(&self) -> Result<()> {
         ensure!(!self.conditions.is_empty(), "no conditions to evaluate");
-        for &[r, t] in &self.conditions {
+        for (i, &[r, t, m]) in self.conditions.iter().enumerate() {
             ensure!(
-                (0.1..=1.0).contains(&r) && (0.0..=89.0).contains(&t),
-                "condition ({r}, {t}) is outside roughness [0.1, 1] x theta_o [0, 89]"
+                (0.1..=1.0).contains(&r) && (0.0..=89.0).contains(&t) && (0.0..=1.0).contains(&m),
+                "condition ({r}, {t}, {m}) is outside roughness [0.1, 1] x theta_o [0, 89] x metallic [0, 1]"
+            );
+            ensure!(
+                !self.conditions[..i].contains(&[r, t, m]),
+                "condition ({r}, {t}, {m}) is listed twice (a metallic value repeated?)"
             );
         }
         ensure!(
@@ -267,10 +313,12 @@ pub fn evaluate(
     let star = settings.star_options();
     let per_instance = settings.instances.max(settings.union_instances);
     let mut results = Vec::with_capacity(settings.conditions.len());
-    for (ci, &[roughness, theta]) in settings.conditions.iter().enumerate() {
-        progress.set_context(format!("roughness {roughness}, theta_o {theta}"));
+    for (ci, &[roughness, theta, metallic]) in settings.conditions.iter().enumerate() {
+        progress.set_context(format!(
+            "roughness {roughness}, theta_o {theta}, metallic {metallic}"
+        ));
         let cond_seed = derive_seed(settings.seed, ci as u64);
-        let target = BrdfTarget::new(roughness, theta, Domain::Hemisphere)?;
+        let target = BrdfTarget::metallic(roughness, theta, metallic, Domain::Hemisphere)?;
         let measure = |w: DVec3, t: f64| target.cap_measure(w, t);
         let judge = Judge {
             target: &target,
@@ -308,7 +356,7 @@ pub fn evaluate(
         for s in samplers {
             let mut sets: Vec<Vec<DVec3>> = (0..per_instance as u32)
                 .into_par_iter()
-                .map(|k| s.set(roughness, theta, k))
+                .map(|k| s.set(roughness, theta, metallic, k))
                 .collect();
             ensure!(
                 sets.iter().all(|p| p.len() == n),
@@ -350,7 +398,7 @@ pub fn evaluate(
             None
         };
         results.push(ConditionResult::new(
-            [roughness, theta],
+            [roughness, theta, metallic],
             target.albedo(),
             methods,
             [exact, mixture],
@@ -372,22 +420,137 @@ pub fn evaluate(
 mod tests {
     use super::*;
 
-    /// Two conditions, no direct optimization: enough to check the figures.
-    fn small() -> ConditionalSettings {
+    /// Two conditions at each of `metallic`, no direct optimization: enough to
+    /// check the figures.
+    fn small(metallic: &[f64]) -> ConditionalSettings {
         let all = held_out_conditions();
         ConditionalSettings {
-            conditions: vec![all[4], all[12]],
+            conditions: cross_metallic(&[all[4], all[12]], metallic),
             direct: vec![],
-            ..ConditionalSettings::quick()
+            ..ConditionalSettings::quick(metallic)
+        }
+    }
+
+    /// A sampler from a whole-set function `f(roughness, theta_o_deg, metallic,
+    /// instance)`.
+    struct SetFn<F>(&'static str, usize, F);
+
+    impl<F: Fn(f64, f64, f64, u32) -> Vec<DVec3> + Sync> ConditionalSets for SetFn<F> {
+        fn name(&self) -> &str {
+            self.0
+        }
+        fn len(&self) -> usize {
+            self.1
+        }
+        fn set(&self, r: f64, t: f64, m: f64, instance: u32) -> Vec<DVec3> {
+            (self.2)(r, t, m, instance)
         }
     }
 
     /// The same set for every instance: instance 0 of the calibration sampler.
     fn identical(n: usize) -> impl ConditionalSets {
         let base = MixtureOwenSobol::new(n, 77);
-        SampleFnSets::new("identical", n, move |r, t, _k, i| {
-            base.set(r, t, 0)[i as usize]
-        })
+        SetFn("identical", n, move |r, t, m, _k| base.set(r, t, m, 0))
+    }
+
+    #[test]
+    fn metallic_crosses_the_grid_and_direct_runs_at_the_dielectric_and_the_metal() {
+        let pairs = held_out_conditions();
+        let c = cross_metallic(&pairs, &[0.0, 0.5, 1.0]);
+        assert_eq!(c.len(), 75);
+        // Metallic-major: the dielectric keeps the pairs' own indices.
+        assert_eq!(c[DIRECT_CONDITIONS[0]], [0.13, 85.0, 0.0]);
+        assert_eq!(c[25 + 7], [pairs[7][0], pairs[7][1], 0.5]);
+        assert_eq!(c[50 + DIRECT_CONDITIONS[4]], [0.85, 4.0, 1.0]);
+        let full = ConditionalSettings::full(&[0.0, 0.5, 1.0]);
+        let direct: Vec<[f64; 3]> = full.direct.iter().map(|&i| full.conditions[i]).collect();
+        assert_eq!(direct.len(), 10);
+        for (k, &i) in DIRECT_CONDITIONS.iter().enumerate() {
+            let [r, t] = pairs[i];
+            assert_eq!(direct[k], [r, t, 0.0]);
+            assert_eq!(direct[5 + k], [r, t, 1.0]);
+        }
+        // Without 0 or 1 in the list, no direct optimization; --quick at the sharpest.
+        assert!(ConditionalSettings::full(&[0.25, 0.5]).direct.is_empty());
+        let quick = ConditionalSettings::quick(&[1.0, 0.5]);
+        assert_eq!(quick.conditions.len(), 6);
+        assert_eq!(quick.direct, vec![0]);
+        assert_eq!(quick.conditions[0], [0.13, 85.0, 1.0]);
+        quick.validate().unwrap();
+        // A repeated metallic value, one out of range: one-line errors.
+        for (bad, says) in [
+            (vec![0.0, 0.0], "listed twice"),
+            (vec![1.5], "metallic [0, 1]"),
+        ] {
+            let e = ConditionalSettings::quick(&bad)
+                .validate()
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(says) && !e.contains('\n'), "{e}");
+        }
+    }
+
+    /// The judge's target at a metal condition is the metal's: Owen-Sobol through
+    /// the exact tabulated inverse CDF of `BrdfTarget::metallic(r, t, m)`, with the
+    /// exact reference's own scrambles, scores exactly 1 at every metallic, while
+    /// the same points through the dielectric's warp score 1 at metallic 0 only and
+    /// well above it at the metal; the mixture reference differs between the two.
+    #[test]
+    fn a_metal_condition_is_judged_against_the_metal_target() {
+        let s = small(&[0.0, 1.0]);
+        let n = 64;
+        let warp = |c: [f64; 3]| {
+            let target = BrdfTarget::metallic(c[0], c[1], c[2], Domain::Hemisphere).unwrap();
+            TabulatedWarp::new(&target, s.tabulation, s.tabulation_subsamples).unwrap()
+        };
+        let own: Vec<TabulatedWarp> = s.conditions.iter().map(|&c| warp(c)).collect();
+        let dielectric: Vec<TabulatedWarp> = s
+            .conditions
+            .iter()
+            .map(|&[r, t, _]| warp([r, t, 0.0]))
+            .collect();
+        // Instance k at condition ci: the exact reference's scramble.
+        let seed = s.seed;
+        let conditions = s.conditions.clone();
+        let through = move |warps: Vec<TabulatedWarp>| {
+            let conditions = conditions.clone();
+            move |r: f64, t: f64, m: f64, k: u32| {
+                let ci = conditions.iter().position(|&c| c == [r, t, m]).unwrap();
+                let u = seeded_owen_sobol(
+                    n,
+                    derive_seed(derive_seed(seed, ci as u64), SCRAMBLE_STREAM + k as u64),
+                );
+                warps[ci].warp_all(&u)
+            }
+        };
+        let (own, dielectric) = (through(own), through(dielectric));
+        let exact = SetFn("own", n, own);
+        let wrong = SetFn("dielectric", n, dielectric);
+        let rep = evaluate(&[&exact, &wrong], &s).unwrap();
+        assert_eq!(rep.conditions.len(), 4);
+        for (c, want) in rep.conditions.iter().zip(&s.conditions) {
+            assert_eq!([c.roughness, c.theta_o_deg, c.metallic], *want);
+            assert_eq!(c.ratios[0].to_exact, 1.0, "{want:?}");
+            if c.metallic == 0.0 {
+                assert_eq!(c.ratios[1].to_exact, 1.0, "{want:?}");
+            } else {
+                assert!(c.ratios[1].to_exact > 1.5, "{want:?}: {:?}", c.ratios[1]);
+            }
+        }
+        // Same (roughness, theta_o), metallic 0 then 1: different mixtures.
+        for i in 0..2 {
+            let (d, m) = (&rep.conditions[i], &rep.conditions[2 + i]);
+            assert_ne!(d.mixture.cap_l2, m.mixture.cap_l2);
+            assert_ne!(d.albedo, m.albedo);
+        }
+        // The per-metallic summary: the metal's worst is the dielectric warp's.
+        assert_eq!(rep.by_metallic.len(), 2);
+        let metal = &rep.by_metallic[1];
+        assert_eq!((metal.metallic, metal.conditions), (1.0, 2));
+        assert_eq!(metal.summary[0].mean_ratio_exact, 1.0);
+        assert!(metal.summary[1].worst_ratio_exact > 1.5);
+        assert_eq!(metal.summary[1].worst_condition[2], 1.0);
+        assert_eq!(rep.by_metallic[0].summary[1].mean_ratio_exact, 1.0);
     }
 
     #[test]
@@ -414,7 +577,10 @@ mod tests {
 
     #[test]
     fn synthetic_samplers_give_the_reference_figures_at_any_thread_count() {
-        let s = small();
+        // The dielectric and the blend: at the metal the calibration sampler's
+        // nearest-neighbour ratio runs higher than 0.65 (0.80 at roughness 0.13,
+        // 85 degrees, pure VNDF).
+        let s = small(&[0.0, 0.5]);
         let calibration = MixtureOwenSobol::new(64, 5);
         let same = identical(64);
         let samplers: [&dyn ConditionalSets; 2] = [&calibration, &same];

@@ -1,6 +1,7 @@
 //! The conditional quality report: per-condition scores and ratios, the summary
-//! over conditions, and its files (`conditional.json`, `conditional.csv`,
-//! `conditional-summary.md`, ratio heat maps and sets drawn over their target).
+//! over all conditions and per metallic value, and its files (`conditional.json`,
+//! `conditional.csv`, `conditional-summary.md`, ratio heat maps per metallic and
+//! sets drawn over their target).
 
 use super::{ConditionalSettings, Diversity};
 use crate::lab::eval::cache::sanitize;
@@ -130,6 +131,8 @@ pub struct ConditionResult {
     pub roughness: f64,
     /// View angle (degrees).
     pub theta_o_deg: f64,
+    /// glTF metallic in `[0, 1]`.
+    pub metallic: f64,
     /// Directional albedo `A` (the estimator weight).
     pub albedo: f64,
     /// The samplers' scores.
@@ -152,7 +155,7 @@ pub struct ConditionResult {
 impl ConditionResult {
     /// Assembles a condition's result and computes its ratios.
     pub fn new(
-        [roughness, theta_o_deg]: [f64; 2],
+        [roughness, theta_o_deg, metallic]: [f64; 3],
         albedo: f64,
         samplers: Vec<MethodScore>,
         [exact, mixture]: [MethodScore; 2],
@@ -172,6 +175,7 @@ impl ConditionResult {
         Self {
             roughness,
             theta_o_deg,
+            metallic,
             albedo,
             samplers,
             exact,
@@ -219,8 +223,8 @@ pub struct SamplerSummary {
     pub mean_ratio_exact: f64,
     /// Largest such ratio ...
     pub worst_ratio_exact: f64,
-    /// ... and where (`[roughness, theta_o_deg]`).
-    pub worst_condition: [f64; 2],
+    /// ... and where (`[roughness, theta_o_deg, metallic]`).
+    pub worst_condition: [f64; 3],
     /// Conditions where the ratio to the exact reference exceeds 1.
     pub conditions_above_one: usize,
     /// Mean cap-L2 ratio to the mixture reference.
@@ -237,6 +241,21 @@ pub struct SamplerSummary {
     pub mean_nn_ratio: f64,
     /// Smallest nearest-neighbour ratio.
     pub worst_nn_ratio: f64,
+}
+
+/// The summary over the conditions of one metallic value.
+#[derive(Clone, Debug, Serialize)]
+pub struct MetallicSummary {
+    /// The metallic value.
+    pub metallic: f64,
+    /// Conditions at it.
+    pub conditions: usize,
+    /// As [`ConditionalReport::summary`], over these conditions only.
+    pub summary: Vec<SamplerSummary>,
+    /// Mean of mixture / exact (cap L2) over them.
+    pub mixture_over_exact: f64,
+    /// Mean of direct / exact (cap L2) over those with direct optimization.
+    pub direct_over_exact: Option<f64>,
 }
 
 /// The whole report (`conditional.json`). Deterministic: no timings.
@@ -257,6 +276,8 @@ pub struct ConditionalReport {
     pub mixture_over_exact: f64,
     /// Mean over direct conditions of direct / exact (cap L2).
     pub direct_over_exact: Option<f64>,
+    /// The summary per metallic value, in the order of the conditions.
+    pub by_metallic: Vec<MetallicSummary>,
     /// Per condition.
     pub conditions: Vec<ConditionResult>,
 }
@@ -274,18 +295,26 @@ impl ConditionalReport {
         n: usize,
         conditions: Vec<ConditionResult>,
     ) -> Self {
-        let mut summary: Vec<SamplerSummary> = samplers
-            .iter()
-            .enumerate()
-            .map(|(j, name)| summarize(name, &conditions, |c| c.ratios[j].clone()))
+        let all: Vec<&ConditionResult> = conditions.iter().collect();
+        let (summary, mixture_over_exact, direct_over_exact) = summaries(&samplers, &all);
+        let by_metallic = metallic_values(&conditions)
+            .into_iter()
+            .map(|m| {
+                let at: Vec<&ConditionResult> =
+                    conditions.iter().filter(|c| c.metallic == m).collect();
+                let (summary, mixture_over_exact, direct_over_exact) = summaries(&samplers, &at);
+                MetallicSummary {
+                    metallic: m,
+                    conditions: at.len(),
+                    summary,
+                    mixture_over_exact,
+                    direct_over_exact,
+                }
+            })
             .collect();
-        // The exact reference against itself: ratios 1, its own diversity.
-        summary.push(summarize(EXACT, &conditions, |c| {
-            SamplerRatios::of(&c.exact, &c.references())
-        }));
         Self {
             title: format!(
-                "conditional sampler on held-out conditions, N = {n}: cap L2 and largest \
+                "conditional sampler on held-out (roughness, θo, metallic), N = {n}: cap L2 and largest \
                  local discrepancy vs Owen-Sobol + exact inverse CDF, Owen-Sobol + \
                  VNDF/cosine mixture, and per-condition optimization; instance diversity"
             ),
@@ -293,60 +322,74 @@ impl ConditionalReport {
             samplers,
             settings: settings.clone(),
             summary,
-            mixture_over_exact: mean(conditions.iter().map(|c| c.mixture.cap_l2 / c.exact.cap_l2))
-                .unwrap_or(f64::NAN),
-            direct_over_exact: mean(
-                conditions
-                    .iter()
-                    .filter_map(|c| c.direct.as_ref().map(|d| d.cap_l2 / c.exact.cap_l2)),
-            ),
+            mixture_over_exact,
+            direct_over_exact,
+            by_metallic,
             conditions,
         }
     }
 
-    /// The summary as a Markdown table (what `eval conditional` prints).
+    /// The summary as Markdown tables (what `eval conditional` prints): over all
+    /// conditions, then per metallic value.
     pub fn summary_markdown(&self) -> String {
+        let metallic: Vec<String> = self
+            .by_metallic
+            .iter()
+            .map(|m| m.metallic.to_string())
+            .collect();
         let mut s = format!(
-            "N = {}, {} conditions, {} instances (diversity: {}); cap L2 ratios (mean / worst) \
-             to Owen-Sobol + exact inverse CDF, mean to the VNDF/cosine mixture and to direct \
-             optimization; diversity: union of instances / one instance (independent sets \
-             ~{:.3}, identical 1), nearest-neighbour angle across / within (independent \
-             ~0.65, identical 0).\n\n\
-             | sampler | / exact (mean) | / exact (worst, at) | above 1 | / mixture | / direct | D* / exact | union ratio (mean, worst) | NN ratio (mean, worst) |\n\
+            "N = {}, {} conditions (metallic {}), {} instances (diversity: {}); cap L2 ratios \
+             (mean / worst) to Owen-Sobol + exact inverse CDF, mean to the VNDF/cosine mixture \
+             and to direct optimization; diversity: union of instances / one instance \
+             (independent sets ~{:.3}, identical 1), nearest-neighbour angle across / within \
+             (independent ~0.65, identical 0).\n\n\
+             | sampler | / exact (mean) | / exact (worst, at r, θo, m) | above 1 | / mixture | / direct | D* / exact | union ratio (mean, worst) | NN ratio (mean, worst) |\n\
              |---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
             self.n,
             self.conditions.len(),
+            metallic.join(", "),
             self.settings.instances,
             self.settings.union_instances,
             1.0 / (self.settings.union_instances as f64).sqrt(),
         );
         for l in &self.summary {
-            let _ = writeln!(
-                s,
-                "| {} | {:.3} | {:.3} ({}, {}) | {} | {:.3} | {} | {:.3} | {:.3}, {:.3} | {:.3}, {:.3} |",
-                l.sampler,
-                l.mean_ratio_exact,
-                l.worst_ratio_exact,
-                l.worst_condition[0],
-                l.worst_condition[1],
-                l.conditions_above_one,
-                l.mean_ratio_mixture,
-                l.mean_ratio_direct
-                    .map_or("-".to_string(), |v| format!("{v:.3}")),
-                l.mean_star_ratio_exact,
-                l.mean_union_ratio,
-                l.worst_union_ratio,
-                l.mean_nn_ratio,
-                l.worst_nn_ratio,
-            );
+            let _ = writeln!(s, "| {} | {} |", l.sampler, summary_cells(l, true));
         }
         let _ = writeln!(
             s,
             "\nReferences: mixture / exact {:.3}, direct / exact {}.",
             self.mixture_over_exact,
-            self.direct_over_exact
-                .map_or("-".to_string(), |v| format!("{v:.3}"))
+            opt3(self.direct_over_exact)
         );
+        s.push_str(
+            "\nPer metallic:\n\n\
+             | metallic | sampler | / exact (mean) | / exact (worst, at r, θo) | above 1 | / mixture | / direct | D* / exact | union ratio (mean, worst) | NN ratio (mean, worst) |\n\
+             |---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        );
+        for m in &self.by_metallic {
+            for l in &m.summary {
+                let _ = writeln!(
+                    s,
+                    "| {} | {} | {} |",
+                    m.metallic,
+                    l.sampler,
+                    summary_cells(l, false)
+                );
+            }
+        }
+        let refs: Vec<String> = self
+            .by_metallic
+            .iter()
+            .map(|m| {
+                format!(
+                    "metallic {}: mixture / exact {:.3}, direct / exact {}",
+                    m.metallic,
+                    m.mixture_over_exact,
+                    opt3(m.direct_over_exact)
+                )
+            })
+            .collect();
+        let _ = writeln!(s, "\nReferences per metallic: {}.", refs.join("; "));
         s
     }
 
@@ -354,8 +397,8 @@ impl ConditionalReport {
     /// where they do not apply.
     pub fn csv(&self) -> String {
         let mut out = String::from(
-            "roughness,theta_o_deg,method,sets,cap_l2,cap_l2_se,cap_star,ratio_to_exact,\
-             ratio_to_mixture,ratio_to_direct,union_ratio,nn_ratio\n",
+            "roughness,theta_o_deg,metallic,method,sets,cap_l2,cap_l2_se,cap_star,\
+             ratio_to_exact,ratio_to_mixture,ratio_to_direct,union_ratio,nn_ratio\n",
         );
         let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:e}"));
         for c in &self.conditions {
@@ -366,9 +409,10 @@ impl ConditionalReport {
                 let d = c.diversity_of(&m.method);
                 let _ = writeln!(
                     out,
-                    "{},{},{},{},{:e},{:e},{:e},{},{},{},{},{}",
+                    "{},{},{},{},{},{:e},{:e},{:e},{},{},{},{},{}",
                     c.roughness,
                     c.theta_o_deg,
+                    c.metallic,
                     m.method,
                     m.sets,
                     m.cap_l2,
@@ -385,13 +429,13 @@ impl ConditionalReport {
         out
     }
 
-    /// Writes `conditional.json`, `conditional.csv`, `conditional-summary.md`, a
-    /// heat map of each sampler's ratio to the exact reference
-    /// (`conditional-<sampler>-ratio.png`) and of its union ratio
-    /// (`conditional-<sampler>-union.png`), and instance 0 of every sampler and of
-    /// the exact reference over the target at up to three conditions
-    /// (`conditional-sets-<method>-r<R>-t<T>.png`, one file per method and
-    /// condition); returns the paths.
+    /// Writes `conditional.json`, `conditional.csv`, `conditional-summary.md`, per
+    /// metallic value a heat map over `(roughness, theta_o)` of each sampler's
+    /// ratio to the exact reference (`conditional-<sampler>-ratio-m<M>.png`) and of
+    /// its union ratio (`conditional-<sampler>-union-m<M>.png`), and instance 0 of
+    /// every sampler and of the exact reference over the target at up to three
+    /// conditions (`conditional-sets-<method>-r<R>-t<T>-m<M>.png`, one file per
+    /// method and condition); returns the paths.
     pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
         crate::output::ensure_dir(dir)?;
         let mut written = Vec::new();
@@ -413,52 +457,48 @@ impl ConditionalReport {
             v.dedup();
         }
         for (j, name) in self.samplers.iter().enumerate() {
-            for (what, center, value) in [
-                (
-                    "ratio",
-                    1.0,
-                    &(|c: &ConditionResult| Some(c.ratios[j].to_exact))
-                        as &dyn Fn(&ConditionResult) -> Option<f64>,
-                ),
-                ("union", 0.3, &|c: &ConditionResult| {
-                    c.diversity_of(name).map(|d| d.union_ratio)
-                }),
-            ] {
-                let cells: Vec<Option<f64>> = rs
-                    .iter()
-                    .flat_map(|&r| ts.iter().map(move |&t| (r, t)))
-                    .map(|(r, t)| {
-                        self.conditions
-                            .iter()
-                            .find(|c| c.roughness == r && c.theta_o_deg == t)
-                            .and_then(value)
-                    })
-                    .collect();
-                let file = format!("conditional-{}-{what}.png", sanitize(name));
-                let title = match what {
-                    "ratio" => format!(
-                        "{name}: cap L2 / Owen-Sobol + exact inverse CDF, N = {}",
-                        self.n
-                    ),
-                    _ => format!(
-                        "{name}: cap L2 of {} instances' union / one instance's",
-                        self.settings.union_instances
-                    ),
-                };
-                render_heatmap(
-                    &dir.join(&file),
-                    &Heatmap {
-                        title: &title,
-                        x_label: "theta_o (degrees)",
-                        y_label: "roughness",
-                        xs: &ts,
-                        ys: &rs,
-                        values: &cells,
-                        center,
-                    },
-                    (720, 600),
-                )?;
-                written.push(dir.join(file));
+            let ratio = |c: &ConditionResult| Some(c.ratios[j].to_exact);
+            let union = |c: &ConditionResult| c.diversity_of(name).map(|d| d.union_ratio);
+            let plots: [(&str, f64, &CellValue); 2] =
+                [("ratio", 1.0, &ratio), ("union", 0.3, &union)];
+            for m in self.by_metallic.iter().map(|m| m.metallic) {
+                for &(what, center, value) in &plots {
+                    let cells: Vec<Option<f64>> = rs
+                        .iter()
+                        .flat_map(|&r| ts.iter().map(move |&t| (r, t)))
+                        .map(|(r, t)| {
+                            self.conditions
+                                .iter()
+                                .find(|c| c.roughness == r && c.theta_o_deg == t && c.metallic == m)
+                                .and_then(value)
+                        })
+                        .collect();
+                    let file = format!("conditional-{}-{what}-m{m}.png", sanitize(name));
+                    let title = match what {
+                        "ratio" => format!(
+                            "{name}: cap L2 / Owen-Sobol + exact inverse CDF, N = {}, metallic {m}",
+                            self.n
+                        ),
+                        _ => format!(
+                            "{name}: cap L2 of {} instances' union / one instance's, metallic {m}",
+                            self.settings.union_instances
+                        ),
+                    };
+                    render_heatmap(
+                        &dir.join(&file),
+                        &Heatmap {
+                            title: &title,
+                            x_label: "theta_o (degrees)",
+                            y_label: "roughness",
+                            xs: &ts,
+                            ys: &rs,
+                            values: &cells,
+                            center,
+                        },
+                        (720, 600),
+                    )?;
+                    written.push(dir.join(file));
+                }
             }
         }
         written.extend(self.write_set_pictures(dir)?);
@@ -482,7 +522,7 @@ impl ConditionalReport {
         let mut written = Vec::new();
         for c in picks.into_iter().map(|i| pool[i]) {
             // Only the density is drawn: no cap-measure table worth building.
-            let target = BrdfTarget::coarse(c.roughness, c.theta_o_deg, 0.0, 1 << 10)?;
+            let target = BrdfTarget::coarse(c.roughness, c.theta_o_deg, c.metallic, 1 << 10)?;
             for e in &c.examples {
                 let square: Vec<glam::DVec2> = e
                     .directions
@@ -490,16 +530,17 @@ impl ConditionalReport {
                     .map(|d| Domain::Hemisphere.to_square(DVec3::from_array(*d)))
                     .collect();
                 let file = format!(
-                    "conditional-sets-{}-r{}-t{}.png",
+                    "conditional-sets-{}-r{}-t{}-m{}.png",
                     sanitize(&e.method),
                     c.roughness,
-                    c.theta_o_deg
+                    c.theta_o_deg,
+                    c.metallic
                 );
                 render_direction_set(
                     &dir.join(&file),
                     &format!(
-                        "{} instance 0, roughness {}, theta_o {} deg",
-                        e.method, c.roughness, c.theta_o_deg
+                        "{} instance 0: r {}, theta_o {}, m {}",
+                        e.method, c.roughness, c.theta_o_deg, c.metallic
                     ),
                     &|d| target.pdf(d),
                     &|p| Domain::Hemisphere.to_direction(p),
@@ -513,14 +554,86 @@ impl ConditionalReport {
     }
 }
 
-/// The summary of one sampler over all conditions, `ratio(c)` its ratios at
+/// A heat map's value at a condition (`None`: an empty cell).
+type CellValue<'a> = dyn Fn(&ConditionResult) -> Option<f64> + 'a;
+
+/// The metallic values of `conditions`, in the order they first appear.
+fn metallic_values(conditions: &[ConditionResult]) -> Vec<f64> {
+    let mut values: Vec<f64> = Vec::new();
+    for c in conditions {
+        if !values.contains(&c.metallic) {
+            values.push(c.metallic);
+        }
+    }
+    values
+}
+
+/// Over `conditions`: the summary of every sampler of `samplers` (named in the
+/// order of each condition's ratios), then of the exact reference against
+/// itself (ratios 1, its own diversity); the mean mixture / exact and the mean
+/// direct / exact (cap L2) where direct optimization ran.
+fn summaries(
+    samplers: &[String],
+    conditions: &[&ConditionResult],
+) -> (Vec<SamplerSummary>, f64, Option<f64>) {
+    let mut summary: Vec<SamplerSummary> = samplers
+        .iter()
+        .enumerate()
+        .map(|(j, name)| summarize(name, conditions, |c| c.ratios[j].clone()))
+        .collect();
+    summary.push(summarize(EXACT, conditions, |c| {
+        SamplerRatios::of(&c.exact, &c.references())
+    }));
+    let mixture_over_exact =
+        mean(conditions.iter().map(|c| c.mixture.cap_l2 / c.exact.cap_l2)).unwrap_or(f64::NAN);
+    let direct_over_exact = mean(
+        conditions
+            .iter()
+            .filter_map(|c| c.direct.as_ref().map(|d| d.cap_l2 / c.exact.cap_l2)),
+    );
+    (summary, mixture_over_exact, direct_over_exact)
+}
+
+/// `v` to 3 decimals, `-` for none.
+fn opt3(v: Option<f64>) -> String {
+    v.map_or("-".to_string(), |v| format!("{v:.3}"))
+}
+
+/// The Markdown cells of a summary row after the sampler's name; the worst
+/// condition with its metallic when `with_metallic`.
+fn summary_cells(l: &SamplerSummary, with_metallic: bool) -> String {
+    let [r, t, m] = l.worst_condition;
+    let at = if with_metallic {
+        format!("{r}, {t}, {m}")
+    } else {
+        format!("{r}, {t}")
+    };
+    format!(
+        "{:.3} | {:.3} ({at}) | {} | {:.3} | {} | {:.3} | {:.3}, {:.3} | {:.3}, {:.3}",
+        l.mean_ratio_exact,
+        l.worst_ratio_exact,
+        l.conditions_above_one,
+        l.mean_ratio_mixture,
+        opt3(l.mean_ratio_direct),
+        l.mean_star_ratio_exact,
+        l.mean_union_ratio,
+        l.worst_union_ratio,
+        l.mean_nn_ratio,
+        l.worst_nn_ratio,
+    )
+}
+
+/// The summary of one sampler over `conditions`, `ratio(c)` its ratios at
 /// condition `c`.
+///
+/// # Panics
+/// If `conditions` is empty.
 fn summarize(
     name: &str,
-    conditions: &[ConditionResult],
+    conditions: &[&ConditionResult],
     ratio: impl Fn(&ConditionResult) -> SamplerRatios,
 ) -> SamplerSummary {
-    let ratios: Vec<SamplerRatios> = conditions.iter().map(ratio).collect();
+    let ratios: Vec<SamplerRatios> = conditions.iter().map(|c| ratio(c)).collect();
     let to_exact: Vec<f64> = ratios.iter().map(|r| r.to_exact).collect();
     let (worst_at, worst) =
         to_exact
@@ -542,6 +655,7 @@ fn summarize(
         worst_condition: [
             conditions[worst_at].roughness,
             conditions[worst_at].theta_o_deg,
+            conditions[worst_at].metallic,
         ],
         conditions_above_one: to_exact.iter().filter(|&&v| v > 1.0).count(),
         mean_ratio_mixture: mean(ratios.iter().map(|r| r.to_mixture)).unwrap_or(f64::NAN),

@@ -5,15 +5,15 @@
 
 use crate::baselines::seeded_owen_sobol;
 use crate::seeding::derive_seed;
-use crate::sphere::brdf_albedo::lobe_probability;
+use crate::sphere::{BrdfTarget, DirectionDensity};
 use anyhow::Result;
 use glam::DVec3;
-use nuld_core::brdf::{clamp_roughness, clamp_theta_o_deg, BrdfModel};
-use nuld_core::conditional::brdf_mixture_direction;
+use nuld_core::brdf::{clamp_metallic, clamp_roughness, clamp_theta_o_deg};
 
 /// One conditional sampler: the `len()` directions of instance `k` at condition
-/// `(roughness, theta_o_deg)` (glTF BRDF of `nuld_core::brdf`, view in the
-/// `xz`-plane on the `+x` side, directions in the local frame, `z` = normal).
+/// `(roughness, theta_o_deg, metallic)` (glTF metallic-roughness BRDF of
+/// `nuld_core::brdf`, base colour 1, view in the `xz`-plane on the `+x` side,
+/// directions in the local frame, `z` = normal).
 pub trait ConditionalSets: Sync {
     /// Short name (report rows, file names): `table`, `network`, ...
     fn name(&self) -> &str;
@@ -24,19 +24,20 @@ pub trait ConditionalSets: Sync {
         self.len() == 0
     }
     /// The `N` unit directions of instance `instance` at the condition.
-    fn set(&self, roughness: f64, theta_o_deg: f64, instance: u32) -> Vec<DVec3>;
+    fn set(&self, roughness: f64, theta_o_deg: f64, metallic: f64, instance: u32) -> Vec<DVec3>;
 }
 
 /// A [`ConditionalSets`] from a per-sample function `f(roughness, theta_o_deg,
-/// instance, index) -> direction` (what a runtime's `sample(cond, instance, i)`
-/// is), evaluated for `index = 0..n`.
+/// metallic, instance, index) -> direction` (what a runtime's
+/// `sample_metallic(cond, metallic, instance, i)` is), evaluated for
+/// `index = 0..n`.
 pub struct SampleFnSets<F> {
     name: String,
     n: usize,
     f: F,
 }
 
-impl<F: Fn(f64, f64, u32, u32) -> DVec3 + Sync> SampleFnSets<F> {
+impl<F: Fn(f64, f64, f64, u32, u32) -> DVec3 + Sync> SampleFnSets<F> {
     /// The sampler `f` named `name`, `n` samples per set.
     pub fn new(name: impl Into<String>, n: usize, f: F) -> Self {
         Self {
@@ -47,25 +48,27 @@ impl<F: Fn(f64, f64, u32, u32) -> DVec3 + Sync> SampleFnSets<F> {
     }
 }
 
-impl<F: Fn(f64, f64, u32, u32) -> DVec3 + Sync> ConditionalSets for SampleFnSets<F> {
+impl<F: Fn(f64, f64, f64, u32, u32) -> DVec3 + Sync> ConditionalSets for SampleFnSets<F> {
     fn name(&self) -> &str {
         &self.name
     }
     fn len(&self) -> usize {
         self.n
     }
-    fn set(&self, roughness: f64, theta_o_deg: f64, instance: u32) -> Vec<DVec3> {
+    fn set(&self, roughness: f64, theta_o_deg: f64, metallic: f64, instance: u32) -> Vec<DVec3> {
         (0..self.n as u32)
-            .map(|i| (self.f)(roughness, theta_o_deg, instance, i))
+            .map(|i| (self.f)(roughness, theta_o_deg, metallic, instance, i))
             .collect()
     }
 }
 
 /// Independent Owen-scrambled Sobol sets, one scramble per instance
 /// (`seeded_owen_sobol(n, derive_seed(seed, instance))`), warped by the renderer's
-/// mixture warp ([`brdf_mixture_direction`]: VNDF with probability
-/// `p_s = A_spec / A`, else cosine; what the `brdf:` target's
-/// [`DirectionDensity::sample`](crate::sphere::DirectionDensity::sample) does): what a renderer does today, as a [`ConditionalSets`].
+/// mixture warp for the condition's metallic: the target's own
+/// [`BrdfTarget::sample`](DirectionDensity::sample) (VNDF with probability
+/// `p_s = A_spec / A` of [`BrdfTarget::metallic`], 1 for the metal, else
+/// cosine), what a renderer does today, as a [`ConditionalSets`]. Conditions are
+/// clamped into the target's range first.
 ///
 /// It is the calibration sampler of the report: its instances are independent
 /// randomizations, so the diversity figures come out near their independent values
@@ -74,6 +77,11 @@ pub struct MixtureOwenSobol {
     n: usize,
     seed: u64,
 }
+
+/// Points of the cap-measure rule of [`MixtureOwenSobol`]'s targets: only their
+/// mixture warp is used, which does not read the rule, so the smallest rule
+/// keeps building a target per set cheap (its albedo quadrature, a few ms).
+const MIXTURE_RULE_POINTS: usize = 16;
 
 impl MixtureOwenSobol {
     /// Sets of `n` points for scramble seed `seed`.
@@ -89,12 +97,17 @@ impl ConditionalSets for MixtureOwenSobol {
     fn len(&self) -> usize {
         self.n
     }
-    fn set(&self, roughness: f64, theta_o_deg: f64, instance: u32) -> Vec<DVec3> {
-        let cond = [clamp_roughness(roughness), clamp_theta_o_deg(theta_o_deg)];
-        let p_s = lobe_probability(BrdfModel::Gltf, cond[0], cond[1]);
+    fn set(&self, roughness: f64, theta_o_deg: f64, metallic: f64, instance: u32) -> Vec<DVec3> {
+        let target = BrdfTarget::coarse(
+            clamp_roughness(roughness),
+            clamp_theta_o_deg(theta_o_deg),
+            clamp_metallic(metallic),
+            MIXTURE_RULE_POINTS,
+        )
+        .expect("a clamped condition is in range");
         seeded_owen_sobol(self.n, derive_seed(self.seed, instance as u64))
             .into_iter()
-            .map(|u| DVec3::from_array(brdf_mixture_direction(cond, p_s, u.to_array())))
+            .map(|u| target.sample(u))
             .collect()
     }
 }
@@ -102,8 +115,12 @@ impl ConditionalSets for MixtureOwenSobol {
 /// The table-mode and network-mode samplers of a conditional `.nuld` blob, read
 /// through `nuld-runtime` exactly as a renderer reads them:
 /// `Blob::parse(bytes)?.brdf()?.conditional()`, then
-/// `sample(Vec2::new(roughness, theta_o_deg), instance, i).direction` (named
-/// `table`) and `network().sample(..)` (named `network`), in that order.
+/// `sample_metallic(Vec2::new(roughness, theta_o_deg), metallic, instance, i).direction`
+/// (named `table`) and `network().sample_metallic(..)` (named `network`), in that
+/// order. Only a blob on the tabulated prior reads the metallic; others sample
+/// their metallic-0 warp at every metallic (the runtime's
+/// `ConditionalSampler::sample_metallic`), and the report judges that against
+/// each metallic's own target.
 pub fn blob_sets(bytes: &[u8]) -> Result<Vec<Box<dyn ConditionalSets + '_>>> {
     let blob = nuld_runtime::Blob::parse(bytes).map_err(|e| anyhow::anyhow!("{e}"))?;
     let cs = match blob.brdf() {
@@ -115,11 +132,16 @@ pub fn blob_sets(bytes: &[u8]) -> Result<Vec<Box<dyn ConditionalSets + '_>>> {
     };
     let n = cs.len() as usize;
     let cond = |r: f64, t: f64| nuld_runtime::glam::Vec2::new(r as f32, t as f32);
-    let table = SampleFnSets::new("table", n, move |r, t, k, i| {
-        cs.sample(cond(r, t), k, i).direction.as_dvec3()
+    let table = SampleFnSets::new("table", n, move |r, t, m, k, i| {
+        cs.sample_metallic(cond(r, t), m as f32, k, i)
+            .direction
+            .as_dvec3()
     });
-    let network = SampleFnSets::new("network", n, move |r, t, k, i| {
-        cs.network().sample(cond(r, t), k, i).direction.as_dvec3()
+    let network = SampleFnSets::new("network", n, move |r, t, m, k, i| {
+        cs.network()
+            .sample_metallic(cond(r, t), m as f32, k, i)
+            .direction
+            .as_dvec3()
     });
     Ok(vec![Box::new(table), Box::new(network)])
 }
