@@ -30,7 +30,10 @@ fn main() -> anyhow::Result<()> {
         judges.push(Judge::new(*c, &t, &|u| exact.warp(u), &s, i as u64));
     }
     for p in [25u32, 100, 200] {
-        let space = PriorSpace::HalfVector { stretch_percent: p };
+        let space = match p {
+            25 => PriorSpace::HALF_VECTOR,
+            p => PriorSpace::HalfVectorPower { stretch_percent: p },
+        };
         let prior = BrdfPrior::new([10, 12, 2], 96, space)?;
         let warp = prior.warp();
         for (j, c) in conds.iter().enumerate() {

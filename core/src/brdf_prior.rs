@@ -6,7 +6,11 @@
 //!
 //! **Nodes.** `G_r x G_t x G_m` conditions at the vertices of a regular grid over
 //! roughness `[MIN_ROUGHNESS, MAX_ROUGHNESS]`, `θo` `[0°, MAX_THETA_O_DEG]` and
-//! metallic `[0, 1]`; node `(i, j, l)` is table `i + G_r (j + G_t l)`
+//! metallic `[0, 1]`, the `θo` axis warped so that the nodes crowd towards
+//! grazing views ([`theta_o_of_unit`]: a smooth metal's lobe, cut by the
+//! horizon, changes fastest there; a lattice through the prior at a metal of
+//! roughness 0.13 seen at 85° scores 2.1 of the exact warp's Owen-Sobol instead
+//! of 4.8 with uniform nodes); node `(i, j, l)` is table `i + G_r (j + G_t l)`
 //! ([`node_condition`]). The view is the xz-plane one of
 //! [`crate::brdf::view_direction`].
 //!
@@ -133,21 +137,33 @@ pub fn node_condition(grid: [u32; 3], node: u32) -> [f64; 3] {
     let (j, l) = (rest % g1, rest / g1);
     [
         at(i, grid[0], MIN_ROUGHNESS, MAX_ROUGHNESS),
-        at(j, grid[1], 0.0, MAX_THETA_O_DEG),
+        theta_o_of_unit(at(j, grid[1], 0.0, 1.0)),
         at(l, grid[2], MIN_METALLIC, MAX_METALLIC),
     ]
 }
 
+/// The view angle in degrees of the unit coordinate `u` of the `θo` axis:
+/// `θo = 89 (1 - (1 - u)^2)`, nodes uniform in `u` crowd towards grazing
+/// views, where the lobes change fastest with the view (the horizon cuts them).
+/// The inverse of [`unit_condition`]'s `θo` coordinate, `u = 1 - sqrt(1 - θo /
+/// 89)`.
+pub fn theta_o_of_unit(u: f64) -> f64 {
+    let v = 1.0 - u.clamp(0.0, 1.0);
+    MAX_THETA_O_DEG * (1.0 - v * v)
+}
+
 /// The condition `[roughness, θo in degrees, metallic]` clamped into the
-/// prior's ranges (NaN to their lower ends) and placed on `[0,1]^3`.
+/// prior's ranges (NaN to their lower ends) and placed on `[0,1]^3`: roughness
+/// and metallic linearly, `θo` as `1 - sqrt(1 - θo / 89)` ([`theta_o_of_unit`]).
 #[inline]
 pub fn unit_condition<T: Real>(cond: [T; 3]) -> [T; 3] {
     let r = clamp_roughness(cond[0]);
     let t = clamp_theta_o_deg(cond[1]);
     let m = clamp_metallic(cond[2]);
+    let rest = (T::ONE - t / T::of(MAX_THETA_O_DEG)).max(T::ZERO);
     [
         (r - T::of(MIN_ROUGHNESS)) / T::of(MAX_ROUGHNESS - MIN_ROUGHNESS),
-        t / T::of(MAX_THETA_O_DEG),
+        T::ONE - rest.sqrt(),
         (m - T::of(MIN_METALLIC)) / T::of(MAX_METALLIC - MIN_METALLIC),
     ]
 }
@@ -213,6 +229,8 @@ pub fn half_vector_point<T: Real>(wo: [T; 3], wi: [T; 3], k: T) -> Option<([T; 2
 /// The half vector's slopes are divided by `k` before the equal-area map
 /// (module docs), which widens the smooth specular lobes over more table cells
 /// and makes neighbouring roughness nodes' lobes more alike; 1 at roughness 1.
+/// The same at every metallic, so that the two metallic nodes' tables share
+/// the square and their blend is exact.
 #[inline]
 pub fn stretch<T: Real>(roughness: T) -> T {
     clamp_roughness(roughness).sqrt().sqrt()
@@ -228,9 +246,6 @@ pub fn stretch_with<T: Real>(roughness: T, power: T) -> T {
     }
     (clamp_roughness(roughness).ln() * power).exp()
 }
-
-/// The exponent of [`stretch`].
-pub const STRETCH_POWER: f64 = 0.25;
 
 /// The blend at `cond = [roughness, θo in degrees, metallic]` (clamped,
 /// [`unit_condition`]) on a node grid `grid` whose node `k` has mass

@@ -1241,10 +1241,12 @@ struct NuldBlend {
 // metallic)`, clamped (NaN to the lower ends) and placed on `[0,1]^3`, each
 // weighed by its multilinear weight times its mass (weights not above 0 as 0).
 fn nuld_brdf_blend(pr: NuldBrdfPrior, cond: vec3<f32>) -> NuldBlend {
-    // `unit_condition`; the metallic's `(m - 0) / (1 - 0)` is `m` exactly.
+    // `unit_condition`; the metallic's `(m - 0) / (1 - 0)` is `m` exactly; the
+    // view's `1 - sqrt(1 - theta_o / 89)`, nodes crowding towards grazing.
+    let rest = max(1.0 - nuld_clamp_theta_o(cond.y) / NULD_MAX_THETA_O_DEG, 0.0);
     let unit = vec3<f32>(
         (nuld_clamp_roughness(cond.x) - NULD_MIN_ROUGHNESS) / NULD_ROUGHNESS_SPAN,
-        nuld_clamp_theta_o(cond.y) / NULD_MAX_THETA_O_DEG,
+        1.0 - sqrt(rest),
         nuld_clamp01(cond.z),
     );
     var lower = vec3<u32>(0u, 0u, 0u);

@@ -4,7 +4,8 @@
 //! trilinearly between the nodes and sampled exactly ([`nuld_core::marginal2d`]).
 //!
 //! * **Nodes**: `G_r x G_t x G_m` conditions at the vertices of a regular grid over
-//!   roughness `[0.1, 1]`, `θo` `[0°, 89°]` and metallic `[0, 1]`. Before
+//!   roughness `[0.1, 1]`, `θo` `[0°, 89°]` (crowding towards grazing,
+//!   [`nuld_core::brdf_prior::theta_o_of_unit`]) and metallic `[0, 1]`. Before
 //!   normalization the target is linear in metallic, and the blend weighs each
 //!   node by its mass before normalization (the tabulated albedo), so two
 //!   metallic nodes reproduce every metallic exactly
@@ -57,29 +58,30 @@ pub const PRIOR_SIZE: u32 = 96;
 pub enum PriorSpace {
     /// The equal-area square of the light direction `wi`.
     Direction,
-    /// The equal-area square of the half vector `h`, its slopes divided by
-    /// `roughness^p` with `p` the hundredths held here
-    /// ([`nuld_core::brdf_prior::half_vector_direction`]); the blob's prior is
-    /// [`Self::HALF_VECTOR`].
-    HalfVector {
-        /// The stretch's exponent in hundredths (0: the plain half vector).
+    /// The equal-area square of the half vector `h`, its slopes divided by the
+    /// blob's stretch at the condition's roughness
+    /// ([`nuld_core::brdf_prior::stretch`],
+    /// [`nuld_core::brdf_prior::half_vector_direction`]): the blob's prior.
+    HalfVector,
+    /// The half vector's square with the slopes divided by `roughness^p`, `p`
+    /// the hundredths held here (0: the plain half vector); for measurements.
+    HalfVectorPower {
+        /// The stretch's exponent in hundredths.
         stretch_percent: u32,
     },
 }
 
 impl PriorSpace {
-    /// The blob's space: the half vector under [`nuld_core::brdf_prior::stretch`].
-    pub const HALF_VECTOR: Self = Self::HalfVector {
-        stretch_percent: (nuld_core::brdf_prior::STRETCH_POWER * 100.0) as u32,
-    };
+    /// The blob's space ([`Self::HalfVector`]).
+    pub const HALF_VECTOR: Self = Self::HalfVector;
 
     /// `direction`, `half-vector` (the blob's) or `half-vector:P` (the stretch's
     /// exponent `P` in hundredths).
     pub fn name(self) -> String {
         match self {
             Self::Direction => "direction".into(),
-            s if s == Self::HALF_VECTOR => "half-vector".into(),
-            Self::HalfVector { stretch_percent } => format!("half-vector:{stretch_percent}"),
+            Self::HalfVector => "half-vector".into(),
+            Self::HalfVectorPower { stretch_percent } => format!("half-vector:{stretch_percent}"),
         }
     }
 
@@ -87,10 +89,10 @@ impl PriorSpace {
     pub fn parse(name: &str) -> Option<Self> {
         match name.trim() {
             "direction" => Some(Self::Direction),
-            "half-vector" => Some(Self::HALF_VECTOR),
+            "half-vector" => Some(Self::HalfVector),
             other => {
                 let p = other.strip_prefix("half-vector:")?.parse().ok()?;
-                (p <= 400).then_some(Self::HalfVector { stretch_percent: p })
+                (p <= 400).then_some(Self::HalfVectorPower { stretch_percent: p })
             }
         }
     }
@@ -99,9 +101,8 @@ impl PriorSpace {
     fn stretch(self, roughness: f64) -> f64 {
         match self {
             Self::Direction => 1.0,
-            // The blob's stretch to the bit.
-            s if s == Self::HALF_VECTOR => stretch(roughness),
-            Self::HalfVector { stretch_percent } => {
+            Self::HalfVector => stretch(roughness),
+            Self::HalfVectorPower { stretch_percent } => {
                 stretch_with(roughness, stretch_percent as f64 / 100.0)
             }
         }
@@ -117,8 +118,9 @@ impl PriorSpace {
                 let d = square_to_hemisphere(p);
                 (d.z > 0.0).then_some((d, 1.0))
             }
-            Self::HalfVector { .. } => {
-                half_vector_direction(wo.to_array(), p.to_array(), self.stretch(roughness))
+            Self::HalfVector | Self::HalfVectorPower { .. } => {
+                let k = self.stretch(roughness);
+                half_vector_direction(wo.to_array(), p.to_array(), k)
                     .map(|(wi, jac)| (DVec3::from_array(wi), jac))
             }
         }
@@ -129,8 +131,9 @@ impl PriorSpace {
     fn point(self, wo: DVec3, roughness: f64, wi: DVec3) -> Option<(DVec2, f64)> {
         match self {
             Self::Direction => (wi.z > 0.0).then(|| (hemisphere_to_square(wi), 1.0)),
-            Self::HalfVector { .. } => {
-                half_vector_point(wo.to_array(), wi.to_array(), self.stretch(roughness))
+            Self::HalfVector | Self::HalfVectorPower { .. } => {
+                let k = self.stretch(roughness);
+                half_vector_point(wo.to_array(), wi.to_array(), k)
                     .map(|(p, jac)| (DVec2::from_array(p), jac))
             }
         }
@@ -408,7 +411,8 @@ mod tests {
         assert_eq!(BrdfPrior::node_condition(grid, 0), [0.1, 0.0, 0.0]);
         assert_eq!(BrdfPrior::node_condition(grid, 23), [1.0, 89.0, 1.0]);
         let [r, t, m] = BrdfPrior::node_condition(grid, 1 + 3 * (2 + 4));
-        assert!((r - 0.55).abs() < 1e-12 && (t - 178.0 / 3.0).abs() < 1e-12 && m == 1.0);
+        // θo node 2 of 4: 89 (1 - (1/3)^2), the axis crowding towards grazing.
+        assert!((r - 0.55).abs() < 1e-12 && (t - 89.0 * 8.0 / 9.0).abs() < 1e-12 && m == 1.0);
         let prior = BrdfPrior::new(grid, 8, PriorSpace::HALF_VECTOR).unwrap();
         let b = prior.blend([r, t, m]);
         let pairs: Vec<(u32, f32)> = b.pairs().filter(|p| p.1 > 1e-6).collect();

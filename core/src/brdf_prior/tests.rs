@@ -289,3 +289,24 @@ fn bad_tables_are_refused_and_views_check_lengths_only() {
         None
     );
 }
+
+/// The `θo` axis: nodes at `89 (1 - (1 - u)^2)`, crowding towards grazing (the
+/// last interval of 12 nodes spans 0.74°, the first 15.4°), and
+/// `unit_condition` places each node back at its `u`.
+#[test]
+fn view_nodes_crowd_towards_grazing_and_unit_condition_inverts_them() {
+    let grid = [2, 12, 2];
+    for j in 0..12u32 {
+        let [_, t, _] = node_condition(grid, 2 * j);
+        let u = j as f64 / 11.0;
+        assert!((t - 89.0 * (1.0 - (1.0 - u) * (1.0 - u))).abs() < 1e-12);
+        let back = unit_condition([0.5, t, 0.0])[1];
+        assert!((back - u).abs() < 1e-12, "{j}: {back} vs {u}");
+    }
+    let span = |j: u32| node_condition(grid, 2 * (j + 1))[1] - node_condition(grid, 2 * j)[1];
+    assert!((span(10) - 89.0 / 121.0).abs() < 1e-12);
+    assert!((span(0) - 89.0 * 21.0 / 121.0).abs() < 1e-12);
+    assert_eq!(unit_condition([0.5, 200.0, 0.0])[1], 1.0);
+    assert_eq!(unit_condition([0.5, f64::NAN, 0.0])[1], 0.0);
+    assert_eq!(theta_o_of_unit(2.0), 89.0);
+}
