@@ -352,7 +352,7 @@ impl<'a> ConditionalSampler<'a> {
 
     /// The **unbiased mode**: point `i` (mod `n`) of the blob's rank-1 lattice,
     /// shifted on the unit torus by instance `instance`'s offset and by
-    /// [`randomization_shift`]`(seed)`
+    /// [`nuld_core::conditional::randomization_shift`]`(seed)`
     /// ([`nuld_core::conditional::randomized_point`]), through the prior's warp,
     /// so that for a random `seed` (one per pixel) every sample is distributed
     /// exactly as its [`Sample::pdf`]. The table's learned points are not read:
