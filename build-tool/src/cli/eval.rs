@@ -131,6 +131,11 @@ pub struct EvalArgs {
     /// blob's prior does) and `half-vector:P` (slopes divided by roughness^(P/100)).
     #[arg(long, value_delimiter = ',', default_value = "direction,half-vector", value_parser = prior_space)]
     pub spaces: Vec<crate::sphere::brdf_prior::PriorSpace>,
+    /// brdf-prior: held-out conditions judged (roughness 0.1 + 0.9 u^2, θo
+    /// uniform in 0° to 85°, metallic 0, 0.5, 1 and uniform in turn; 16 cost
+    /// about 10 s; more include smooth metals).
+    #[arg(long, default_value_t = 16, value_parser = super::count)]
+    pub conditions: usize,
     /// envmap-prior: depths of the hierarchical product warp (`2^L` leaves per
     /// axis; each 3 to 12).
     #[arg(long, value_delimiter = ',', default_value = "8,9,10")]
@@ -293,6 +298,7 @@ fn run_brdf_prior(a: &EvalArgs) -> Result<()> {
         a.sizes.iter().all(|&v| v >= 2),
         "--sizes needs values of at least 2"
     );
+    anyhow::ensure!(a.conditions >= 1, "--conditions needs at least 1");
     let blob = match &a.blob {
         Some(path) => Some(crate::pointset::AlignedBytes::read(path)?),
         None => None,
@@ -310,6 +316,7 @@ fn run_brdf_prior(a: &EvalArgs) -> Result<()> {
         sizes: a.sizes.clone(),
         spaces: a.spaces.clone(),
         n,
+        conditions: a.conditions,
         ..BrdfPriorSettings::default()
     };
     crate::output::ensure_dir(&a.out)?;
@@ -438,5 +445,42 @@ mod tests {
                 "{e}"
             );
         }
+    }
+
+    /// `--conditions` (brdf-prior) defaults to the judge's 16, and a run with 0
+    /// is refused before any work.
+    #[test]
+    fn brdf_prior_conditions_default_to_sixteen_and_refuse_zero() {
+        let parse = |extra: &[&str]| {
+            let args = ["build-tool", "eval", "brdf-prior", "--out", "x"];
+            match crate::cli::Cli::try_parse_from(args.iter().chain(extra)) {
+                Ok(crate::cli::Cli {
+                    command: crate::cli::Command::Eval(a),
+                }) => Ok(a.conditions),
+                Ok(_) => unreachable!("eval parses to Eval"),
+                Err(e) => Err(e.to_string()),
+            }
+        };
+        let judge = crate::lab::eval::brdf_prior::BrdfPriorSettings::default();
+        assert_eq!(parse(&[]).unwrap(), judge.conditions);
+        assert_eq!(parse(&["--conditions", "48"]).unwrap(), 48);
+        let out = std::env::temp_dir().join(format!("nuld-cond0-{}", std::process::id()));
+        let args = [
+            "build-tool",
+            "eval",
+            "brdf-prior",
+            "--conditions",
+            "0",
+            "--out",
+        ];
+        let cli = crate::cli::Cli::try_parse_from(
+            args.iter()
+                .map(|a| a.to_string())
+                .chain([out.display().to_string()]),
+        )
+        .unwrap();
+        let e = crate::cli::run(cli).unwrap_err().to_string();
+        assert!(e.contains("--conditions needs at least 1"), "{e}");
+        assert!(!out.exists());
     }
 }
