@@ -45,7 +45,7 @@ pub enum Command {
     /// Render the Fig. 8 evaluation (BRDF and envmap sampling vs a reference): DIR/render.csv, PNGs.
     Render(render::RenderArgs),
     /// Evaluate the paper's §5 figures (fig2, fig3, fig5, fig6, fig7, all): CSV, JSON, plots.
-    Eval(eval::EvalArgs),
+    Eval(Box<eval::EvalArgs>),
 }
 
 /// `--domain` values.
@@ -96,7 +96,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Optimize(a) => optimize::run(a),
         Command::Metrics(a) => metrics::run(a),
         Command::Bench(a) => bench::run(a),
-        Command::Eval(a) => eval::run(a),
+        Command::Eval(a) => eval::run(*a),
         Command::Shader(a) => shader::run(a),
         Command::Render(a) => render::run(a),
     }
