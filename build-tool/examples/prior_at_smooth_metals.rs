@@ -31,7 +31,7 @@ fn main() -> anyhow::Result<()> {
     }
     for p in [25u32, 100, 200] {
         let space = match p {
-            25 => PriorSpace::HALF_VECTOR,
+            25 => PriorSpace::HalfVector,
             p => PriorSpace::HalfVectorPower { stretch_percent: p },
         };
         let prior = BrdfPrior::new([10, 12, 2], 96, space)?;

@@ -219,7 +219,10 @@ pub fn half_vector_point<T: Real>(wo: [T; 3], wi: [T; 3], k: T) -> Option<([T; 2
     }
     let v = [h[0] / k, h[1] / k, h[2]];
     let len = dot(v, v).sqrt();
-    let s = normalized(v)?;
+    if !(len > T::ZERO && len.is_finite()) {
+        return None;
+    }
+    let s = v.map(|x| x / len);
     let jac = T::of(4.0) * c * k * k * len * len * len;
     jac.is_finite().then(|| (hemisphere_to_square_real(s), jac))
 }

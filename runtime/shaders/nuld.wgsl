@@ -1939,11 +1939,10 @@ fn nuld_sample_brdf_network(wo: vec3<f32>, roughness: f32, metallic: f32, instan
     return nuld_rotate(nuld_sample_network_metallic(view.cond, metallic, instance, i), view.azimuth);
 }
 
-// Rust: `BrdfNetwork::sample_randomized`: the unbiased mode in network mode.
+// Rust: `BrdfNetwork::sample_randomized`: the unbiased mode, the same samples as
+// `nuld_sample_brdf_randomized` (the network is not evaluated).
 fn nuld_sample_brdf_network_randomized(wo: vec3<f32>, roughness: f32, metallic: f32, instance: u32, i: u32, seed: u32) -> NuldSample {
-    let view = nuld_view_condition(wo, roughness);
-    let s = nuld_sample_network_randomized_metallic(view.cond, metallic, instance, i, seed);
-    return nuld_rotate(s, view.azimuth);
+    return nuld_sample_brdf_randomized(wo, roughness, metallic, instance, i, seed);
 }
 
 // Rust: `BrdfSampler::pdf` (both modes share the prior): the solid-angle density

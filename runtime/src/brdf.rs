@@ -270,19 +270,13 @@ impl<'a> BrdfNetwork<'a> {
         i: u32,
         seed: u32,
     ) -> Sample {
-        let (cond, azimuth) = view_condition(wo, roughness);
-        let s = self
-            .0
-            .sample_randomized_metallic(cond, metallic, instance, i, seed);
-        rotate(s, azimuth)
+        BrdfSampler(self.0.table()).sample_randomized(wo, roughness, metallic, instance, i, seed)
     }
 
     /// The prior's pdf ([`BrdfSampler::pdf`]; both modes share the prior).
     #[inline]
     pub fn pdf(&self, wo: Vec3, roughness: f32, metallic: f32, direction: Vec3) -> f32 {
-        let (cond, azimuth) = view_condition(wo, roughness);
-        self.0
-            .pdf_metallic(cond, metallic, unrotate(direction, azimuth))
+        BrdfSampler(self.0.table()).pdf(wo, roughness, metallic, direction)
     }
 
     /// The target-agnostic network view, conditions in the blob's units.

@@ -178,8 +178,7 @@ impl<'a> EnvmapNetwork<'a> {
     /// samples; the network is not evaluated).
     #[inline]
     pub fn sample_randomized(&self, normal: Vec3, instance: u32, i: u32, seed: u32) -> Sample {
-        self.0
-            .sample_randomized(normal_condition(normal), instance, i, seed)
+        EnvmapSampler(self.0.table()).sample_randomized(normal, instance, i, seed)
     }
 
     /// The prior's pdf ([`EnvmapSampler::pdf`]; both modes share the prior).

@@ -136,7 +136,7 @@ pub fn small_brdf_prior() -> std::sync::Arc<nuld_build_tool::sphere::brdf_prior:
     static PRIOR: std::sync::OnceLock<std::sync::Arc<BrdfPrior>> = std::sync::OnceLock::new();
     let prior = PRIOR.get_or_init(|| {
         std::sync::Arc::new(
-            BrdfPrior::new([3, 2, 2], 5, PriorSpace::HALF_VECTOR).expect("a valid prior"),
+            BrdfPrior::new([3, 2, 2], 5, PriorSpace::HalfVector).expect("a valid prior"),
         )
     });
     std::sync::Arc::clone(prior)

@@ -421,20 +421,23 @@ fn run_envmap_prior(a: &EvalArgs) -> Result<()> {
 mod tests {
     use clap::Parser;
 
+    /// `build-tool eval FIG --out x EXTRA...` parsed, or clap's message.
+    fn eval_args(fig: &str, extra: &[&str]) -> Result<super::EvalArgs, String> {
+        let args = ["build-tool", "eval", fig, "--out", "x"];
+        match crate::cli::Cli::try_parse_from(args.iter().chain(extra)) {
+            Ok(crate::cli::Cli {
+                command: crate::cli::Command::Eval(a),
+            }) => Ok(*a),
+            Ok(_) => unreachable!("eval parses to Eval"),
+            Err(e) => Err(e.to_string()),
+        }
+    }
+
     /// `--metallic` defaults to the report's `DEFAULT_METALLIC` and says why a
     /// value is refused.
     #[test]
     fn metallic_list_defaults_to_the_report_and_refuses_values_off_zero_one() {
-        let parse = |extra: &[&str]| {
-            let args = ["build-tool", "eval", "conditional", "--out", "x"];
-            match crate::cli::Cli::try_parse_from(args.iter().chain(extra)) {
-                Ok(crate::cli::Cli {
-                    command: crate::cli::Command::Eval(a),
-                }) => Ok(a.metallic),
-                Ok(_) => unreachable!("eval parses to Eval"),
-                Err(e) => Err(e.to_string()),
-            }
-        };
+        let parse = |extra: &[&str]| eval_args("conditional", extra).map(|a| a.metallic);
         use crate::lab::eval::conditional::DEFAULT_METALLIC;
         assert_eq!(parse(&[]).unwrap(), DEFAULT_METALLIC);
         assert_eq!(parse(&["--metallic", "1,0.25"]).unwrap(), [1.0, 0.25]);
@@ -451,16 +454,7 @@ mod tests {
     /// is refused before any work.
     #[test]
     fn brdf_prior_conditions_default_to_sixteen_and_refuse_zero() {
-        let parse = |extra: &[&str]| {
-            let args = ["build-tool", "eval", "brdf-prior", "--out", "x"];
-            match crate::cli::Cli::try_parse_from(args.iter().chain(extra)) {
-                Ok(crate::cli::Cli {
-                    command: crate::cli::Command::Eval(a),
-                }) => Ok(a.conditions),
-                Ok(_) => unreachable!("eval parses to Eval"),
-                Err(e) => Err(e.to_string()),
-            }
-        };
+        let parse = |extra: &[&str]| eval_args("brdf-prior", extra).map(|a| a.conditions);
         let judge = crate::lab::eval::brdf_prior::BrdfPriorSettings::default();
         assert_eq!(parse(&[]).unwrap(), judge.conditions);
         assert_eq!(parse(&["--conditions", "48"]).unwrap(), 48);

@@ -72,9 +72,6 @@ pub enum PriorSpace {
 }
 
 impl PriorSpace {
-    /// The blob's space ([`Self::HalfVector`]).
-    pub const HALF_VECTOR: Self = Self::HalfVector;
-
     /// `direction`, `half-vector` (the blob's) or `half-vector:P` (the stretch's
     /// exponent `P` in hundredths).
     pub fn name(self) -> String {
@@ -242,7 +239,7 @@ impl BrdfPrior {
         PRIOR
             .get_or_init(|| {
                 std::sync::Arc::new(
-                    Self::new(PRIOR_GRID, PRIOR_SIZE, PriorSpace::HALF_VECTOR)
+                    Self::new(PRIOR_GRID, PRIOR_SIZE, PriorSpace::HalfVector)
                         .expect("the BRDF has mass at every node"),
                 )
             })
@@ -252,7 +249,7 @@ impl BrdfPrior {
     /// [`Self::core`] over the tables widened to `f64` (the same values; the
     /// warp's arithmetic in `f64`).
     pub fn core_f64(&self) -> Option<nuld_core::brdf_prior::BrdfPrior<'_, f64>> {
-        (self.space == PriorSpace::HALF_VECTOR).then(|| {
+        (self.space == PriorSpace::HalfVector).then(|| {
             let [data, marginal, conditional, masses] = &self.wide;
             nuld_core::brdf_prior::BrdfPrior::view(self.info(), data, marginal, conditional, masses)
                 .expect("tables written by tabulate")
@@ -295,7 +292,7 @@ impl BrdfPrior {
     /// The runtime's prior over these tables (half-vector tables only; `None`
     /// for direction ones): the one implementation every sampler draws from.
     pub fn core(&self) -> Option<nuld_core::brdf_prior::BrdfPrior<'_, f32>> {
-        (self.space == PriorSpace::HALF_VECTOR).then(|| {
+        (self.space == PriorSpace::HalfVector).then(|| {
             nuld_core::brdf_prior::BrdfPrior::view(
                 self.info(),
                 &self.data,
@@ -364,7 +361,7 @@ mod tests {
     /// tables approximate; and `pdf` returns the samples' pdf.
     #[test]
     fn the_estimate_with_the_priors_pdf_is_the_albedo() {
-        for space in [PriorSpace::Direction, PriorSpace::HALF_VECTOR] {
+        for space in [PriorSpace::Direction, PriorSpace::HalfVector] {
             let prior = BrdfPrior::new([3, 4, 2], 32, space).unwrap();
             assert_eq!(prior.state_bytes(), 4 * 24 * (2 * 32 * 32 + 32 + 1));
             let warp = prior.warp();
@@ -413,7 +410,7 @@ mod tests {
         let [r, t, m] = BrdfPrior::node_condition(grid, 1 + 3 * (2 + 4));
         // θo node 2 of 4: 89 (1 - (1/3)^2), the axis crowding towards grazing.
         assert!((r - 0.55).abs() < 1e-12 && (t - 89.0 * 8.0 / 9.0).abs() < 1e-12 && m == 1.0);
-        let prior = BrdfPrior::new(grid, 8, PriorSpace::HALF_VECTOR).unwrap();
+        let prior = BrdfPrior::new(grid, 8, PriorSpace::HalfVector).unwrap();
         let b = prior.blend([r, t, m]);
         let pairs: Vec<(u32, f32)> = b.pairs().filter(|p| p.1 > 1e-6).collect();
         assert_eq!(pairs.len(), 1);

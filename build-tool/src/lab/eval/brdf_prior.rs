@@ -46,7 +46,7 @@ impl Default for BrdfPriorSettings {
         Self {
             grids: vec![[10, 12, 3]],
             sizes: vec![32, 64, 128],
-            spaces: vec![PriorSpace::Direction, PriorSpace::HALF_VECTOR],
+            spaces: vec![PriorSpace::Direction, PriorSpace::HalfVector],
             n: 64,
             conditions: 16,
             instances: 8,
@@ -201,7 +201,7 @@ mod tests {
         let s = BrdfPriorSettings {
             grids: vec![[2, 3, 2]],
             sizes: vec![8, 16],
-            spaces: vec![PriorSpace::Direction, PriorSpace::HALF_VECTOR],
+            spaces: vec![PriorSpace::Direction, PriorSpace::HalfVector],
             n: 16,
             conditions: 4,
             instances: 2,

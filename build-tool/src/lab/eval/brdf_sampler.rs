@@ -301,7 +301,7 @@ mod tests {
         let (_, judges) = judges_of(&s, &|_| {}).unwrap();
         let shape = random_shape(16, &[8], Activation::Relu, PointWarp::BrdfTable, 4).unwrap();
         let mut parts = random_parts(shape, PointWarp::BrdfTable, 4, [3, 3], 2).unwrap();
-        let prior = BrdfPrior::new([3, 3, 2], 32, PriorSpace::HALF_VECTOR).unwrap();
+        let prior = BrdfPrior::new([3, 3, 2], 32, PriorSpace::HalfVector).unwrap();
         parts.prior = Some(Prior::Brdf(Arc::new(prior)));
         let meta = Metadata {
             generator: "test",
