@@ -161,7 +161,8 @@ impl<T: Real> Blend<T> {
                 continue;
             }
             let pos = clamp_unit(params[k]) * T::of((c - 1) as f64);
-            let i = (pos.floor().to_f64() as u32).min(c - 2);
+            // `pos >= 0`, so truncation is the floor (without a call to libm's).
+            let i = (pos.to_f64() as u32).min(c - 2);
             lower[k] = i;
             frac[k] = pos - T::of(i as f64);
         }
@@ -420,91 +421,121 @@ impl<'a, T: Real> Marginal2D<'a, T> {
         })
     }
 
-    /// The blend's value of `values` at offset `at` of each node's block of
-    /// `block` values (nodes past the tables count as 0).
+    /// `blend`'s nodes that have tables, with their offsets (module docs' layout),
+    /// worked out once per query rather than at each of its ~35 table reads.
     #[inline]
-    fn blended(&self, values: &[T], block: usize, at: usize, blend: &Blend<T>) -> T {
-        let mut s = T::ZERO;
+    fn pick(&self, blend: &Blend<T>) -> Picked<T> {
+        let mut p = Picked {
+            len: 0,
+            weight: [T::ZERO; MAX_BLEND],
+            table: [0; MAX_BLEND],
+            marginal: [0; MAX_BLEND],
+        };
         for (node, w) in blend.pairs() {
-            if (node as usize) < self.nodes {
-                if let Some(&v) = values.get(node as usize * block + at) {
-                    s = s + w * v;
-                }
+            let node = node as usize;
+            if node < self.nodes && p.len < MAX_BLEND {
+                p.weight[p.len] = w;
+                p.table[p.len] = node * self.nx * self.ny;
+                p.marginal[p.len] = node * self.ny;
+                p.len += 1;
             }
         }
-        s
+        p
     }
 
-    fn m(&self, j: usize, b: &Blend<T>) -> T {
-        self.blended(self.marginal, self.ny, j, b)
+    fn m(&self, j: usize, p: &Picked<T>) -> T {
+        p.blended(self.marginal, &p.marginal, j)
     }
 
-    fn c(&self, j: usize, i: usize, b: &Blend<T>) -> T {
-        self.blended(self.conditional, self.nx * self.ny, j * self.nx + i, b)
+    fn c(&self, j: usize, i: usize, p: &Picked<T>) -> T {
+        p.blended(self.conditional, &p.table, j * self.nx + i)
     }
 
-    fn f(&self, j: usize, i: usize, b: &Blend<T>) -> T {
-        self.blended(self.data, self.nx * self.ny, j * self.nx + i, b)
+    fn f(&self, j: usize, i: usize, p: &Picked<T>) -> T {
+        p.blended(self.data, &p.table, j * self.nx + i)
     }
 
     /// The blended conditional CDF at vertex `i` of the row at `y = (j + t) dy`.
-    fn c_at(&self, j: usize, t: T, i: usize, b: &Blend<T>) -> T {
-        (T::ONE - t) * self.c(j, i, b) + t * self.c(j + 1, i, b)
+    fn c_at(&self, j: usize, t: T, i: usize, p: &Picked<T>) -> T {
+        (T::ONE - t) * self.c(j, i, p) + t * self.c(j + 1, i, p)
     }
 
     /// The blended density at vertex `i` of the row at `y = (j + t) dy`.
-    fn f_at(&self, j: usize, t: T, i: usize, b: &Blend<T>) -> T {
-        (T::ONE - t) * self.f(j, i, b) + t * self.f(j + 1, i, b)
+    fn f_at(&self, j: usize, t: T, i: usize, p: &Picked<T>) -> T {
+        (T::ONE - t) * self.f(j, i, p) + t * self.f(j + 1, i, p)
     }
 
     /// Draws the point at primary sample `u` in `[0,1]^2` from the blend's
     /// density and returns it with its density ([`Self::pdf`]). `u` outside the
     /// square is clamped into it (NaN as 0).
     pub fn sample(&self, u: [T; 2], blend: &Blend<T>) -> ([T; 2], T) {
+        let blend = &self.pick(blend);
         let (nx, ny) = (self.nx, self.ny);
         let total = self.m(ny - 1, blend);
         // y: the marginal, then the quadratic within the row interval.
         let target = clamp_unit(u[1]) * total;
-        let j = search(ny, target, |j| self.m(j, blend));
+        let (j, m_j) = search(ny, target, |j| self.m(j, blend));
         let dy = T::ONE / T::of((ny - 1) as f64);
         let (r0, r1) = (self.c(j, nx - 1, blend), self.c(j + 1, nx - 1, blend));
-        let t = solve_linear(r0 * dy, r1 * dy, target - self.m(j, blend));
+        let t = solve_linear(r0 * dy, r1 * dy, target - m_j);
         let y = (T::of(j as f64) + t) * dy;
-        // x: the conditional CDF of the row at y, then the quadratic in the cell.
-        let row_total = self.c_at(j, t, nx - 1, blend);
-        let x = if row_total > T::ZERO {
+        // x: the conditional CDF of the row at y, then the quadratic in the cell
+        // (`c_at` and `f_at` written out, to keep the values they read).
+        let row_total = (T::ONE - t) * r0 + t * r1;
+        let (x, corners) = if row_total > T::ZERO {
             let target = clamp_unit(u[0]) * row_total;
-            let i = search(nx, target, |i| self.c_at(j, t, i, blend));
+            let (i, c_i) = search(nx, target, |i| self.c_at(j, t, i, blend));
             let dx = T::ONE / T::of((nx - 1) as f64);
-            let (g0, g1) = (self.f_at(j, t, i, blend), self.f_at(j, t, i + 1, blend));
-            let s = solve_linear(g0 * dx, g1 * dx, target - self.c_at(j, t, i, blend));
-            (T::of(i as f64) + s) * dx
+            let f =
+                [(j, i), (j, i + 1), (j + 1, i), (j + 1, i + 1)].map(|(b, a)| self.f(b, a, blend));
+            let g0 = (T::ONE - t) * f[0] + t * f[2];
+            let g1 = (T::ONE - t) * f[1] + t * f[3];
+            let s = solve_linear(g0 * dx, g1 * dx, target - c_i);
+            ((T::of(i as f64) + s) * dx, Some(((i, j), f)))
         } else {
             // A row without mass (only at a row interval's end): any x, density 0.
-            clamp_unit(u[0])
+            (clamp_unit(u[0]), None)
         };
         let p = [x.min(T::ONE), y.min(T::ONE)];
-        (p, self.pdf(p, blend))
+        (p, self.pdf_known(p, blend, total, corners))
     }
 
     /// The density at `p` in `[0,1]^2` (clamped into it) of the points
     /// [`Self::sample`] draws: the blend's bilinear value over the blend's mass
     /// (per unit area of the square).
     pub fn pdf(&self, p: [T; 2], blend: &Blend<T>) -> T {
-        let total = self.m(self.ny - 1, blend);
+        let blend = &self.pick(blend);
+        self.pdf_known(p, blend, self.m(self.ny - 1, blend), None)
+    }
+
+    /// [`Self::pdf`] given the blend's mass `total` and, where the caller has
+    /// them, the blended densities at the corners `(j, i), (j, i + 1), (j + 1,
+    /// i), (j + 1, i + 1)` of cell `(i, j)`: the same values, read once.
+    fn pdf_known(
+        &self,
+        p: [T; 2],
+        blend: &Picked<T>,
+        total: T,
+        corners: Option<((usize, usize), [T; 4])>,
+    ) -> T {
         if !positive(total) {
             return T::ZERO;
         }
         let (i, s) = cell(p[0], self.nx);
         let (j, t) = cell(p[1], self.ny);
-        let lo = (T::ONE - s) * self.f(j, i, blend) + s * self.f(j, i + 1, blend);
-        let hi = (T::ONE - s) * self.f(j + 1, i, blend) + s * self.f(j + 1, i + 1, blend);
+        let f = match corners {
+            Some((at, f)) if at == (i, j) => f,
+            _ => [(j, i), (j, i + 1), (j + 1, i), (j + 1, i + 1)].map(|(b, a)| self.f(b, a, blend)),
+        };
+        let lo = (T::ONE - s) * f[0] + s * f[1];
+        let hi = (T::ONE - s) * f[2] + s * f[3];
         ((T::ONE - t) * lo + t * hi) / total
     }
 
     /// The primary sample that [`Self::sample`] maps to `p` (clamped into the
     /// square): the blend's marginal CDF at `p.y` and its conditional CDF at `p.x`.
     pub fn invert(&self, p: [T; 2], blend: &Blend<T>) -> [T; 2] {
+        let blend = &self.pick(blend);
         let (nx, ny) = (self.nx, self.ny);
         let total = self.m(ny - 1, blend);
         if !positive(total) {
@@ -527,6 +558,33 @@ impl<'a, T: Real> Marginal2D<'a, T> {
     }
 }
 
+/// A blend's nodes that have tables: weights and the offsets of their tables
+/// (`node nx ny`) and marginals (`node ny`), in the blend's order.
+struct Picked<T> {
+    len: usize,
+    weight: [T; MAX_BLEND],
+    table: [usize; MAX_BLEND],
+    marginal: [usize; MAX_BLEND],
+}
+
+impl<T: Real> Picked<T> {
+    /// `Σ weight values[offset + at]` over the picked nodes, in order (an offset
+    /// past `values` counts as 0: tables of checked lengths never are). A
+    /// pairwise sum, fewer additions deep, measured slower: the warp is bound by
+    /// the number of reads, not by their latency.
+    #[inline]
+    fn blended(&self, values: &[T], offsets: &[usize; MAX_BLEND], at: usize) -> T {
+        let mut s = T::ZERO;
+        let len = self.len.min(MAX_BLEND);
+        for (&w, &offset) in self.weight[..len].iter().zip(&offsets[..len]) {
+            if let Some(&v) = values.get(offset + at) {
+                s = s + w * v;
+            }
+        }
+        s
+    }
+}
+
 /// Whether `x > 0` (false for NaN).
 fn positive<T: Real>(x: T) -> bool {
     x > T::ZERO
@@ -536,25 +594,30 @@ fn positive<T: Real>(x: T) -> bool {
 /// `(k, s)` with `x = (k + s) / (n - 1)`, `k <= n - 2`.
 fn cell<T: Real>(x: T, n: usize) -> (usize, T) {
     let pos = clamp_unit(x) * T::of((n - 1) as f64);
-    let k = (pos.floor().to_f64() as usize).min(n - 2);
+    // `pos >= 0`, so truncation is the floor.
+    let k = (pos.to_f64() as usize).min(n - 2);
     (k, clamp_unit(pos - T::of(k as f64)))
 }
 
 /// The interval `k` in `0..n-1` with `cdf(k) <= target < cdf(k + 1)` of a
 /// non-decreasing `cdf` on `n` vertices, skipping intervals without mass (the
-/// last such interval at or below `target`; interval 0 if none has mass there).
-fn search<T: Real>(n: usize, target: T, cdf: impl Fn(usize) -> T) -> usize {
-    // The largest k in 0..=n-2 with cdf(k) <= target (0 if none).
-    let (mut lo, mut hi) = (0usize, n - 1);
-    while hi - lo > 1 {
-        let mid = lo + (hi - lo) / 2;
-        if cdf(mid) <= target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
+/// last such interval at or below `target`; interval 0 if none has mass there),
+/// and `cdf(k)`.
+fn search<T: Real>(n: usize, target: T, cdf: impl Fn(usize) -> T) -> (usize, T) {
+    // The largest k in 0..=n-2 with cdf(k) <= target (0 if none), without
+    // branches on the values.
+    let (mut k, mut len) = (0usize, n - 1);
+    while len > 1 {
+        let half = len / 2;
+        k += half * usize::from(cdf(k + half) <= target);
+        len -= half;
     }
-    let mut k = lo;
+    let (below, above) = (cdf(k), cdf(k + 1));
+    if above > below {
+        // The interval has mass: the common case, and the moves below would
+        // not start.
+        return (k, below);
+    }
     // Move off an interval without mass: down while the interval is empty (a
     // target at the top of the CDF), up while it is empty (a target at 0).
     while k > 0 && cdf(k + 1) <= cdf(k) {
@@ -563,7 +626,7 @@ fn search<T: Real>(n: usize, target: T, cdf: impl Fn(usize) -> T) -> usize {
     while k + 2 < n && cdf(k + 1) <= cdf(k) {
         k += 1;
     }
-    k
+    (k, cdf(k))
 }
 
 /// `∫_0^s (a + (b - a) r) dr = a s + (b - a) s^2 / 2`: the mass below `s` of a

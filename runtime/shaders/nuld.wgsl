@@ -1290,7 +1290,7 @@ fn nuld_brdf_blend(pr: NuldBrdfPrior, cond: vec3<f32>) -> NuldBlend {
     return b;
 }
 
-// Rust: `Marginal2D::blended`: the blend of the `f32` at element `at` of each
+// Rust: `Picked::blended` (in `Marginal2D`): the blend of the `f32` at element `at` of each
 // node's block of `block` elements of the section at byte `section`, summed in
 // corner order.
 fn nuld_blended(b: NuldBlend, section: u32, block: u32, at: u32) -> f32 {

@@ -369,3 +369,58 @@ fn bad_tables_are_refused_and_bad_queries_do_not_panic() {
     let (p, _) = w.sample([0.3, 0.4], &Blend::from_pairs(&[(0, f64::NAN), (1, 1.0)]));
     assert!(p[0].is_finite() && p[1].is_finite());
 }
+
+/// The answer `search` promises, by brute force: the largest `k <= n - 2` with
+/// `cdf(k) <= target` (0 if none), then moved off intervals without mass as the
+/// contract says.
+fn brute_search(cdf: &[f64], target: f64) -> usize {
+    let n = cdf.len();
+    let mut k = (0..n - 1).rev().find(|&k| cdf[k] <= target).unwrap_or(0);
+    while k > 0 && cdf[k + 1] <= cdf[k] {
+        k -= 1;
+    }
+    while k + 2 < n && cdf[k + 1] <= cdf[k] {
+        k += 1;
+    }
+    k
+}
+
+#[test]
+fn search_finds_the_brute_force_interval_at_every_length() {
+    let mut rng = Rng(0x5ea7c4);
+    for n in [
+        2usize, 3, 16, 17, 18, 33, 96, 255, 256, 257, 258, 300, 1024, 4097,
+    ] {
+        for trial in 0..40 {
+            // Non-decreasing with runs of equal values (intervals without mass).
+            let mut v = 0.0;
+            let cdf: Vec<f64> = (0..n)
+                .map(|k| {
+                    if k > 0 && rng.next() < 0.6 - 0.01 * trial as f64 {
+                        v += rng.next();
+                    }
+                    v
+                })
+                .collect();
+            let top = cdf[n - 1];
+            let mut targets = vec![0.0, top, -1.0, top + 1.0];
+            targets.extend(cdf.iter().copied());
+            targets.extend((0..20).map(|_| rng.next() * top));
+            for t in targets {
+                let k = brute_search(&cdf, t);
+                assert_eq!(search(n, t, |k| cdf[k]), (k, cdf[k]), "n {n} target {t}");
+            }
+        }
+    }
+}
+
+#[test]
+fn search_stays_in_range_on_a_cdf_that_decreases_or_is_nan() {
+    let mut rng = Rng(0xbad);
+    for n in [2usize, 17, 96, 300, 4097] {
+        let cdf: Vec<f64> = (0..n).map(|_| rng.next()).collect();
+        for t in [-1.0, 0.0, 0.3, 0.7, 2.0, f64::NAN] {
+            assert!(search(n, t, |k| cdf[k]).0 <= n - 2, "n {n} target {t}");
+        }
+    }
+}
