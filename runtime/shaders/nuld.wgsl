@@ -1236,26 +1236,53 @@ struct NuldBlend {
     weights_hi: vec4<f32>,
 }
 
-// Rust: `BrdfPrior::blend` (with `unit_condition`, `Blend::multilinear` and
-// `Blend::from_pairs`): the nodes around `cond = (roughness, theta_o in degrees,
-// metallic)`, clamped (NaN to the lower ends) and placed on `[0,1]^3`, each
-// weighed by its multilinear weight times its mass (weights not above 0 as 0).
+// Rust: `reads_metal_layer`: metallic 1 exactly (clamped, NaN as 0) on a grid
+// with the metal layer (`G_m = 3`).
+fn nuld_reads_metal_layer(pr: NuldBrdfPrior, metallic: f32) -> bool {
+    return pr.grid.z == 3u && nuld_clamp01(metallic) >= 1.0;
+}
+
+// Rust: `query_stretch`: the metal layer's stretch `k = roughness` where a query
+// reads it, else the shared square's `roughness^(1/4)`.
+fn nuld_prior_stretch(pr: NuldBrdfPrior, cond: vec3<f32>) -> f32 {
+    if nuld_reads_metal_layer(pr, cond.z) {
+        return nuld_clamp_roughness(cond.x);
+    }
+    return nuld_stretch(cond.x);
+}
+
+// Rust: `BrdfPrior::blend` (`mass_weighted_blend`, with `unit_condition`,
+// `Blend::multilinear` and `Blend::from_pairs`): the nodes around `cond =
+// (roughness, theta_o in degrees, metallic)`, clamped (NaN to the lower ends)
+// and placed on `[0,1]^3`, each weighed by its multilinear weight times its mass
+// (weights not above 0 as 0). With the metal layer (`G_m = 3`) the metallic axis
+// spans the first two layers; a query at metallic 1 takes the metal layer's four
+// nodes around `(roughness, theta_o)` alone (corners 0-3, past `2 G_r G_t`;
+// corners 4-7 repeat them at weight 0, as Rust's two-parameter blend has none).
 fn nuld_brdf_blend(pr: NuldBrdfPrior, cond: vec3<f32>) -> NuldBlend {
     // `unit_condition`; the metallic's `(m - 0) / (1 - 0)` is `m` exactly; the
     // view's `1 - sqrt(1 - theta_o / 89)`, nodes crowding towards grazing.
     let rest = max(1.0 - nuld_clamp_theta_o(cond.y) / NULD_MAX_THETA_O_DEG, 0.0);
-    let unit = vec3<f32>(
+    var unit = vec3<f32>(
         (nuld_clamp_roughness(cond.x) - NULD_MIN_ROUGHNESS) / NULD_ROUGHNESS_SPAN,
         1.0 - sqrt(rest),
         nuld_clamp01(cond.z),
     );
+    let metal = nuld_reads_metal_layer(pr, cond.z);
+    let counts = vec3<u32>(pr.grid.xy, min(pr.grid.z, 2u));
+    var first = 0u;
+    if metal {
+        // The metallic coordinate at node 0 of a two-node axis: weight 1 - 0.
+        unit.z = 0.0;
+        first = 2u * pr.grid.x * pr.grid.y;
+    }
     var lower = vec3<u32>(0u, 0u, 0u);
     var frac = vec3<f32>(0.0, 0.0, 0.0);
     var stride = vec3<u32>(0u, 0u, 0u);
     var s = 1u;
     for (var k = 0u; k < 3u; k++) {
         stride[k] = s;
-        let c = pr.grid[k];
+        let c = counts[k];
         s = s * c;
         let pos = nuld_clamp01(unit[k]) * f32(c - 1u);
         let i = min(u32(floor(pos)), c - 2u);
@@ -1264,11 +1291,12 @@ fn nuld_brdf_blend(pr: NuldBrdfPrior, cond: vec3<f32>) -> NuldBlend {
     }
     var b: NuldBlend;
     for (var corner = 0u; corner < NULD_MAX_BLEND; corner++) {
-        var node = 0u;
+        var node = first;
         var w = 1.0;
         for (var k = 0u; k < 3u; k++) {
             let up = (corner >> k) & 1u;
-            node = node + (lower[k] + up) * stride[k];
+            // A metal query's corners 4-7: the same nodes as 0-3 (at weight 0).
+            node = node + (lower[k] + select(up, 0u, metal && k == 2u)) * stride[k];
             if up == 1u {
                 w = w * frac[k];
             } else {
@@ -1643,7 +1671,7 @@ fn nuld_half_vector_point(wo: vec3<f32>, wi: vec3<f32>, k: f32) -> NuldHalfVecto
 fn nuld_brdf_prior_sample(pr: NuldBrdfPrior, cond: vec3<f32>, u: vec2<f32>) -> NuldTreeSample {
     let wo = nuld_view_direction(cond.y);
     let s = nuld_marginal_sample(pr, nuld_brdf_blend(pr, cond), u);
-    let hv = nuld_half_vector_direction(wo, s.p, nuld_stretch(cond.x));
+    let hv = nuld_half_vector_direction(wo, s.p, nuld_prior_stretch(pr, cond));
     if hv.jac > 0.0 {
         return NuldTreeSample(hv.w, s.pdf / (2.0 * NULD_PI * hv.jac));
     }
@@ -1655,7 +1683,7 @@ fn nuld_brdf_prior_sample(pr: NuldBrdfPrior, cond: vec3<f32>, u: vec2<f32>) -> N
 // nothing.
 fn nuld_brdf_prior_pdf(pr: NuldBrdfPrior, cond: vec3<f32>, wi: vec3<f32>) -> f32 {
     let wo = nuld_view_direction(cond.y);
-    let hv = nuld_half_vector_point(wo, wi, nuld_stretch(cond.x));
+    let hv = nuld_half_vector_point(wo, wi, nuld_prior_stretch(pr, cond));
     if hv.jac > 0.0 {
         return nuld_marginal_pdf(pr, nuld_brdf_blend(pr, cond), hv.w.xy) / (2.0 * NULD_PI * hv.jac);
     }

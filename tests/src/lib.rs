@@ -128,15 +128,15 @@ pub fn as_envmap(
     nuld_build_tool::lab::bench::runtime::envmap_parts(parts, fixture_tree())
 }
 
-/// A small tabulated BRDF prior (3 x 2 x 2 conditions, 5 x 5 half-vector
-/// vertices; built once per test binary): for blobs whose every byte a test
-/// visits.
+/// A small tabulated BRDF prior (3 x 2 x 3 conditions, the metal layer
+/// included, 5 x 5 half-vector vertices; built once per test binary): for
+/// blobs whose every byte a test visits.
 pub fn small_brdf_prior() -> std::sync::Arc<nuld_build_tool::sphere::brdf_prior::BrdfPrior> {
     use nuld_build_tool::sphere::brdf_prior::{BrdfPrior, PriorSpace};
     static PRIOR: std::sync::OnceLock<std::sync::Arc<BrdfPrior>> = std::sync::OnceLock::new();
     let prior = PRIOR.get_or_init(|| {
         std::sync::Arc::new(
-            BrdfPrior::new([3, 2, 2], 5, PriorSpace::HalfVector).expect("a valid prior"),
+            BrdfPrior::new([3, 2, 3], 5, PriorSpace::HalfVector).expect("a valid prior"),
         )
     });
     std::sync::Arc::clone(prior)

@@ -114,7 +114,7 @@ fn envmap_blob() -> AlignedBytes {
 }
 
 /// [`conditional_blob`]'s shape as a BRDF sampler on the tabulated prior, with
-/// a small prior (3 x 2 x 2 conditions, 5 x 5 vertices: [`small_brdf_prior`]) so
+/// a small prior (3 x 2 x 3 conditions, 5 x 5 vertices: [`small_brdf_prior`]) so
 /// that every truncation stays cheap.
 fn brdf_table_blob() -> AlignedBytes {
     let shape = shape(4, &[3, 2], Activation::Relu, PointWarp::BrdfTable, 2);
@@ -516,6 +516,41 @@ fn each_error_variant_is_produced_by_the_corruption_it_names() {
     }
 }
 
+/// A BRDF prior's metallic axis holds metallic 0 and 1, and perhaps the metal
+/// layer: tables of 16 nodes labelled `2 x 2 x 4` (every length consistent) are
+/// refused, the same tables as `2 x 4 x 2` load, and `3 x 2 x 3` (the metal
+/// layer) loads.
+#[test]
+fn a_brdf_prior_with_four_metallic_layers_is_refused() {
+    use nuld_build_tool::sphere::brdf_prior::{BrdfPrior, PriorSpace};
+    let blob = |prior: BrdfPrior| {
+        let parts = conditional_parts(
+            shape(8, &[4], Activation::Relu, PointWarp::BrdfTable, 2),
+            2,
+            [3, 2],
+            7,
+        );
+        with_brdf_prior(parts, std::sync::Arc::new(prior))
+            .to_blob(&META)
+            .unwrap()
+    };
+    let tables = BrdfPrior::new([2, 4, 2], 5, PriorSpace::HalfVector).unwrap();
+    let ok = blob(tables.clone());
+    assert!(Blob::parse(ok.as_slice()).unwrap().brdf().is_ok());
+    let mut relabelled = tables;
+    relabelled.grid = [2, 2, 4];
+    let four = blob(relabelled);
+    let err = Blob::parse(four.as_slice())
+        .and_then(|b| b.brdf())
+        .unwrap_err();
+    assert!(err.to_string().contains("warp"), "{err}");
+    assert!(parse_and_touch(four.as_slice()).is_err());
+    assert!(Blob::parse(brdf_table_blob().as_slice())
+        .unwrap()
+        .brdf()
+        .is_ok());
+}
+
 #[test]
 fn blob_errors_convert_into_boxed_std_errors_with_question_mark() {
     fn len(bytes: &[u8]) -> Result<usize, Box<dyn std::error::Error + Send + Sync>> {
@@ -655,8 +690,8 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
 }
 
 /// The BRDF prior's sections (core/FORMAT.md, tags 11-15), checked from the raw
-/// bytes: a 16-byte info of three grid counts of 2 to 256 and a size `S` of 2 to
-/// 4096; `nodes S^2` data and conditional CDF values and `nodes S` marginal CDF
+/// bytes: a 16-byte info of grid counts `G_r, G_t` of 2 to 256 and `G_m` of 2
+/// or 3 (the metal layer), and a size `S` of 2 to 4096; `nodes S^2` data and conditional CDF values and `nodes S` marginal CDF
 /// values, all finite `f32 >= 0`, each row of `S` CDF values non-decreasing,
 /// each node's marginal ending above 0; `nodes` finite masses above 0.
 fn brdf_prior_semantics_hold(layout: &Layout<'_>) -> bool {
@@ -669,7 +704,8 @@ fn brdf_prior_semantics_hold(layout: &Layout<'_>) -> bool {
     }
     let word = |at: usize| u32::from_le_bytes(info[at..at + 4].try_into().unwrap());
     let (grid, size) = ([word(0), word(4), word(8)], word(12));
-    if !(grid.iter().all(|g| (2..=256).contains(g)) && (2..=4096).contains(&size)) {
+    let axes = grid[..2].iter().all(|g| (2..=256).contains(g)) && (2..=3).contains(&grid[2]);
+    if !(axes && (2..=4096).contains(&size)) {
         return false;
     }
     let nodes = (grid[0] * grid[1] * grid[2]) as usize;

@@ -123,7 +123,9 @@ pub struct EvalArgs {
     /// envmap-prior, brdf-prior: table sizes, vertices per axis (each >= 2).
     #[arg(long, value_delimiter = ',', default_value = "32,64,128")]
     pub sizes: Vec<u32>,
-    /// brdf-prior: condition grids RxTxM (roughness, θo, metallic nodes, each >= 1).
+    /// brdf-prior: condition grids RxTxM: roughness and θo nodes (2 to 64 each),
+    /// and M = 2 (metallic 0 and 1) or 3 (and the metal layer, the metal again in
+    /// its own square, read at metallic 1: the blob's).
     #[arg(long, value_delimiter = ',', default_value = "10x12x3", value_parser = condition_grid)]
     pub brdf_grids: Vec<[u32; 3]>,
     /// brdf-prior: table spaces, `direction` (the light direction's equal-area
@@ -267,18 +269,19 @@ fn metallic_value(s: &str) -> Result<f64, String> {
 
 /// `RxTxM`, each in `1..=64`.
 fn condition_grid(s: &str) -> Result<[u32; 3], String> {
-    let bad = || format!("{s:?} is not a grid RxTxM with each in 1..=64");
+    let bad = || {
+        format!(
+            "{s:?} is not a grid RxTxM: R and T in 2..=64, M 2 (metallic 0 and 1) or 3 (and the metal layer)"
+        )
+    };
     let v: Vec<u32> = s
         .split('x')
-        .map(|p| {
-            p.trim()
-                .parse::<u32>()
-                .ok()
-                .filter(|n| (1..=64).contains(n))
-        })
+        .map(|p| p.trim().parse::<u32>().ok())
         .collect::<Option<_>>()
         .ok_or_else(bad)?;
-    v.try_into().map_err(|_| bad())
+    let grid: [u32; 3] = v.try_into().map_err(|_| bad())?;
+    let ok = grid[..2].iter().all(|n| (2..=64).contains(n)) && (2..=3).contains(&grid[2]);
+    ok.then_some(grid).ok_or_else(bad)
 }
 
 /// `direction`, `half-vector` or `half-vector:P`.
@@ -447,6 +450,23 @@ mod tests {
                 e.contains("is not a metallic value: a number in [0, 1]"),
                 "{e}"
             );
+        }
+    }
+
+    /// `--brdf-grids` defaults to the blob's prior grid (with the metal layer)
+    /// and refuses a metallic axis other than 2 or 3 nodes, and short axes.
+    #[test]
+    fn brdf_grids_default_to_the_blobs_and_take_two_or_three_metallic_nodes() {
+        let parse = |extra: &[&str]| eval_args("brdf-prior", extra).map(|a| a.brdf_grids);
+        use crate::sphere::brdf_prior::PRIOR_GRID;
+        assert_eq!(parse(&[]).unwrap(), [PRIOR_GRID]);
+        assert_eq!(
+            parse(&["--brdf-grids", "10x12x2,4x5x3"]).unwrap(),
+            [[10, 12, 2], [4, 5, 3]]
+        );
+        for bad in ["10x12x4", "10x12x1", "1x12x2", "10x12", "10x65x2", "axbxc"] {
+            let e = parse(&["--brdf-grids", bad]).unwrap_err();
+            assert!(e.contains("is not a grid RxTxM"), "{bad}: {e}");
         }
     }
 

@@ -52,10 +52,12 @@ impl Tables {
             for j in 0..s {
                 for i in 0..s {
                     let p = [i as f64 / (s - 1) as f64, j as f64 / (s - 1) as f64];
-                    data.push(match half_vector_direction(wo, p, stretch(r)) {
-                        Some((wi, jac)) => gltf_metallic(wo, wi, r, m) * wi[2] * jac,
-                        None => 0.0,
-                    });
+                    data.push(
+                        match half_vector_direction(wo, p, node_stretch(grid, node)) {
+                            Some((wi, jac)) => gltf_metallic(wo, wi, r, m) * wi[2] * jac,
+                            None => 0.0,
+                        },
+                    );
                 }
             }
         }
@@ -187,13 +189,25 @@ fn the_stretched_jacobian_integrates_the_hemisphere() {
 /// independent reference table at a reference condition (`A_m = (1 - m) A_0 +
 /// m A_1`), at metallic 0, 0.5 and 1 between nodes in roughness and `θo`; and
 /// `pdf` and `invert` answer for every sample.
+///
+/// With the metal layer (`G_m = 3`) the same holds, metallic 1 drawing from the
+/// metal's own square and just below it from the shared one.
 #[test]
 fn the_estimate_with_the_priors_pdf_is_the_reference_albedo() {
-    let tables = Tables::new([4, 5, 2], 48);
+    for (grid, metallics) in [
+        ([4, 5, 2], &[0.0, 0.5, 1.0][..]),
+        ([4, 5, 3], &[0.0, 0.999, 1.0]),
+    ] {
+        estimate_is_the_reference_albedo(grid, metallics);
+    }
+}
+
+fn estimate_is_the_reference_albedo(grid: [u32; 3], metallics: &[f64]) {
+    let tables = Tables::new(grid, 48);
     let prior = tables.prior();
     let mut g = Rng(11);
     for (ri, ti) in [(3, 1), (4, 3), (5, 4)] {
-        for m in [0.0, 0.5, 1.0] {
+        for &m in metallics {
             let (r, t) = (REFERENCE_ROUGHNESSES[ri], REFERENCE_THETAS[ti]);
             let want = (1.0 - m) * REFERENCE_ALBEDO[ri][ti] + m * REFERENCE_METAL_ALBEDO[ri][ti];
             let cond = [r, t, m];
@@ -218,9 +232,65 @@ fn the_estimate_with_the_priors_pdf_is_the_reference_albedo() {
             let se = ((sum2 / count as f64 - mean * mean) / count as f64).sqrt();
             assert!(
                 (mean - want).abs() < 4.0 * se + 1e-6,
-                "{cond:?}: {mean} vs {want} (se {se})"
+                "{grid:?} {cond:?}: {mean} vs {want} (se {se})"
             );
         }
+    }
+}
+
+/// The metal layer: its nodes hold metallic 1 in the metal's square
+/// (`node_stretch`), a query at metallic 1 blends its four nodes around
+/// `(roughness, θo)` alone with the metal's stretch, a query below metallic 1
+/// the first two layers with the shared stretch; at a metal-layer node the
+/// density is proportional to the metal's `f cos |dwi/dh|` in its square.
+#[test]
+fn the_metal_layer_serves_metallic_one_alone() {
+    let (grid, size) = ([3, 4, 3], 32);
+    let layer = 3 * 4;
+    assert!(has_metal_layer(grid) && !has_metal_layer([3, 4, 2]));
+    for node in 0..3 * layer {
+        let [r, t, m] = node_condition(grid, node);
+        let two = node_condition([3, 4, 2], node % (2 * layer));
+        assert_eq!([r, t], [two[0], two[1]]);
+        assert_eq!(m, if node < layer { 0.0 } else { 1.0 });
+        let k = if node < 2 * layer {
+            stretch(r)
+        } else {
+            metal_stretch(r)
+        };
+        assert_eq!(node_stretch(grid, node), k);
+    }
+    let tables = Tables::new(grid, size);
+    let prior = tables.prior();
+    let (r, t) = (0.37, 41.0);
+    let metal = prior.blend([r, t, 1.0]);
+    assert_eq!(metal.pairs().count(), 4);
+    assert!(metal.pairs().all(|(n, w)| n >= 2 * layer && w > 0.0));
+    assert!(prior
+        .blend([r, t, 0.999])
+        .pairs()
+        .all(|(n, _)| n < 2 * layer));
+    assert!(prior.blend([r, t, 0.5]).pairs().all(|(n, _)| n < 2 * layer));
+    assert_eq!(query_stretch(grid, [r, t, 1.0]), metal_stretch(r));
+    assert_eq!(query_stretch(grid, [r, t, 2.0]), metal_stretch(r));
+    assert_eq!(query_stretch(grid, [r, t, 0.999]), stretch(r));
+    assert_eq!(query_stretch([3, 4, 2], [r, t, 1.0]), stretch(r));
+    let node = 2 * layer + 1 + 3 * 2;
+    let [r, t, _] = node_condition(grid, node);
+    let wo = view_direction_real(t);
+    let mut ratios = Vec::new();
+    for (i, j) in [(16, 16), (18, 16), (21, 17), (17, 13), (19, 19)] {
+        let p = [i as f64 / (size - 1) as f64, j as f64 / (size - 1) as f64];
+        let Some((wi, jac)) = half_vector_direction(wo, p, metal_stretch(r)) else {
+            continue;
+        };
+        let target = gltf_metallic(wo, wi, r, 1.0) * wi[2] * jac;
+        let pdf_square = prior.pdf([r, t, 1.0], wi) * 2.0 * core::f64::consts::PI * jac;
+        ratios.push(pdf_square / target);
+    }
+    assert!(ratios.len() >= 4);
+    for q in &ratios {
+        assert!((q / ratios[0] - 1.0).abs() < 1e-9, "{ratios:?}");
     }
 }
 
@@ -288,6 +358,14 @@ fn bad_tables_are_refused_and_views_check_lengths_only() {
         .nodes(),
         None
     );
+    // The metallic axis: metallic 0 and 1, and perhaps the metal layer.
+    for (g_m, nodes) in [(1, None), (2, Some(12)), (3, Some(18)), (4, None)] {
+        let info = BrdfPriorInfo {
+            grid: [2, 3, g_m],
+            size: 5,
+        };
+        assert_eq!(info.nodes(), nodes, "G_m {g_m}");
+    }
 }
 
 /// The `θo` axis: nodes at `89 (1 - (1 - u)^2)`, crowding towards grazing (the
