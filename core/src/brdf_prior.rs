@@ -166,12 +166,19 @@ pub fn query_stretch<T: Real>(grid: [u32; 3], cond: [T; 3]) -> T {
     }
 }
 
+/// Whether node `node` of `grid` is one of the metal layer's (layer 2 of a grid
+/// with the layer, [`has_metal_layer`]).
+#[inline]
+pub fn is_metal_layer_node(grid: [u32; 3], node: u32) -> bool {
+    has_metal_layer(grid) && node / (grid[0].max(1) * grid[1].max(1)) >= 2
+}
+
 /// The stretch of node `node`'s square on `grid`: [`metal_stretch`] for the
-/// metal layer's nodes, else [`stretch`], at the node's roughness.
+/// metal layer's nodes ([`is_metal_layer_node`]), else [`stretch`], at the
+/// node's roughness.
 pub fn node_stretch(grid: [u32; 3], node: u32) -> f64 {
     let r = node_condition(grid, node)[0];
-    let layer = node / (grid[0].max(1) * grid[1].max(1));
-    match has_metal_layer(grid) && layer >= 2 {
+    match is_metal_layer_node(grid, node) {
         true => metal_stretch(r),
         false => stretch(r),
     }
@@ -338,10 +345,11 @@ pub fn mass_weighted_blend<T: Real>(grid: [u32; 3], masses: &[T], cond: [T; 3]) 
             Blend::multilinear(&unit[..2], &grid[..2]),
             layer.saturating_mul(2),
         )
-    } else if has_metal_layer(grid) {
-        (Blend::multilinear(&unit, &[grid[0], grid[1], 2]), 0)
     } else {
-        (Blend::multilinear(&unit, &grid), 0)
+        // Below metallic 1 the metallic axis spans the first two layers.
+        let metallic_nodes = if has_metal_layer(grid) { 2 } else { grid[2] };
+        let counts = [grid[0], grid[1], metallic_nodes];
+        (Blend::multilinear(&unit, &counts), 0)
     };
     let mut pairs = [(0u32, T::ZERO); MAX_BLEND];
     let mut len = 0;

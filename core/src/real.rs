@@ -112,14 +112,7 @@ impl Real for f64 {
         // i64; at or above it, and for NaN and infinities, `self` is its floor.
         // The same value as libm's for every input, -0.0 included.
         if libm::fabs(self) < 4_503_599_627_370_496.0 {
-            let t = self as i64 as f64;
-            if t == self {
-                self
-            } else if t > self {
-                t - 1.0
-            } else {
-                t
-            }
+            floor_of_truncation(self, self as i64 as f64)
         } else {
             self
         }
@@ -191,14 +184,7 @@ impl Real for f32 {
         // As for `f64`, below 2^23 (exact in i32): the warps' hot paths floor
         // several times per sample.
         if libm::fabsf(self) < 8_388_608.0 {
-            let t = self as i32 as f32;
-            if t == self {
-                self
-            } else if t > self {
-                t - 1.0
-            } else {
-                t
-            }
+            floor_of_truncation(self, self as i32 as f32)
         } else {
             self
         }
@@ -232,6 +218,22 @@ pub fn clamp_unit<T: Real>(x: T) -> T {
     }
 }
 
+/// The floor of `x` from its truncation toward zero `t` (exact): `x` itself
+/// when it is whole (keeping -0.0), else `t`, or `t - 1` below zero.
+#[inline]
+fn floor_of_truncation<T>(x: T, t: T) -> T
+where
+    T: Copy + PartialOrd + core::ops::Sub<Output = T> + From<u8>,
+{
+    if t == x {
+        x
+    } else if t > x {
+        t - T::from(1u8)
+    } else {
+        t
+    }
+}
+
 #[cfg(test)]
 mod tests {
     extern crate std;
@@ -254,60 +256,49 @@ mod tests {
         assert_eq!(Real::to_f64(0.5f32), 0.5);
     }
 
-    /// The inline floors return libm's bits: every f32 in a dense sweep of
-    /// `[-2^25, 2^25]` (both sides of the 2^23 switch), signed zeros,
-    /// infinities, NaN, and f64s on both sides of 2^52.
+    /// `Real::floor` against `libm` on `xs` and their negatives, bit for bit
+    /// (compared widened to f64, which keeps every value and -0.0), and NaN.
+    fn floor_matches<T: Real>(xs: impl IntoIterator<Item = T>, libm_floor: fn(T) -> T, nan: T) {
+        for x in xs {
+            for v in [x, T::ZERO - x] {
+                let (got, want) = (Real::floor(v).to_f64(), libm_floor(v).to_f64());
+                assert_eq!(got.to_bits(), want.to_bits(), "{}", v.to_f64());
+            }
+        }
+        assert!(Real::floor(nan).is_nan());
+    }
+
+    /// The inline floors return libm's bits: a dense sweep of f32 over
+    /// `[2^-31, 2^25]` (both sides of the 2^23 switch) and of f64 over `[2^-63,
+    /// 2^65]` (both sides of 2^52), their negatives, signed zeros, infinities,
+    /// NaN and the values next to the switches.
     #[test]
     fn floor_is_libms_bit_for_bit() {
-        let mut xs = std::vec![0.0f32, -0.0, 0.5, -0.5, 1.0, -1.0, f32::MIN_POSITIVE];
-        xs.extend([
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::MAX,
-            f32::MIN,
-            -f32::MIN_POSITIVE,
-        ]);
-        xs.extend([
-            8_388_607.5,
-            -8_388_607.5,
-            8_388_608.0,
-            -8_388_608.0,
-            8_388_609.0,
-        ]);
-        let mut bits = 0x3000_0000u32;
-        while bits < 0x4c00_0000 {
-            let x = f32::from_bits(bits);
-            xs.extend([x, -x]);
-            bits += 997;
-        }
-        for x in xs {
-            assert_eq!(Real::floor(x).to_bits(), libm::floorf(x).to_bits(), "{x}");
-        }
-        assert!(Real::floor(f32::NAN).is_nan());
-        let mut ys = std::vec![0.0f64, -0.0, -0.5, 0.5, -1e-300, 4_503_599_627_370_495.5];
-        ys.extend([
-            -4_503_599_627_370_495.5,
+        let specials = [0.5, 1.0, 2.7, 3.0, 123_456.789, f64::INFINITY];
+        let f32s = (0x3000_0000u32..0x4c00_0000)
+            .step_by(997)
+            .map(f32::from_bits);
+        let f32_edges = [-0.0, 8_388_607.5, 8_388_608.0, 8_388_609.0, f32::MAX];
+        floor_matches(
+            f32s.chain(f32_edges)
+                .chain(specials.map(|x| x as f32))
+                .chain([f32::MIN_POSITIVE]),
+            libm::floorf,
+            f32::NAN,
+        );
+        let f64s = (0x3c00_0000_0000_0000u64..0x4400_0000_0000_0000)
+            .step_by(0x0000_1234_5678_9abc)
+            .map(f64::from_bits);
+        let f64_edges = [
+            -0.0,
+            1e-300,
+            4_503_599_627_370_495.5,
             4_503_599_627_370_496.0,
-            -9.1e15,
-            1e300,
-        ]);
-        ys.extend([
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            -2.7,
-            2.7,
-            -3.0,
-            123_456.789,
-        ]);
-        let mut bits = 0x3c00_0000_0000_0000u64;
-        while bits < 0x4400_0000_0000_0000 {
-            let y = f64::from_bits(bits);
-            ys.extend([y, -y]);
-            bits += 0x0000_1234_5678_9abc;
-        }
-        for y in ys {
-            assert_eq!(Real::floor(y).to_bits(), libm::floor(y).to_bits(), "{y}");
-        }
-        assert!(Real::floor(f64::NAN).is_nan());
+        ];
+        floor_matches(
+            f64s.chain(f64_edges).chain(specials).chain([9.1e15, 1e300]),
+            libm::floor,
+            f64::NAN,
+        );
     }
 }

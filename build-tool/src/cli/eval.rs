@@ -267,7 +267,7 @@ fn metallic_value(s: &str) -> Result<f64, String> {
         .ok_or_else(|| format!("{s:?} is not a metallic value: a number in [0, 1]"))
 }
 
-/// `RxTxM`, each in `1..=64`.
+/// `RxTxM`: R and T in `2..=64`, M 2 or 3.
 fn condition_grid(s: &str) -> Result<[u32; 3], String> {
     let bad = || {
         format!(
@@ -280,8 +280,13 @@ fn condition_grid(s: &str) -> Result<[u32; 3], String> {
         .collect::<Option<_>>()
         .ok_or_else(bad)?;
     let grid: [u32; 3] = v.try_into().map_err(|_| bad())?;
-    let ok = grid[..2].iter().all(|n| (2..=64).contains(n)) && (2..=3).contains(&grid[2]);
-    ok.then_some(grid).ok_or_else(bad)
+    // A blob's grid (the metallic axis 2 or 3), at most 64 nodes per axis here.
+    let blob_grid = nuld_core::brdf_prior::BrdfPriorInfo { grid, size: 2 }
+        .nodes()
+        .is_some();
+    (blob_grid && grid[..2].iter().all(|&n| n <= 64))
+        .then_some(grid)
+        .ok_or_else(bad)
 }
 
 /// `direction`, `half-vector` or `half-vector:P`.

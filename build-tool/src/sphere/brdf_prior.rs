@@ -31,8 +31,8 @@ use super::envmap_prior::tabulated;
 use glam::{DVec2, DVec3};
 use nuld_core::brdf::{gltf_metallic, view_direction};
 use nuld_core::brdf_prior::{
-    half_vector_direction, half_vector_point, has_metal_layer, mass_weighted_blend, metal_stretch,
-    node_condition, reads_metal_layer, stretch, stretch_with, BrdfPriorInfo,
+    half_vector_direction, half_vector_point, is_metal_layer_node, mass_weighted_blend,
+    metal_stretch, node_condition, reads_metal_layer, stretch, stretch_with, BrdfPriorInfo,
 };
 use nuld_core::marginal2d::{Blend, Marginal2D, Marginal2DError, Marginal2DShape};
 use nuld_core::sphere::{hemisphere_to_square, square_to_hemisphere};
@@ -185,21 +185,14 @@ impl BrdfPrior {
     /// The prior on `grid` condition nodes and `size x size` table vertices in
     /// `space`, tables in `f32` (as a blob stores them). `O(nodes R^2)` with
     /// `R` = [`SUPERSAMPLED_AXIS`], in parallel over the nodes; the same bits for
-    /// any thread count. An error if `size` is below 2, a grid axis is 0, or a
-    /// node's table has no mass.
+    /// any thread count. An error if the grid and size are not a blob's
+    /// ([`BrdfPriorInfo::shape`]: 2 to 256 roughness and view nodes, 2 or 3
+    /// metallic layers, 2 to 4096 vertices), or a node's table has no mass.
     pub fn new(grid: [u32; 3], size: u32, space: PriorSpace) -> Result<Self, Marginal2DError> {
-        // The metallic axis: metallic 0 and 1, and perhaps the metal layer.
-        if size < 2 || grid.contains(&0) || !(2..=3).contains(&grid[2]) {
-            return Err(Marginal2DError::Shape);
-        }
-        let nodes = grid[0]
-            .checked_mul(grid[1])
-            .and_then(|n| n.checked_mul(grid[2]))
+        let shape = BrdfPriorInfo { grid, size }
+            .shape()
             .ok_or(Marginal2DError::Shape)?;
-        let shape = Marginal2DShape {
-            size: [size, size],
-            nodes,
-        };
+        let nodes = shape.nodes;
         let s = size as usize;
         let k = SUPERSAMPLED_AXIS.div_ceil(size).max(1) as usize;
         let h = 1.0 / (s - 1) as f64;
@@ -207,7 +200,7 @@ impl BrdfPrior {
             .into_par_iter()
             .map(|node| {
                 let [r, t, m] = node_condition(grid, node);
-                let metal_layer = has_metal_layer(grid) && node >= 2 * grid[0] * grid[1];
+                let metal_layer = is_metal_layer_node(grid, node);
                 let wo = view_direction(t);
                 let mut out = vec![0.0f32; s * s];
                 for j in 0..s {

@@ -259,6 +259,7 @@ fn the_metal_layer_serves_metallic_one_alone() {
             metal_stretch(r)
         };
         assert_eq!(node_stretch(grid, node), k);
+        assert_eq!(is_metal_layer_node(grid, node), node >= 2 * layer);
     }
     let tables = Tables::new(grid, size);
     let prior = tables.prior();
