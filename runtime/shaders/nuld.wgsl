@@ -1382,6 +1382,11 @@ fn nuld_search(pr: NuldBrdfPrior, b: NuldBlend, axis: u32, j: u32, t: f32, n: u3
         }
     }
     var k = lo;
+    // The interval has mass: the common case, and the moves below would not start
+    // (two blended reads instead of four, as the Rust).
+    if nuld_prior_cdf(pr, b, axis, j, t, k + 1u) > nuld_prior_cdf(pr, b, axis, j, t, k) {
+        return k;
+    }
     while k > 0u && nuld_prior_cdf(pr, b, axis, j, t, k + 1u) <= nuld_prior_cdf(pr, b, axis, j, t, k) {
         k -= 1u;
     }
