@@ -642,6 +642,12 @@ fn envmap_bake_and_sample_reject_bad_input_with_one_line() {
     assert!(e.contains("negative"), "{e}");
     let e = failure(&["bake", "--brdf", "--union-weight", "nan"], &out);
     assert!(e.contains("--union-weight must be finite"), "{e}");
+    let e = failure(&["bake", "--brdf", "--pool-conditions", "0"], &out);
+    assert!(
+        e.contains("--pool-conditions must be in 1..=65536, got 0"),
+        "{e}"
+    );
+    assert_eq!(e.trim().lines().count(), 1, "{e}");
     assert!(!out.exists());
     // A map that exists but does not decode fails in the pool, after the output
     // directory was made: it goes again.
