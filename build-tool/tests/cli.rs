@@ -516,7 +516,12 @@ fn sample_prints_what_the_runtime_serves_and_rejects_bad_input() {
             mode,
         ]));
         let mut lines = csv.lines();
-        assert_eq!(lines.next(), Some("index,x,y,z,weight,pdf"));
+        let header = lines.next().unwrap();
+        assert_eq!(header, "index,x,y,z,weight,pdf");
+        // The command list of `build-tool --help` names the same columns.
+        let help = stdout_of(build_tool().arg("--help"));
+        let line = help.lines().find(|l| l.trim_start().starts_with("sample"));
+        assert!(line.unwrap().contains(&format!("`{header}`")), "{help}");
         let rows: Vec<Vec<f32>> = lines
             .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
             .collect();

@@ -30,7 +30,7 @@ pub enum Command {
     Sobol(sobol::SobolArgs),
     /// Print a blob's points as CSV: `set,index,x,y` (2D) or `set,index,x,y,z`.
     Export(export::ExportArgs),
-    /// Print a conditional blob's samples at one condition (--cond) or normal (--normal) as CSV: `index,x,y,z,weight`.
+    /// Print a conditional blob's samples at one condition (--cond) or normal (--normal) as CSV: `index,x,y,z,weight,pdf`.
     Sample(sample::SampleArgs),
     /// Optimize point sets for a target density: DIR/set.nuld, report.json, set.png.
     Optimize(optimize::OptimizeArgs),
