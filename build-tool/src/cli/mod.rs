@@ -38,7 +38,7 @@ pub enum Command {
     Metrics(metrics::MetricsArgs),
     /// Train and distill a conditional sampler (--brdf, or --envmap MAP): DIR/brdf.nuld or DIR/envmap.nuld, report.json, loss.png, sets.png.
     Bake(bake::BakeArgs),
-    /// Time the optimizer: fast vs dense gradient per epoch, and full default runs.
+    /// Time the optimizer (fast vs dense gradient per epoch, full default runs); with --only, the baselines, the runtime samplers against the incumbents, the environment prior or training.
     Bench(bench::BenchArgs),
     /// Write the sampling kernel (WGSL sampler + compute entry point) in a shading language.
     Shader(shader::ShaderArgs),
