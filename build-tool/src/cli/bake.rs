@@ -59,9 +59,9 @@ pub struct BakeArgs {
     pub union_weight: Option<f64>,
     /// Training conditions in the pool, each with its caps measured once before
     /// training (more: a longer pool phase, a finer cover of the condition
-    /// range) [default: 256].
-    #[arg(long, allow_negative_numbers = true, value_parser = super::count)]
-    pub pool_conditions: Option<usize>,
+    /// range).
+    #[arg(long, default_value_t = TrainConfig::default().pool_conditions, allow_negative_numbers = true, value_parser = super::count)]
+    pub pool_conditions: usize,
     /// Initial Adam step.
     #[arg(long, default_value_t = TrainConfig::default().learning_rate)]
     pub lr: f64,
@@ -123,14 +123,14 @@ pub fn run(a: BakeArgs) -> Result<()> {
         a.lr.is_finite() && a.lr > 0.0,
         "--lr must be finite and > 0"
     );
-    let pool_conditions = a.pool_conditions.unwrap_or(defaults.train.pool_conditions);
     ensure!(
-        (1..=1 << 16).contains(&pool_conditions),
-        "--pool-conditions must be in 1..=65536, got {pool_conditions}"
+        (1..=1 << 16).contains(&a.pool_conditions),
+        "--pool-conditions must be in 1..=65536, got {}",
+        a.pool_conditions
     );
     let train = TrainConfig {
         n: a.n as u32,
-        pool_conditions,
+        pool_conditions: a.pool_conditions,
         hidden: a.hidden,
         silu: a.silu,
         instance_slots: instance_slots as u32,
