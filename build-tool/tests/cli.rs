@@ -471,7 +471,7 @@ fn conditional_blob(path: &Path) {
         lattice_generator: 5,
         warp: 0,
         instance_slots: 0,
-        reserved: 0,
+        offset_hash: 1,
     };
     let params = (0..info.shape().unwrap().param_len())
         .map(|j| f16_encode(((j * 37 % 101) as f32 - 50.0) / 60.0))

@@ -90,6 +90,7 @@ const NULD_INFO_ACTIVATION: u32 = 60u;
 const NULD_INFO_LATTICE_GENERATOR: u32 = 64u;
 const NULD_INFO_WARP: u32 = 68u;
 const NULD_INFO_INSTANCE_SLOTS: u32 = 72u;
+const NULD_INFO_OFFSET_HASH: u32 = 76u;
 
 // `nuld_core::network`: `INPUTS`, `MAX_WIDTH`, `MAX_HIDDEN_LAYERS`, `OUTPUTS`, and
 // the dot product's partial sums (`DOT_LANES`).
@@ -126,6 +127,10 @@ const NULD_TREE_UNIT_MIN: f32 = 9.9999996826552253889678874634872052240552875446
 // The salts of `randomization_shift` (core/src/conditional/mod.rs).
 const NULD_RANDOMIZE_SALT_A: u32 = 0x5eed0b1au;
 const NULD_RANDOMIZE_SALT_B: u32 = 0x68e31da4u;
+// `OFFSET_SALTS` and `OffsetHash::Salted` (core/src/network/features.rs).
+const NULD_OFFSET_SALT_X: u32 = 0x9e3779b9u;
+const NULD_OFFSET_SALT_Y: u32 = 0xbb67ae85u;
+const NULD_OFFSET_HASH_SALTED: u32 = 1u;
 
 // `f32` constants written as the runtime's `f32` values (a decimal literal would be
 // rounded from the exact value, which is not always the same `f32`).
@@ -412,8 +417,8 @@ fn nuld_direction(set_index: u32, i: u32) -> vec3<f32> {
 
 // Rust: `ConditionalInfo` (core/src/conditional/mod.rs), field for field at the same
 // byte offsets and of the same size (`target` is a reserved word in WGSL; `hidden`
-// is a vector and the zero `reserved` tail is left to the struct's padding, since
-// naga's GLSL front end does not read back arrays in struct constructors).
+// is a vector, since naga's GLSL front end does not read back arrays in struct
+// constructors).
 struct NuldConditionalInfo {
     n: u32,
     instances: u32,
@@ -428,6 +433,7 @@ struct NuldConditionalInfo {
     lattice_generator: u32,
     warp: u32,
     instance_slots: u32,
+    offset_hash: u32,
 }
 
 // Rust: `ConditionalSampler::info` (the info section read from the buffer).
@@ -452,6 +458,7 @@ fn nuld_info() -> NuldConditionalInfo {
     info.lattice_generator = nuld_u32(o + NULD_INFO_LATTICE_GENERATOR);
     info.warp = nuld_u32(o + NULD_INFO_WARP);
     info.instance_slots = nuld_u32(o + NULD_INFO_INSTANCE_SLOTS);
+    info.offset_hash = nuld_u32(o + NULD_INFO_OFFSET_HASH);
     return info;
 }
 
@@ -632,12 +639,27 @@ fn nuld_hash_u32(x0: u32) -> u32 {
     return x;
 }
 
-// Rust: `instance_offset`: the instance's pseudo-random point of `[0,1)^2`.
+// Rust: `instance_offset`: the instance's pseudo-random point of `[0,1)^2` under
+// the plain hash (the unbiased mode's, and blobs of offset hash 0).
 fn nuld_instance_offset(k: u32) -> vec2<f32> {
     let k2 = k * 2u;
     return vec2<f32>(
         f32(nuld_hash_u32(k2) >> 8u) * NULD_INSTANCE_UNIT,
         f32(nuld_hash_u32(k2 + 1u) >> 8u) * NULD_INSTANCE_UNIT,
+    );
+}
+
+// Rust: `Shape::instance_offset`: the offset of instance `k`, under the blob's
+// hash (`salted_instance_offset` for offset hash 1).
+fn nuld_network_offset(info: NuldConditionalInfo, k0: u32) -> vec2<f32> {
+    let k = nuld_instance_key(info, k0);
+    if info.offset_hash != NULD_OFFSET_HASH_SALTED {
+        return nuld_instance_offset(k);
+    }
+    let k2 = k * 2u;
+    return vec2<f32>(
+        f32(nuld_hash_u32(k2 ^ NULD_OFFSET_SALT_X) >> 8u) * NULD_INSTANCE_UNIT,
+        f32(nuld_hash_u32(k2 ^ NULD_OFFSET_SALT_Y) >> 8u) * NULD_INSTANCE_UNIT,
     );
 }
 
@@ -700,7 +722,7 @@ fn nuld_embedding_row(info: NuldConditionalInfo, k: u32, i: u32) -> u32 {
 // Rust: `input_features`: the network's 11 inputs (condition, instance offset,
 // shifted lattice point, lattice point), each mapped by `2x - 1`.
 fn nuld_input_features(info: NuldConditionalInfo, c: vec2<f32>, k: u32, i: u32) -> array<f32, 11> {
-    let z = nuld_instance_offset(nuld_instance_key(info, k));
+    let z = nuld_network_offset(info, k);
     let l = nuld_lattice_point(i, info.n, info.lattice_generator);
     // `shifted_lattice_point`: `frac(l + z)` with `frac(x) = x - floor(x)`.
     let lz = l + z;

@@ -454,7 +454,7 @@ fn doc_example_parts(
         lattice_generator: 1,
         warp: 0,
         instance_slots: 0,
-        reserved: 0,
+        offset_hash: 1,
     };
     // 2 x 1 embedding, 1 x 11 + 1 first layer, 2 x 1 + 2 output: 18 parameters.
     let params: [u16; 18] =

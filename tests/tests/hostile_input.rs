@@ -581,7 +581,7 @@ struct ConditionalFields {
     activation: u32,
     warp: u32,
     instance_slots: u32,
-    reserved: u32,
+    offset_hash: u32,
 }
 
 /// What a parsed conditional blob promises (core/FORMAT.md, "Validation"), checked
@@ -619,7 +619,7 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
         activation: word(60),
         warp: word(68),
         instance_slots: word(72),
-        reserved: word(76),
+        offset_hash: word(76),
     };
     let h = info.hidden;
     let layers = h.iter().take_while(|&&w| w > 0).count();
@@ -644,7 +644,8 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
         && ((info.target == 1
             && (info.warp == 0 || ((info.warp == 1 || info.warp == 3) && info.domain == 2)))
             || (info.target == 2 && info.warp == 2))
-        && info.reserved == 0)
+        // The plain (0) and the salted (1) instance-offset hash.
+        && info.offset_hash <= 1)
     {
         return false;
     }

@@ -53,7 +53,7 @@ use nuld_core::brdf_prior::{
 };
 use nuld_core::conditional::randomized_point;
 use nuld_core::conditional::PointWarp;
-use nuld_core::network::Activation;
+use nuld_core::network::{Activation, OffsetHash};
 use nuld_runtime::glam::{DVec2, DVec3, Vec2, Vec3};
 use nuld_runtime::shader::SAMPLE_STRIDE;
 use nuld_runtime::shader::{kernel_wgsl, KernelMode, KernelParams, KERNEL_ENTRY_POINT};
@@ -842,6 +842,12 @@ fn shader_random_samplers_of_every_shape_match_the_runtime() {
             // 64-bit-free `(i g) mod n`.
             parts.info.lattice_generator = g;
             let mut label = format!("random {s} {warp:?}");
+            if s == 1 && warp == PointWarp::EqualArea {
+                // A blob of the plain instance-offset hash (code 0, before the
+                // salted one): both branches of the shader's offsets.
+                parts.info.offset_hash = OffsetHash::Plain as u32;
+                label = format!("random {s} {warp:?}, plain offsets");
+            }
             if s == 2 && warp == PointWarp::BrdfMixture {
                 // An environment sampler on its tree: the sphere, the tree's warp.
                 parts = as_envmap(parts);

@@ -438,6 +438,22 @@ mod tests {
         for f in ["report.json", "loss.png", "sets.png", "checkpoint.bin"] {
             assert!(dir.join(f).is_file(), "{f}");
         }
+        // Instance 0's first point is served at every condition, metallic 0
+        // and 1, both modes: under the plain offset hash its offset is (0, y),
+        // the square's edge, which the prior sends below the horizon (pdf 0).
+        let cs = nuld_runtime::Blob::parse(bytes)
+            .unwrap()
+            .conditional()
+            .unwrap();
+        for (r, t, m) in (0..16).map(|j| (0.1 + 0.06 * j as f32, 5.6 * j as f32, (j % 2) as f32)) {
+            let c = glam::Vec2::new(r, t);
+            for s in [
+                cs.sample_metallic(c, m, 0, 0),
+                cs.network().sample_metallic(c, m, 0, 0),
+            ] {
+                assert!(s.pdf > 0.0 && s.weight > 0.0, "({r}, {t}, {m}): {s:?}");
+            }
+        }
         // Resuming a finished run trains nothing and writes the same blob.
         let again = bake(
             &BakeConfig {

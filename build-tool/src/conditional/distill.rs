@@ -60,7 +60,7 @@ pub fn info(
         lattice_generator: shape.lattice_generator(),
         warp: PointWarp::of(kind, shape) as u32,
         instance_slots: shape.instance_slots(),
-        reserved: 0,
+        offset_hash: shape.offset_hash() as u32,
     }
 }
 

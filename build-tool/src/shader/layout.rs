@@ -17,7 +17,8 @@ use nuld_core::conditional::{ConditionalInfo, PointWarp, RANDOMIZE_SALTS};
 use nuld_core::envmap_tree::{node_count, TreeInfo, TOP_FLOOR, TOP_LEVELS};
 use nuld_core::marginal2d::MAX_BLEND;
 use nuld_core::network::{
-    Activation, DOT_LANES, INPUTS, LATTICE_LOGIT_EPS, MAX_HIDDEN_LAYERS, MAX_WIDTH, OUTPUTS,
+    Activation, OffsetHash, DOT_LANES, INPUTS, LATTICE_LOGIT_EPS, MAX_HIDDEN_LAYERS, MAX_WIDTH,
+    OFFSET_SALTS, OUTPUTS,
 };
 use nuld_core::quadtree::MAX_LEVELS;
 use nuld_core::quantize::{f16_decode_finite, UNORM16_CELLS};
@@ -46,7 +47,7 @@ macro_rules! at {
 /// Each [`ConditionalInfo`] field: the WGSL constant `nuld_info` reads it at, the
 /// `NuldConditionalInfo` member it lands in, and its Rust offset (the two WGSL
 /// names of one offset, listed once).
-fn info_fields() -> [(&'static str, &'static str, u64); 13] {
+fn info_fields() -> [(&'static str, &'static str, u64); 14] {
     [
         (
             "NULD_INFO_N",
@@ -113,6 +114,11 @@ fn info_fields() -> [(&'static str, &'static str, u64); 13] {
             "NuldConditionalInfo.instance_slots",
             at!(ConditionalInfo, instance_slots),
         ),
+        (
+            "NULD_INFO_OFFSET_HASH",
+            "NuldConditionalInfo.offset_hash",
+            at!(ConditionalInfo, offset_hash),
+        ),
     ]
 }
 
@@ -176,6 +182,9 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_TREE_UNIT_MIN", f(1e-20f64 as f32)),
         ("NULD_RANDOMIZE_SALT_A", RANDOMIZE_SALTS[0] as u64),
         ("NULD_RANDOMIZE_SALT_B", RANDOMIZE_SALTS[1] as u64),
+        ("NULD_OFFSET_SALT_X", OFFSET_SALTS[0] as u64),
+        ("NULD_OFFSET_SALT_Y", OFFSET_SALTS[1] as u64),
+        ("NULD_OFFSET_HASH_SALTED", OffsetHash::Salted as u64),
         ("NULD_DOMAIN_SQUARE", Domain::Square as u64),
         ("NULD_DOMAIN_SPHERE", Domain::Sphere as u64),
         ("NULD_DOMAIN_HEMISPHERE", Domain::Hemisphere as u64),

@@ -31,7 +31,7 @@ use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
 use nuld_core::brdf::{gltf_metallic, view_direction};
 use nuld_core::conditional::{ConditionalTarget, PointWarp};
-use nuld_core::network::{instance_offset, shifted_lattice_point, Shape};
+use nuld_core::network::{shifted_lattice_point, Shape};
 use nuld_core::sphere::{hemisphere_to_square, sphere_to_square, square_to_sphere};
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -239,7 +239,7 @@ fn warp_targets(target: &BrdfTarget, shape: &Shape) -> Vec<DVec2> {
     let residual = shape.lattice_residual();
     (0..PRETRAIN_INSTANCES)
         .flat_map(|k| {
-            let z = instance_offset::<f64>(shape.instance_key(k));
+            let z = shape.instance_offset::<f64>(k);
             (0..shape_n).map(move |i| {
                 let u = shifted_lattice_point(i, shape_n, g, z);
                 let u = DVec2::new(u[0], u[1]);
@@ -427,7 +427,7 @@ fn envmap_condition(
     let share = irradiance / map.integral();
     let warp_targets = (0..PRETRAIN_INSTANCES)
         .flat_map(|k| {
-            let z = instance_offset::<f64>(shape.instance_key(k));
+            let z = shape.instance_offset::<f64>(k);
             let g = shape.lattice_generator();
             let lit = &lit;
             (0..shape.n()).map(move |i| {

@@ -400,8 +400,9 @@ pub enum ConditionalError {
     /// The conditional info's instance slots `M` make the network's embedding
     /// (`M n h1` numbers) larger than a `u32` counts.
     InstanceSlots(u32),
-    /// The reserved field of the conditional info is not zero.
-    Reserved(u32),
+    /// The conditional info's offset hash is not a
+    /// [`crate::network::OffsetHash`] code.
+    UnknownOffsetHash(u32),
     /// The conditional info's warp is not a
     /// [`crate::conditional::PointWarp`] code, or names a warp the target has none of.
     UnknownPointWarp(u32),
@@ -540,9 +541,10 @@ impl core::fmt::Display for ConditionalError {
                 f,
                 "blob network instance slots {m} make an embedding larger than 2^32 numbers"
             ),
-            Self::Reserved(r) => {
-                write!(f, "blob conditional info reserved field {r} is not zero")
-            }
+            Self::UnknownOffsetHash(h) => write!(
+                f,
+                "blob conditional instance-offset hash {h} is unknown (a newer tool's blob: update the runtime)"
+            ),
             Self::UnknownPointWarp(w) => write!(f, "blob conditional point warp {w} is unknown"),
             Self::ParamElementSize(s) => write!(
                 f,

@@ -21,7 +21,7 @@
 use crate::blob::{SectionSpec, SectionTag};
 use crate::domain::Domain;
 use crate::envmap_tree::EnvmapTree;
-use crate::network::{Activation, Shape, MAX_HIDDEN_LAYERS};
+use crate::network::{Activation, OffsetHash, Shape, MAX_HIDDEN_LAYERS};
 use crate::real::Real;
 
 mod target;
@@ -183,8 +183,9 @@ pub struct ConditionalInfo {
     /// offset per instance and one embedding row per index; `M >= 1`, instance `k`
     /// is slot `k mod M`, with its own offset and embedding rows.
     pub instance_slots: u32,
-    /// Reserved, zero.
-    pub reserved: u32,
+    /// An [`OffsetHash`](OffsetHash) code: how instance numbers
+    /// hash to offsets (0: plain, blobs baked before the salted hash; 1: salted).
+    pub offset_hash: u32,
 }
 
 /// Size of [`ConditionalInfo`] in bytes.
@@ -342,8 +343,9 @@ impl ConditionalInfo {
         }
         let act = Activation::from_code(self.activation)?;
         let residual = PointWarp::from_code(self.warp)?.lattice_residual();
+        let offsets = OffsetHash::from_code(self.offset_hash)?;
         Shape::new(self.n, &self.hidden[..layers], act, self.lattice_generator)
-            .map(|s| s.with_lattice_residual(residual))
+            .map(|s| s.with_lattice_residual(residual).with_offset_hash(offsets))
     }
 
     /// The info's [`PointWarp`], if its code is known.
@@ -562,7 +564,7 @@ mod tests {
             lattice_generator: 3,
             warp: 0,
             instance_slots: 0,
-            reserved: 0,
+            offset_hash: 1,
         }
     }
 

@@ -52,14 +52,77 @@ pub fn hash_u32(mut x: u32) -> u32 {
     x
 }
 
-/// The pseudo-random offset `z_k` in `[0,1)^2` of instance `k`: the top 24 bits of
-/// `hash_u32(2k)` and `hash_u32(2k + 1)` (wrapping) times `2^-24`, exact in `f32`
-/// and `f64`. Every `u32` is an instance.
+/// The pseudo-random offset `z_k` in `[0,1)^2` of instance `k` under the plain
+/// hash ([`OffsetHash::Plain`]): the top 24 bits of `hash_u32(2k)` and
+/// `hash_u32(2k + 1)` (wrapping) times `2^-24`, exact in `f32` and `f64`. Every
+/// `u32` is an instance. `hash_u32(0) = 0`, so `z_0 = (0, y)`: what the unbiased
+/// mode's shift ([`crate::conditional::randomized_point`]) starts from, and the
+/// offsets of blobs baked before [`salted_instance_offset`].
 #[inline]
 pub fn instance_offset<T: Real>(k: u32) -> [T; 2] {
-    let unit = |h: u32| T::of((h >> 8) as f64 * (1.0 / 16_777_216.0));
     let k2 = k.wrapping_mul(2);
-    [unit(hash_u32(k2)), unit(hash_u32(k2.wrapping_add(1)))]
+    [
+        offset_unit(hash_u32(k2)),
+        offset_unit(hash_u32(k2.wrapping_add(1))),
+    ]
+}
+
+/// The salts of [`salted_instance_offset`]'s two hashes, both odd (the golden
+/// ratio's and `sqrt(3)`'s fraction bits), apart from the unbiased mode's.
+pub const OFFSET_SALTS: [u32; 2] = [0x9e37_79b9, 0xbb67_ae85];
+
+/// The pseudo-random offset `z_k` in `[0,1)^2` of instance `k` under the salted
+/// hash ([`OffsetHash::Salted`]): the top 24 bits of `hash_u32(2k ^ S_x)` and
+/// `hash_u32(2k ^ S_y)` ([`OFFSET_SALTS`]) times `2^-24`, exact in `f32` and `f64`.
+///
+/// An odd salt makes each hash's input odd, never 0, and `hash_u32` is a
+/// bijection with `hash_u32(0) = 0`, so no hash here is 0. Under the plain hash
+/// instance 0's offset is `(0, y)`: its point 0 sits on the square's edge, which
+/// the hemisphere's equal-area map sends to the horizon, and the BRDF sampler
+/// returned a sample with pdf 0 there at most conditions.
+#[inline]
+pub fn salted_instance_offset<T: Real>(k: u32) -> [T; 2] {
+    let k2 = k.wrapping_mul(2);
+    [
+        offset_unit(hash_u32(k2 ^ OFFSET_SALTS[0])),
+        offset_unit(hash_u32(k2 ^ OFFSET_SALTS[1])),
+    ]
+}
+
+/// The top 24 bits of `h` times `2^-24`, in `[0, 1)`, exact in `f32`.
+#[inline]
+fn offset_unit<T: Real>(h: u32) -> T {
+    T::of((h >> 8) as f64 * (1.0 / 16_777_216.0))
+}
+
+/// How instance numbers hash to offsets: the code of
+/// [`crate::conditional::ConditionalInfo::offset_hash`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OffsetHash {
+    /// [`instance_offset`] (code 0): blobs baked before the salted hash.
+    Plain = 0,
+    /// [`salted_instance_offset`] (code 1): what the tool bakes.
+    Salted = 1,
+}
+
+impl OffsetHash {
+    /// The hash of `code`, or `None` for an unknown code.
+    pub fn from_code(code: u32) -> Option<Self> {
+        match code {
+            0 => Some(Self::Plain),
+            1 => Some(Self::Salted),
+            _ => None,
+        }
+    }
+
+    /// The offset of instance `k` under this hash.
+    #[inline]
+    pub fn offset<T: Real>(self, k: u32) -> [T; 2] {
+        match self {
+            Self::Plain => instance_offset(k),
+            Self::Salted => salted_instance_offset(k),
+        }
+    }
 }
 
 /// Point `i mod n` of the rank-1 lattice with generator `g`:
@@ -97,11 +160,11 @@ pub fn lattice_features<T: Real>(p: [T; 2], l: [T; 2]) -> [T; 4] {
 
 /// The network input of index `i`, instance `k`, normalized condition `c` (in
 /// `[0,1]^2`): `[condition_features(c), 2 z - 1, lattice_features(p, l_i)]` with
-/// `z` the offset of [`Shape::instance_key`]`(k)` (`z_k` without slots), `p` the
+/// `z` the offset [`Shape::instance_offset`]`(k)` (`z_k` without slots), `p` the
 /// [`shifted_lattice_point`] and `l_i` the [`lattice_point`].
 #[inline]
 pub fn input_features<T: Real>(shape: &Shape, c: [T; 2], k: u32, i: u32) -> [T; INPUTS] {
-    let z = instance_offset::<T>(shape.instance_key(k));
+    let z = shape.instance_offset::<T>(k);
     let (n, g) = (shape.n, shape.lattice_generator);
     let p = shifted_lattice_point(i, n, g, z);
     let cf = condition_features(c);

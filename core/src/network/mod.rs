@@ -9,7 +9,8 @@
 //!
 //! * `features` ([`input_features`], [`INPUTS`] numbers): five polynomial features of
 //!   the condition normalized to `[0,1]^2` ([`condition_features`]), the instance's
-//!   pseudo-random offset `z_k` ([`instance_offset`]), and two points of the unit
+//!   pseudo-random offset `z_k` ([`Shape::instance_offset`]: [`salted_instance_offset`],
+//!   or [`instance_offset`] for older blobs), and two points of the unit
 //!   square ([`lattice_features`]): the rank-1 lattice point
 //!   `l_i = (i/N, frac(i g / N))` shifted by `z_k` on the torus, `p = frac(l_i + z_k)`,
 //!   and `l_i` itself. The shifted lattice makes every instance a different set by
@@ -63,7 +64,8 @@ mod tests;
 
 pub use features::{
     condition_features, hash_u32, input_features, instance_offset, lattice_features, lattice_logit,
-    lattice_point, shifted_lattice_point, LATTICE_LOGIT_EPS,
+    lattice_point, salted_instance_offset, shifted_lattice_point, OffsetHash, LATTICE_LOGIT_EPS,
+    OFFSET_SALTS,
 };
 pub use forward::{F16Params, Network, Parameters, Trace};
 pub use kernels::{dot, dot_block, DOT_LANES, UNIT_BLOCK};

@@ -1,7 +1,8 @@
 //! The network's architecture: widths, instance slots, the flat parameter layout
 //! ([`Shape::param_len`], [`Shape::layers`]).
 
-use super::{Activation, INPUTS, MAX_HIDDEN_LAYERS, MAX_WIDTH, OUTPUTS};
+use super::{Activation, OffsetHash, INPUTS, MAX_HIDDEN_LAYERS, MAX_WIDTH, OUTPUTS};
+use crate::real::Real;
 
 /// The architecture of a network: points per set, hidden widths, activation, and the
 /// rank-1 lattice generator of its input.
@@ -14,6 +15,7 @@ pub struct Shape {
     pub(crate) lattice_generator: u32,
     pub(crate) lattice_residual: bool,
     pub(crate) instance_slots: u32,
+    pub(crate) offset_hash: OffsetHash,
 }
 
 impl Shape {
@@ -45,6 +47,7 @@ impl Shape {
             lattice_generator,
             lattice_residual: false,
             instance_slots: 0,
+            offset_hash: OffsetHash::Salted,
         })
     }
 
@@ -53,7 +56,7 @@ impl Shape {
     /// `slots n` or the embedding `slots n h1` does not fit in a `u32`.
     ///
     /// With `slots = M >= 1`, instance `k` is slot `s = k mod M`: its offset is
-    /// `z_s` ([`instance_offset`](super::instance_offset) of `s`) and its first hidden layer adds the row
+    /// `z_s` ([`Shape::instance_offset`]) and its first hidden layer adds the row
     /// `E[s n + i]`, so each slot is a set the network can place point by point
     /// (the embedding gives every point of every slot its own learned bias), and
     /// instances wrap modulo `M` as a point table's do.
@@ -82,6 +85,27 @@ impl Shape {
             0 => k,
             m => k % m,
         }
+    }
+
+    /// The shape whose instances hash to offsets by `offset_hash`
+    /// ([`OffsetHash::Salted`] is what [`Shape::new`] makes).
+    pub fn with_offset_hash(self, offset_hash: OffsetHash) -> Self {
+        Self {
+            offset_hash,
+            ..self
+        }
+    }
+
+    /// How instance numbers hash to offsets.
+    pub fn offset_hash(&self) -> OffsetHash {
+        self.offset_hash
+    }
+
+    /// The offset `z` of instance `k`: the [`OffsetHash::offset`] of
+    /// [`Shape::instance_key`]`(k)`.
+    #[inline]
+    pub fn instance_offset<T: Real>(&self, k: u32) -> [T; 2] {
+        self.offset_hash.offset(self.instance_key(k))
     }
 
     /// The row of `E` that index `i` of instance `k` adds: `i mod n` without

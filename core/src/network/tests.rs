@@ -95,7 +95,7 @@ fn lattice_residual_adds_the_logit_of_the_shifted_lattice_point() {
         let s = shape(act).with_lattice_residual(true);
         let (c, k, i) = ([0.3, 0.7], 5, 6); // i wraps to row 2 of E
         let x = input_features::<f64>(&s, c, k, i);
-        let z = instance_offset::<f64>(k);
+        let z = salted_offset(k);
         let p = shifted_lattice_point(i, s.n(), s.lattice_generator(), z);
         // Away from the clamp at LATTICE_LOGIT_EPS, where the logit is exact.
         assert!(p.iter().all(|&q| (0.01..0.99).contains(&q)), "{p:?}");
@@ -187,6 +187,53 @@ fn instance_offsets_are_exact_in_both_precisions_and_distinct() {
     assert_eq!(hash_u32(0x1234_5678), 0xf5e7_1c96);
 }
 
+/// The salted offset of instance `k` written out from its definition: the top
+/// 24 bits of `hash_u32(2k ^ 0x9e3779b9)` and `hash_u32(2k ^ 0xbb67ae85)`.
+fn salted_offset(k: u32) -> [f64; 2] {
+    let unit = |salt: u32| (hash_u32(k.wrapping_mul(2) ^ salt) >> 8) as f64 / 16_777_216.0;
+    [unit(0x9e37_79b9), unit(0xbb67_ae85)]
+}
+
+/// Under the plain hash instance 0's offset has x = 0 (its point 0 on the
+/// square's edge); the salted hash feeds `hash_u32` odd numbers only, and
+/// `hash_u32` maps nothing but 0 to 0 (undoing its steps on 0 gives 0), so no
+/// salted offset has a zero coordinate. New shapes and blobs of code 1 use
+/// it; code 0 reads as plain, other codes as nothing.
+#[test]
+fn salted_offsets_never_sit_on_the_edge_and_old_blobs_keep_the_plain_hash() {
+    assert_eq!(instance_offset::<f64>(0)[0], 0.0);
+    assert!(OFFSET_SALTS.iter().all(|s| s & 1 == 1));
+    for k in (0..4096u32).chain([u32::MAX / 2, u32::MAX - 1, u32::MAX]) {
+        let a = salted_instance_offset::<f32>(k);
+        let b = salted_instance_offset::<f64>(k);
+        assert_eq!(b, salted_offset(k));
+        assert_eq!(a.map(f64::from), b);
+        assert!(b.iter().all(|&z| z > 0.0 && z < 1.0), "{k}: {b:?}");
+    }
+    // lowbias32 undone step by step (xorshift and odd-multiplier inverses).
+    let unhash = |mut x: u32| {
+        let unshift = |x: u32, s: u32| (0..32 / s + 1).fold(x, |y, _| x ^ (y >> s));
+        x = unshift(x, 16);
+        x = x.wrapping_mul(0x43021123); // 0x846ca68b^-1 mod 2^32
+        x = unshift(x, 15);
+        x = x.wrapping_mul(0x1d69e2a5); // 0x7feb352d^-1 mod 2^32
+        unshift(x, 16)
+    };
+    for x in [0u32, 1, 0x1234_5678, u32::MAX] {
+        assert_eq!(unhash(hash_u32(x)), x);
+    }
+    assert_eq!(unhash(0), 0);
+    let shape = Shape::new(8, &[4], Activation::Relu, 3).unwrap();
+    assert_eq!(shape.offset_hash(), OffsetHash::Salted);
+    let plain = shape.with_offset_hash(OffsetHash::Plain);
+    assert_eq!(plain.instance_offset::<f64>(9), instance_offset::<f64>(9));
+    let slots = shape.with_instance_slots(4).unwrap();
+    assert_eq!(slots.instance_offset::<f64>(9), salted_offset(1));
+    assert_eq!(OffsetHash::from_code(0), Some(OffsetHash::Plain));
+    assert_eq!(OffsetHash::from_code(1), Some(OffsetHash::Salted));
+    assert_eq!(OffsetHash::from_code(2), None);
+}
+
 #[test]
 fn lattice_is_a_permutation_and_shift_wraps() {
     let (n, g) = (8u32, 3u32);
@@ -206,7 +253,7 @@ fn lattice_is_a_permutation_and_shift_wraps() {
 fn input_features_hold_the_shifted_and_the_plain_lattice_point() {
     let shape = Shape::new(8, &[4], Activation::Relu, 3).unwrap();
     let f = input_features::<f64>(&shape, [0.5, 0.25], 5, 11);
-    let z = instance_offset::<f64>(5);
+    let z = salted_offset(5);
     // Index 11 wraps to 3: l = (3/8, 1/8).
     let p = [(0.375 + z[0]) % 1.0, (0.125 + z[1]) % 1.0];
     let want = [2.0 * p[0] - 1.0, 2.0 * p[1] - 1.0, -0.25, -0.75];

@@ -57,7 +57,7 @@ fn parts() -> Parts {
         lattice_generator: 2,
         warp: 0,
         instance_slots: 0,
-        reserved: 0,
+        offset_hash: 1,
     };
     let len = info.shape().unwrap().param_len();
     let params = (0..len as u32)
@@ -635,7 +635,10 @@ fn each_validation_failure_has_its_error() {
             |p| p.info.hidden = [129, 3, 0],
             ConditionalError::NetworkWidths([129, 3, 0]),
         ),
-        (|p| p.info.reserved = 1, ConditionalError::Reserved(1)),
+        (
+            |p| p.info.offset_hash = 2,
+            ConditionalError::UnknownOffsetHash(2),
+        ),
         // 5 n x 4 h1 x M embedding numbers reach 2^32 at M = 2^32 / 20.
         (
             |p| p.info.instance_slots = u32::MAX / 16,

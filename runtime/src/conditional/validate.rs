@@ -10,7 +10,7 @@ use nuld_core::envmap_tree::{
     node_count, top_len, EnvmapTree, NodeRecord, TreeInfo, MAX_TREE_LEVELS, TOP_LEVELS,
 };
 use nuld_core::marginal2d::Marginal2DError;
-use nuld_core::network::Activation;
+use nuld_core::network::{Activation, OffsetHash};
 use nuld_core::quadtree::QuadtreeError;
 use nuld_core::quantize::f16_is_finite;
 
@@ -105,14 +105,14 @@ impl<'a> ConditionalSampler<'a> {
         if Activation::from_code(info.activation).is_none() {
             return fail(ConditionalError::UnknownActivation(info.activation));
         }
+        if OffsetHash::from_code(info.offset_hash).is_none() {
+            return fail(ConditionalError::UnknownOffsetHash(info.offset_hash));
+        }
         let shape = info
             .shape_without_slots()
             .ok_or(ConditionalError::NetworkWidths(info.hidden))?
             .with_instance_slots(info.instance_slots)
             .ok_or(ConditionalError::InstanceSlots(info.instance_slots))?;
-        if info.reserved != 0 {
-            return fail(ConditionalError::Reserved(info.reserved));
-        }
 
         let params: &[u16] = typed_section(
             layout,
