@@ -1,7 +1,7 @@
 //! `build-tool bake --brdf` / `bake --envmap MAP`: train a conditional sampler and
 //! write its blob, report and pictures (library: [`crate::conditional::bake`]).
 
-use crate::conditional::bake::{bake, BakeConfig};
+use crate::conditional::bake::{bake, BakeConfig, ENVMAP_POOL_CONDITIONS};
 use crate::train::{TrainConfig, TrainTarget};
 use anyhow::{ensure, Result};
 use clap::Args;
@@ -60,8 +60,9 @@ pub struct BakeArgs {
     /// Training conditions in the pool, each with its caps measured once before
     /// training (more: a longer pool phase, a finer cover of the condition
     /// range).
-    #[arg(long, default_value_t = TrainConfig::default().pool_conditions, allow_negative_numbers = true, value_parser = super::count)]
-    pub pool_conditions: usize,
+    #[arg(long, allow_negative_numbers = true, value_parser = super::count,
+        help = pool_help())]
+    pub pool_conditions: Option<usize>,
     /// Initial Adam step.
     #[arg(long, default_value_t = TrainConfig::default().learning_rate)]
     pub lr: f64,
@@ -71,6 +72,17 @@ pub struct BakeArgs {
     /// Output directory.
     #[arg(long)]
     pub out: PathBuf,
+}
+
+/// `--pool-conditions`' help with its two defaults, the BRDF sampler's and the
+/// environment sampler's.
+fn pool_help() -> String {
+    format!(
+        "Training conditions in the pool, each with its caps measured once before training \
+         (more: a longer pool phase, a finer cover of the condition range) [default: {}; {} with --envmap]",
+        TrainConfig::default().pool_conditions,
+        ENVMAP_POOL_CONDITIONS
+    )
 }
 
 /// `help` followed by `[default: a,b,...]`: clap shows a list's default joined by
@@ -123,14 +135,14 @@ pub fn run(a: BakeArgs) -> Result<()> {
         a.lr.is_finite() && a.lr > 0.0,
         "--lr must be finite and > 0"
     );
+    let pool_conditions = a.pool_conditions.unwrap_or(defaults.train.pool_conditions);
     ensure!(
-        (1..=1 << 16).contains(&a.pool_conditions),
-        "--pool-conditions must be in 1..=65536, got {}",
-        a.pool_conditions
+        (1..=1 << 16).contains(&pool_conditions),
+        "--pool-conditions must be in 1..=65536, got {pool_conditions}"
     );
     let train = TrainConfig {
         n: a.n as u32,
-        pool_conditions: a.pool_conditions,
+        pool_conditions,
         hidden: a.hidden,
         silu: a.silu,
         instance_slots: instance_slots as u32,

@@ -109,8 +109,8 @@ pub const ENVMAP_WEIGHT_GRID: [u32; 2] = [64, 64];
 
 impl BakeConfig {
     /// The defaults of an environment sampler of `target`: [`ENVMAP_GRID`],
-    /// [`ENVMAP_WEIGHT_GRID`], [`ENVMAP_STEPS`], otherwise [`BakeConfig::default`]
-    /// through [`Self::with_envmap`].
+    /// [`ENVMAP_WEIGHT_GRID`], [`ENVMAP_STEPS`], [`ENVMAP_POOL_CONDITIONS`],
+    /// otherwise [`BakeConfig::default`] through [`Self::with_envmap`].
     pub fn envmap(target: TrainTarget) -> Self {
         let mut config = Self {
             grid: ENVMAP_GRID,
@@ -119,6 +119,7 @@ impl BakeConfig {
         }
         .with_envmap(target);
         config.train.steps = ENVMAP_STEPS;
+        config.train.pool_conditions = ENVMAP_POOL_CONDITIONS;
         config
     }
 
@@ -159,6 +160,12 @@ pub const ENVMAP_UNION_WEIGHT: f64 = 0.5;
 /// steps scored as 12 000 did (courtyard N = 64: 0.755 and 0.759 of the
 /// baseline), in a quarter of the time.
 pub const ENVMAP_STEPS: usize = 3000;
+
+/// Training conditions in an environment sampler's pool: the normals' pool
+/// holds the map's caps per normal, and its bake time is a goal (`bake
+/// --envmap` N = 64 within 90 s); the BRDF sampler's larger default
+/// ([`TrainConfig::default`]) was measured on the BRDF sampler only.
+pub const ENVMAP_POOL_CONDITIONS: usize = 256;
 
 /// The checkpoint's path in `dir`.
 pub fn checkpoint_path(dir: &Path) -> PathBuf {

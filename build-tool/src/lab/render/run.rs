@@ -22,7 +22,9 @@ use super::reference::Reference;
 use super::sampler::Technique;
 use super::scene::Scene;
 use super::summary::{csv, errors, markdown, Row};
-use crate::conditional::bake::{BakeConfig, ENVMAP_GRID, ENVMAP_STEPS, ENVMAP_WEIGHT_GRID};
+use crate::conditional::bake::{
+    BakeConfig, ENVMAP_GRID, ENVMAP_POOL_CONDITIONS, ENVMAP_STEPS, ENVMAP_WEIGHT_GRID,
+};
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render_composite, Composite, Tile};
 use crate::progress::Progress;
@@ -84,6 +86,7 @@ impl RenderConfig {
                 weight_grid: ENVMAP_WEIGHT_GRID,
                 train: TrainConfig {
                     steps: ENVMAP_STEPS,
+                    pool_conditions: ENVMAP_POOL_CONDITIONS,
                     ..TrainConfig::default()
                 },
                 ..BakeConfig::default()
