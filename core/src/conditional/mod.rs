@@ -183,7 +183,7 @@ pub struct ConditionalInfo {
     /// offset per instance and one embedding row per index; `M >= 1`, instance `k`
     /// is slot `k mod M`, with its own offset and embedding rows.
     pub instance_slots: u32,
-    /// An [`OffsetHash`](OffsetHash) code: how instance numbers
+    /// An [`OffsetHash`] code: how instance numbers
     /// hash to offsets (0: plain, blobs baked before the salted hash; 1: salted).
     pub offset_hash: u32,
 }
