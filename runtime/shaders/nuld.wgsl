@@ -649,18 +649,24 @@ fn nuld_instance_offset(k: u32) -> vec2<f32> {
     );
 }
 
-// Rust: `Shape::instance_offset`: the offset of instance `k`, under the blob's
-// hash (`salted_instance_offset` for offset hash 1).
-fn nuld_network_offset(info: NuldConditionalInfo, k0: u32) -> vec2<f32> {
-    let k = nuld_instance_key(info, k0);
-    if info.offset_hash != NULD_OFFSET_HASH_SALTED {
-        return nuld_instance_offset(k);
-    }
+// Rust: `salted_instance_offset`: the instance's offset under the salted hash
+// (blobs of offset hash 1).
+fn nuld_salted_instance_offset(k: u32) -> vec2<f32> {
     let k2 = k * 2u;
     return vec2<f32>(
         f32(nuld_hash_u32(k2 ^ NULD_OFFSET_SALT_X) >> 8u) * NULD_INSTANCE_UNIT,
         f32(nuld_hash_u32(k2 ^ NULD_OFFSET_SALT_Y) >> 8u) * NULD_INSTANCE_UNIT,
     );
+}
+
+// Rust: `Shape::instance_offset`: the offset of instance `k` (its slot's) under
+// the blob's hash.
+fn nuld_network_offset(info: NuldConditionalInfo, k: u32) -> vec2<f32> {
+    let key = nuld_instance_key(info, k);
+    if info.offset_hash == NULD_OFFSET_HASH_SALTED {
+        return nuld_salted_instance_offset(key);
+    }
+    return nuld_instance_offset(key);
 }
 
 // `(a b) mod n` for `a < n` as if in 64 bits (WGSL has no u64): the product

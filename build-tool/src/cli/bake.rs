@@ -57,9 +57,8 @@ pub struct BakeArgs {
     /// Weight of the union-of-instances term [default: 0.5].
     #[arg(long)]
     pub union_weight: Option<f64>,
-    /// Training conditions in the pool, each with its caps measured once before
-    /// training (more: a longer pool phase, a finer cover of the condition
-    /// range).
+    /// Training conditions in the pool (`None`: the target's default,
+    /// [`TrainConfig::default`]'s for a BRDF, [`ENVMAP_POOL_CONDITIONS`] for a map).
     #[arg(long, allow_negative_numbers = true, value_parser = super::count,
         help = pool_help())]
     pub pool_conditions: Option<usize>,

@@ -108,19 +108,27 @@ pub const ENVMAP_GRID: [u32; 2] = [13, 13];
 pub const ENVMAP_WEIGHT_GRID: [u32; 2] = [64, 64];
 
 impl BakeConfig {
-    /// The defaults of an environment sampler of `target`: [`ENVMAP_GRID`],
-    /// [`ENVMAP_WEIGHT_GRID`], [`ENVMAP_STEPS`], [`ENVMAP_POOL_CONDITIONS`],
-    /// otherwise [`BakeConfig::default`] through [`Self::with_envmap`].
+    /// The defaults of an environment sampler of `target`:
+    /// [`Self::envmap_sizes`] through [`Self::with_envmap`].
     pub fn envmap(target: TrainTarget) -> Self {
-        let mut config = Self {
+        Self::envmap_sizes().with_envmap(target)
+    }
+
+    /// An environment sampler's sizes before its map is known: [`ENVMAP_GRID`],
+    /// [`ENVMAP_WEIGHT_GRID`], [`ENVMAP_STEPS`], [`ENVMAP_POOL_CONDITIONS`],
+    /// otherwise [`BakeConfig::default`] (what `render` bakes for each map it
+    /// is given, through [`Self::with_envmap`]).
+    pub fn envmap_sizes() -> Self {
+        Self {
             grid: ENVMAP_GRID,
             weight_grid: ENVMAP_WEIGHT_GRID,
+            train: TrainConfig {
+                steps: ENVMAP_STEPS,
+                pool_conditions: ENVMAP_POOL_CONDITIONS,
+                ..TrainConfig::default()
+            },
             ..Self::default()
         }
-        .with_envmap(target);
-        config.train.steps = ENVMAP_STEPS;
-        config.train.pool_conditions = ENVMAP_POOL_CONDITIONS;
-        config
     }
 
     /// These settings for an environment sampler of `target`: the network refines

@@ -21,7 +21,7 @@
 use crate::blob::{SectionSpec, SectionTag};
 use crate::domain::Domain;
 use crate::envmap_tree::EnvmapTree;
-use crate::network::{Activation, OffsetHash, Shape, MAX_HIDDEN_LAYERS};
+use crate::network::{offset_unit, Activation, OffsetHash, Shape, MAX_HIDDEN_LAYERS};
 use crate::real::Real;
 
 mod target;
@@ -183,8 +183,8 @@ pub struct ConditionalInfo {
     /// offset per instance and one embedding row per index; `M >= 1`, instance `k`
     /// is slot `k mod M`, with its own offset and embedding rows.
     pub instance_slots: u32,
-    /// An [`OffsetHash`] code: how instance numbers
-    /// hash to offsets (0: plain, blobs baked before the salted hash; 1: salted).
+    /// An [`OffsetHash`] code: how instance numbers hash to offsets (0: plain,
+    /// blobs baked before the salted hash; 1: salted).
     pub offset_hash: u32,
 }
 
@@ -454,8 +454,7 @@ pub const RANDOMIZE_SALTS: [u32; 2] = [0x5eed_0b1a, 0x68e3_1da4];
 pub fn randomization_shift(seed: u32) -> [f32; 2] {
     let a = crate::network::hash_u32(seed ^ RANDOMIZE_SALTS[0]);
     let b = crate::network::hash_u32(a ^ RANDOMIZE_SALTS[1]);
-    let unit = |h: u32| (h >> 8) as f32 * (1.0 / 16_777_216.0);
-    [unit(a), unit(b)]
+    [offset_unit(a), offset_unit(b)]
 }
 
 /// The unbiased mode's primary point of index `i` (mod `n`) for instance

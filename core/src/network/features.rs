@@ -89,9 +89,11 @@ pub fn salted_instance_offset<T: Real>(k: u32) -> [T; 2] {
     ]
 }
 
-/// The top 24 bits of `h` times `2^-24`, in `[0, 1)`, exact in `f32`.
+/// The top 24 bits of `h` times `2^-24`, in `[0, 1)`, exact in `f32`: how a
+/// hash becomes a coordinate of an instance offset or of the unbiased mode's
+/// shift ([`crate::conditional::randomization_shift`]).
 #[inline]
-fn offset_unit<T: Real>(h: u32) -> T {
+pub fn offset_unit<T: Real>(h: u32) -> T {
     T::of((h >> 8) as f64 * (1.0 / 16_777_216.0))
 }
 

@@ -64,8 +64,8 @@ mod tests;
 
 pub use features::{
     condition_features, hash_u32, input_features, instance_offset, lattice_features, lattice_logit,
-    lattice_point, salted_instance_offset, shifted_lattice_point, OffsetHash, LATTICE_LOGIT_EPS,
-    OFFSET_SALTS,
+    lattice_point, offset_unit, salted_instance_offset, shifted_lattice_point, OffsetHash,
+    LATTICE_LOGIT_EPS, OFFSET_SALTS,
 };
 pub use forward::{F16Params, Network, Parameters, Trace};
 pub use kernels::{dot, dot_block, DOT_LANES, UNIT_BLOCK};

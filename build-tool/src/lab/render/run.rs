@@ -22,9 +22,7 @@ use super::reference::Reference;
 use super::sampler::Technique;
 use super::scene::Scene;
 use super::summary::{csv, errors, markdown, Row};
-use crate::conditional::bake::{
-    BakeConfig, ENVMAP_GRID, ENVMAP_POOL_CONDITIONS, ENVMAP_STEPS, ENVMAP_WEIGHT_GRID,
-};
+use crate::conditional::bake::BakeConfig;
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render_composite, Composite, Tile};
 use crate::progress::Progress;
@@ -81,16 +79,7 @@ impl RenderConfig {
             brdf_blobs: Vec::new(),
             envmap_blobs: Vec::new(),
             bake: BakeConfig::default(),
-            envmap_bake: BakeConfig {
-                grid: ENVMAP_GRID,
-                weight_grid: ENVMAP_WEIGHT_GRID,
-                train: TrainConfig {
-                    steps: ENVMAP_STEPS,
-                    pool_conditions: ENVMAP_POOL_CONDITIONS,
-                    ..TrainConfig::default()
-                },
-                ..BakeConfig::default()
-            },
+            envmap_bake: BakeConfig::envmap_sizes(),
             seed: 0,
             seeds: 4,
             techniques: Technique::ALL.to_vec(),
