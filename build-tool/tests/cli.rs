@@ -563,7 +563,13 @@ fn sample_prints_what_the_runtime_serves_and_rejects_bad_input() {
     );
     // A condition outside the blob's range is clamped, and stderr says so in one
     // line; one inside the range prints nothing there.
-    for (cond, warned) in [("2,-10", true), ("0.35,47.5", false)] {
+    for (cond, warned) in [
+        ("2,-10", true),
+        ("0.35,47.5", false),
+        ("0.35,47.5,1", false),
+        // Metallic outside [0, 1] clamps too.
+        ("0.35,47.5,1.5", true),
+    ] {
         let out = build_tool()
             .arg("sample")
             .arg(&file)
@@ -574,6 +580,12 @@ fn sample_prints_what_the_runtime_serves_and_rejects_bad_input() {
         assert!(out.status.success(), "{err}");
         assert_eq!(err.lines().count(), usize::from(warned), "{cond}: {err}");
         assert_eq!(err.contains("outside the blob's range"), warned, "{err}");
+        if cond.ends_with("1.5") {
+            assert!(
+                err.contains("sampling at the clamped 0.35,47.5,1\n"),
+                "{err}"
+            );
+        }
     }
 
     let sobol = dir.join("sobol.nuld");

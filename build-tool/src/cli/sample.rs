@@ -4,6 +4,8 @@
 use crate::pointset::AlignedBytes;
 use anyhow::{anyhow, bail, Result};
 use clap::{Args, ValueEnum};
+use nuld_core::brdf::{clamp_metallic, MAX_METALLIC, MIN_METALLIC};
+use nuld_core::conditional::ConditionalTarget;
 use nuld_runtime::glam::{Vec2, Vec3};
 use nuld_runtime::{Blob, BlobError, ConditionalSampler, EnvmapSampler};
 use std::io::Write;
@@ -172,13 +174,26 @@ pub fn clamp_warning(bytes: &[u8], at: At) -> Option<String> {
     let info = cs.info();
     let inside = (0..2).all(|a| (info.cond_min[a]..=info.cond_max[a]).contains(&c[a]));
     let clamped = info.denormalize(info.normalize([c[0], c[1]]));
-    (!inside).then(|| {
-        format!(
-            "warning: --cond {},{} is outside the blob's range [{}, {}] x [{}, {}]; sampling at the clamped {},{}",
-            c[0], c[1], info.cond_min[0], info.cond_max[0], info.cond_min[1], info.cond_max[1],
-            clamped[0], clamped[1]
+    // A BRDF sampler also clamps the metallic (an environment sampler ignores it).
+    let brdf = info.target == ConditionalTarget::GltfBrdf as u32;
+    let metallic = clamp_metallic(c[2]);
+    if inside && (!brdf || metallic == c[2]) {
+        return None;
+    }
+    let (range, given, at) = if brdf {
+        (
+            format!(" x metallic [{MIN_METALLIC}, {MAX_METALLIC}]"),
+            format!(",{}", c[2]),
+            format!(",{metallic}"),
         )
-    })
+    } else {
+        Default::default()
+    };
+    Some(format!(
+        "warning: --cond {},{}{given} is outside the blob's range [{}, {}] x [{}, {}]{range}; sampling at the clamped {},{}{at}",
+        c[0], c[1], info.cond_min[0], info.cond_max[0], info.cond_min[1], info.cond_max[1],
+        clamped[0], clamped[1]
+    ))
 }
 
 /// Runs `build-tool sample`. A reader that stops early closes the pipe; the
