@@ -486,6 +486,7 @@ fn conditional_blob(path: &Path) {
         table,
         weights,
         prior: None,
+        metal: None,
     };
     let meta = nuld_core::blob::Metadata {
         generator: "cli-test",

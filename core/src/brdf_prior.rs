@@ -448,24 +448,42 @@ impl<'a, T: Real> BrdfPrior<'a, T> {
     /// The light direction of primary sample `u` in `[0,1]^2` (clamped) for the
     /// xz-plane view of `cond = [roughness, θo in degrees, metallic]`, and its
     /// solid-angle pdf (per steradian); `(+z, 0)` for a point without a
-    /// direction (module docs). `O(8 log size)`, never panics.
+    /// direction (module docs), and where the pdf overflows (only tables with
+    /// values near the float range do). `O(8 log size)`, never panics.
     #[inline]
     pub fn sample(&self, cond: [T; 3], u: [T; 2]) -> ([T; 3], T) {
         let wo = view_direction_real(cond[1]);
         let (p, pdf) = self.warp.sample(u, &self.blend(cond));
+        let dead = ([T::ZERO, T::ZERO, T::ONE], T::ZERO);
         match half_vector_direction(wo, p, query_stretch(self.grid, cond)) {
-            Some((wi, jac)) => (wi, pdf / (T::of(2.0) * T::PI * jac)),
-            None => ([T::ZERO, T::ZERO, T::ONE], T::ZERO),
+            Some((wi, jac)) => {
+                let pdf = pdf / (T::of(2.0) * T::PI * jac);
+                // Only tables near the float range (a hostile blob's) overflow.
+                if pdf.is_finite() {
+                    (wi, pdf)
+                } else {
+                    dead
+                }
+            }
+            None => dead,
         }
     }
 
     /// The solid-angle pdf of [`Self::sample`]'s directions at the unit
-    /// direction `wi` (xz-plane view); 0 where the prior draws nothing.
+    /// direction `wi` (xz-plane view); 0 where the prior draws nothing (and
+    /// where the pdf overflows, as [`Self::sample`]).
     #[inline]
     pub fn pdf(&self, cond: [T; 3], wi: [T; 3]) -> T {
         let wo = view_direction_real(cond[1]);
         match half_vector_point(wo, wi, query_stretch(self.grid, cond)) {
-            Some((p, jac)) => self.warp.pdf(p, &self.blend(cond)) / (T::of(2.0) * T::PI * jac),
+            Some((p, jac)) => {
+                let pdf = self.warp.pdf(p, &self.blend(cond)) / (T::of(2.0) * T::PI * jac);
+                if pdf.is_finite() {
+                    pdf
+                } else {
+                    T::ZERO
+                }
+            }
             None => T::ZERO,
         }
     }

@@ -65,6 +65,8 @@ const NULD_TAG_BRDF_PRIOR_DATA: u32 = 11u;
 const NULD_TAG_BRDF_PRIOR_MARGINAL: u32 = 12u;
 const NULD_TAG_BRDF_PRIOR_CONDITIONAL: u32 = 13u;
 const NULD_TAG_BRDF_PRIOR_MASSES: u32 = 14u;
+const NULD_TAG_METAL_NETWORK_PARAMS: u32 = 16u;
+const NULD_TAG_METAL_POINT_TABLE: u32 = 17u;
 
 // `Domain` codes.
 const NULD_DOMAIN_SQUARE: u32 = 0u;
@@ -485,6 +487,23 @@ fn nuld_conditional() -> NuldConditional {
         nuld_section(NULD_TAG_POINT_TABLE),
         nuld_section(NULD_TAG_WEIGHT_TABLE),
     );
+}
+
+// Rust: `ConditionalSampler::at_metallic`: the sampler whose network and point
+// table serve a BRDF query at `metallic`: the metal layer's own (sections 16 and
+// 17, present only on a prior with the metal layer) where the query reads that
+// layer (metallic 1, clamped, NaN as 0), else the blob's.
+fn nuld_conditional_at_metallic(metallic: f32) -> NuldConditional {
+    var cs = nuld_conditional();
+    let params = nuld_section(NULD_TAG_METAL_NETWORK_PARAMS);
+    let table = nuld_section(NULD_TAG_METAL_POINT_TABLE);
+    // A section never starts at byte 0 (the header): 0 is "absent".
+    if cs.info.warp == NULD_WARP_BRDF_TABLE && params != 0u && table != 0u
+        && nuld_reads_metal_layer(nuld_brdf_prior(), metallic) {
+        cs.params = params;
+        cs.table = table;
+    }
+    return cs;
 }
 
 // Rust: `ConditionalInfo::normalize`: the condition clamped into
@@ -1706,7 +1725,11 @@ fn nuld_brdf_prior_sample(pr: NuldBrdfPrior, cond: vec3<f32>, u: vec2<f32>) -> N
     let s = nuld_marginal_sample(pr, nuld_brdf_blend(pr, cond), u);
     let hv = nuld_half_vector_direction(wo, s.p, nuld_prior_stretch(pr, cond));
     if hv.jac > 0.0 {
-        return NuldTreeSample(hv.w, s.pdf / (2.0 * NULD_PI * hv.jac));
+        let pdf = s.pdf / (2.0 * NULD_PI * hv.jac);
+        // Only tables near the float range (a hostile blob's) overflow.
+        if nuld_is_finite(pdf) {
+            return NuldTreeSample(hv.w, pdf);
+        }
     }
     return NuldTreeSample(vec3<f32>(0.0, 0.0, 1.0), 0.0);
 }
@@ -1718,7 +1741,10 @@ fn nuld_brdf_prior_pdf(pr: NuldBrdfPrior, cond: vec3<f32>, wi: vec3<f32>) -> f32
     let wo = nuld_view_direction(cond.y);
     let hv = nuld_half_vector_point(wo, wi, nuld_prior_stretch(pr, cond));
     if hv.jac > 0.0 {
-        return nuld_marginal_pdf(pr, nuld_brdf_blend(pr, cond), hv.w.xy) / (2.0 * NULD_PI * hv.jac);
+        let pdf = nuld_marginal_pdf(pr, nuld_brdf_blend(pr, cond), hv.w.xy) / (2.0 * NULD_PI * hv.jac);
+        if nuld_is_finite(pdf) {
+            return pdf;
+        }
     }
     return 0.0;
 }
@@ -1747,9 +1773,10 @@ fn nuld_sample(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
 
 // Rust: `ConditionalSampler::sample_metallic`: `nuld_sample` for a BRDF of
 // metallic `metallic` (clamped into `[0, 1]`, NaN as 0), which warp 3 reads and
-// every other warp ignores.
+// every other warp ignores; at metallic 1 the metal layer's points where the
+// blob has them (`nuld_conditional_at_metallic`).
 fn nuld_sample_metallic(cond: vec2<f32>, metallic: f32, instance: u32, i: u32) -> NuldSample {
-    let cs = nuld_conditional();
+    let cs = nuld_conditional_at_metallic(metallic);
     let u = nuld_normalize(cs.info, cond);
     return nuld_mapped(cs, nuld_square_point_of(cs, u, instance, i), u, metallic);
 }
@@ -1777,7 +1804,7 @@ fn nuld_sample_network(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
 
 // Rust: `NetworkSampler::sample_metallic`: network mode at metallic `metallic`.
 fn nuld_sample_network_metallic(cond: vec2<f32>, metallic: f32, instance: u32, i: u32) -> NuldSample {
-    let cs = nuld_conditional();
+    let cs = nuld_conditional_at_metallic(metallic);
     let u = nuld_normalize(cs.info, cond);
     return nuld_mapped(cs, nuld_network_square_point_of(cs, u, instance, i), u, metallic);
 }

@@ -101,7 +101,7 @@ fn nuld_kernel_conditional(p: NuldKernelParams, c: vec2<f32>, instance: u32, ind
     if brdf {
         view = nuld_view_condition(p.view.xyz, c.x);
     }
-    let cs = nuld_conditional();
+    let cs = nuld_conditional_at_metallic(metallic);
     let u = nuld_normalize(cs.info, view.cond);
     var point: vec2<f32>;
     if randomized {

@@ -69,7 +69,8 @@ pub fn shape(
 
 /// A BRDF sampler briefly trained (40 + 40 steps of a 16-point, [16, 16] network:
 /// enough to leave the initialization, a few seconds) and distilled into `instances`
-/// stored instances on a `grid` point table and a `weight_grid` weight table.
+/// stored instances on a `grid` point table and a `weight_grid` weight table,
+/// with its metal points (a second network, trained as briefly on metals).
 pub fn distilled_parts(
     instances: u32,
     grid: [u32; 2],
@@ -88,17 +89,31 @@ pub fn distilled_parts(
         caps_per_step: 64,
         ..TrainConfig::default()
     };
-    let mut trainer = Trainer::new(config, None).expect("the BRDF pool reads no file");
-    while !trainer.done() {
-        trainer.step();
-    }
-    nuld_build_tool::conditional::distill::distill(
+    let trained = |config: TrainConfig| {
+        let mut trainer = Trainer::new(config, None).expect("the BRDF pool reads no file");
+        while !trainer.done() {
+            trainer.step();
+        }
+        trainer
+    };
+    let metal = trained(TrainConfig {
+        layer: nuld_build_tool::train::BrdfLayer::Metal,
+        ..config.clone()
+    });
+    let trainer = trained(config);
+    let mut parts = nuld_build_tool::conditional::distill::distill(
         &trainer.params(),
         &trainer.pool.target,
         instances,
         grid,
         weight_grid,
-    )
+    );
+    parts.metal = Some(nuld_build_tool::conditional::distill::distill_metal(
+        &metal.params(),
+        instances,
+        grid,
+    ));
+    parts
 }
 
 /// A tree of 4 levels (top weights on 3 x 3 normals) over a closed-form light, a
@@ -140,6 +155,25 @@ pub fn small_brdf_prior() -> std::sync::Arc<nuld_build_tool::sphere::brdf_prior:
         )
     });
     std::sync::Arc::clone(prior)
+}
+
+/// `parts` (a [`nuld_core::conditional::PointWarp::BrdfTable`] sampler on a
+/// prior with the metal layer) with random metal points, as
+/// [`conditional_parts`] makes its own: a network of the same shape with f16
+/// parameters uniform in `[-0.6, 0.6]` and a point table of random codes.
+/// Deterministic for a seed.
+pub fn with_metal_points(
+    mut parts: nuld_build_tool::conditional::blob::ConditionalParts,
+    seed: u64,
+) -> nuld_build_tool::conditional::blob::ConditionalParts {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
+    let params = (0..parts.params.len())
+        .map(|_| nuld_core::quantize::f16_encode(rng.random_range(-0.6f32..=0.6)))
+        .collect();
+    let table = (0..parts.table.len()).map(|_| rng.random()).collect();
+    parts.metal = Some(nuld_build_tool::conditional::blob::MetalParts { params, table });
+    parts
 }
 
 /// `parts` (a [`nuld_core::conditional::PointWarp::BrdfTable`] sampler) with

@@ -14,7 +14,7 @@ use nuld_core::quantize::f16_decode;
 use nuld_core::real::Real;
 use nuld_core::sphere::square_to_hemisphere_real;
 use nuld_runtime::{Blob, ConditionalSampler};
-use nuld_tests::{as_envmap, conditional_parts, fixture_tree, shape, META};
+use nuld_tests::{as_envmap, conditional_parts, fixture_tree, shape, with_metal_points, META};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -36,10 +36,11 @@ fn fixtures() -> Vec<ConditionalParts> {
     .into_iter()
     .map(|(act, warp, slots, seed)| {
         let parts = conditional_parts(shape(64, &[32, 32], act, warp, slots), 16, [10, 9], seed);
-        if warp == PointWarp::EnvmapTree {
-            as_envmap(parts)
-        } else {
-            parts
+        match warp {
+            PointWarp::EnvmapTree => as_envmap(parts),
+            // The shared prior has the metal layer: the metal points serve it.
+            PointWarp::BrdfTable => with_metal_points(parts, seed + 100),
+            _ => parts,
         }
     })
     .collect()
@@ -109,11 +110,18 @@ fn with_sampler(parts: &ConditionalParts, f: impl FnOnce(ConditionalSampler<'_>)
 fn network_mode_equals_the_tools_f64_evaluation_of_the_f16_weights() {
     for parts in fixtures() {
         let shape = parts.info.shape().unwrap();
-        let weights: Vec<f64> = parts.params.iter().map(|&h| f16_decode(h) as f64).collect();
+        let decoded =
+            |params: &[u16]| -> Vec<f64> { params.iter().map(|&h| f16_decode(h) as f64).collect() };
+        let weights = decoded(&parts.params);
         let tool = Network {
             shape,
             params: &weights[..],
         };
+        let metal_weights = parts.metal.as_ref().map(|m| decoded(&m.params));
+        let metal_tool = metal_weights.as_ref().map(|w| Network {
+            shape,
+            params: &w[..],
+        });
         let mut rng = Pcg64Mcg::seed_from_u64(7);
         let (mut worst_square, mut worst_direction) = (0.0f64, 0.0f64);
         let fixture = fixture_tree();
@@ -136,6 +144,15 @@ fn network_mode_equals_the_tools_f64_evaluation_of_the_f16_weights() {
                 );
                 let got = cs.network().square_point(c, k, i).as_dvec2();
                 worst_square = worst_square.max((got - p).abs().max_element());
+                if let Some(metal) = &metal_tool {
+                    // At metallic 1 the metal layer's network, at 0.99 the shared one.
+                    let row = shape.embedding_row(k, i);
+                    let pm = DVec2::from(metal.forward(row, input).square_point());
+                    let got = cs.network().square_point_metallic(c, 1.0, k, i).as_dvec2();
+                    worst_square = worst_square.max((got - pm).abs().max_element());
+                    let below = cs.network().square_point_metallic(c, 0.99, k, i).as_dvec2();
+                    assert_eq!(below, cs.network().square_point(c, k, i).as_dvec2());
+                }
                 let d = match parts.info.point_warp().unwrap() {
                     PointWarp::EqualArea => Domain::Hemisphere.to_direction(p),
                     PointWarp::BrdfMixture => {
@@ -226,15 +243,15 @@ fn table_mode_equals_the_reference_interpolation_bit_for_bit() {
                 let i: u32 = rng.random();
                 let (ks, is) = (k % info.instances, i % info.n);
                 let u = normalize::<f32>(&parts, c);
-                let coord = |axis: u32| {
+                let coord = |table: &[u32], axis: u32| {
                     bilinear(u, info.grid, |node| {
                         let at = (node * info.instances as usize + ks as usize) * info.n as usize
                             + is as usize;
-                        let code = (parts.table[at] >> (16 * axis)) & 0xffff;
+                        let code = (table[at] >> (16 * axis)) & 0xffff;
                         (code as f32 + 0.5) / 65536.0
                     })
                 };
-                let p = [coord(0), coord(1)];
+                let p = [coord(&parts.table, 0), coord(&parts.table, 1)];
                 assert_eq!(cs.square_point(c, k, i).to_array(), p, "{c} {k} {i}");
                 let d = match info.point_warp().unwrap() {
                     PointWarp::EqualArea => square_to_hemisphere_real(p),
@@ -259,6 +276,14 @@ fn table_mode_equals_the_reference_interpolation_bit_for_bit() {
                         let f = gltf_metallic(view_direction_real(q[1]), d, q[0], m);
                         let w = if pdf > 0.0 { f * d[2] / pdf } else { 0.0 };
                         assert_eq!(s.weight, w);
+                        if let Some(metal) = &parts.metal {
+                            // Metallic 1 reads the metal layer's own table.
+                            let pm = [coord(&metal.table, 0), coord(&metal.table, 1)];
+                            assert_eq!(cs.square_point_metallic(c, 1.0, k, i).to_array(), pm);
+                            let (d1, pdf1) = prior.sample([q[0], q[1], 1.0], pm);
+                            let s1 = cs.sample_metallic(c, 1.0, k, i);
+                            assert_eq!((s1.direction.to_array(), s1.pdf), (d1, pdf1));
+                        }
                         prior.sample([q[0], q[1], 0.0], p).0
                     }
                 };

@@ -46,13 +46,33 @@ fn node(c: [f64; 2]) -> Vec2 {
 /// conditions to stay within twice the largest midpoint error plus the node bound.
 #[test]
 fn table_mode_follows_network_mode_within_a_measured_bound() {
+    for metallic in [0.0, 1.0] {
+        table_follows_network_at(metallic);
+    }
+}
+
+/// [`table_mode_follows_network_mode_within_a_measured_bound`] at `metallic`: at 1
+/// the metal layer's own table and network, which are not the shared ones.
+fn table_follows_network_at(metallic: f32) {
     let cs = distilled();
     let n = cs.len();
+    assert!(cs.has_metal_points());
     let gap = |c: Vec2, k: u32, i: u32| {
-        (cs.square_point(c, k, i) - cs.network().square_point(c, k, i))
-            .abs()
-            .max_element()
+        (cs.square_point_metallic(c, metallic, k, i)
+            - cs.network().square_point_metallic(c, metallic, k, i))
+        .abs()
+        .max_element()
     };
+    if metallic >= 1.0 {
+        let c = Vec2::new(0.5, 40.0);
+        let apart = (0..n)
+            .map(|i| (cs.square_point_metallic(c, 1.0, 0, i) - cs.square_point(c, 0, i)).length())
+            .fold(0.0f32, f32::max);
+        assert!(
+            apart > 1e-3,
+            "the metal points are the shared ones: {apart}"
+        );
+    }
     let node_bound = UNORM16_MAX_ERROR as f32 + 1e-5;
     let mut at_nodes = 0.0f32;
     let mut at_midpoints = 0.0f32;
@@ -90,8 +110,8 @@ fn table_mode_follows_network_mode_within_a_measured_bound() {
         ));
     }
     println!(
-        "table vs network (square units): nodes {at_nodes:.2e}, midpoints {at_midpoints:.2e}, \
-         20k random conditions {worst:.2e} (bound {bound:.2e})"
+        "table vs network (square units), metallic {metallic}: nodes {at_nodes:.2e}, \
+         midpoints {at_midpoints:.2e}, 20k random conditions {worst:.2e} (bound {bound:.2e})"
     );
     assert!(worst <= bound, "{worst} > {bound}");
 }

@@ -4,8 +4,8 @@
 
 use nuld_build_tool::pointset::AlignedBytes;
 use nuld_core::blob::{
-    checksum, encoded_len, write, BlobError, Domain, Layout, LayoutError, PointSetError,
-    SectionSpec, SectionTag, WriteError, CHECKSUM_OFFSET, MAX_SECTIONS,
+    checksum, encoded_len, write, BlobError, ConditionalError, Domain, Layout, LayoutError,
+    PointSetError, SectionSpec, SectionTag, WriteError, CHECKSUM_OFFSET, MAX_SECTIONS,
 };
 use nuld_core::conditional::{PointWarp, CONDITIONAL_INFO_LEN};
 use nuld_core::network::Activation;
@@ -13,7 +13,8 @@ use nuld_core::quantize::f16_decode;
 use nuld_runtime::glam::{Vec2, Vec3};
 use nuld_runtime::{Blob, BlobKind};
 use nuld_tests::{
-    as_envmap, conditional_parts, shape, small_brdf_prior, sobol_blob, with_brdf_prior, META,
+    as_envmap, conditional_parts, shape, small_brdf_prior, sobol_blob, with_brdf_prior,
+    with_metal_points, META,
 };
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -50,6 +51,8 @@ fn parse_and_touch(bytes: &[u8]) -> Result<(), BlobError> {
                     for k in 0..=cs.instances() {
                         for i in 0..=cs.len() {
                             check_sample(cs.sample(c, k, i));
+                            // The metal layer's own table, where the blob has one.
+                            check_sample(cs.sample_metallic(c, 1.0, k, i));
                         }
                     }
                 }
@@ -118,9 +121,9 @@ fn envmap_blob() -> AlignedBytes {
 /// that every truncation stays cheap.
 fn brdf_table_blob() -> AlignedBytes {
     let shape = shape(4, &[3, 2], Activation::Relu, PointWarp::BrdfTable, 2);
-    with_brdf_prior(conditional_parts(shape, 2, [3, 2], 7), small_brdf_prior())
-        .to_blob(&META)
-        .unwrap()
+    let parts = with_brdf_prior(conditional_parts(shape, 2, [3, 2], 7), small_brdf_prior());
+    // The small prior has the metal layer, which its own points serve.
+    with_metal_points(parts, 8).to_blob(&META).unwrap()
 }
 
 fn valid_blobs() -> Vec<AlignedBytes> {
@@ -551,6 +554,93 @@ fn a_brdf_prior_with_four_metallic_layers_is_refused() {
         .is_ok());
 }
 
+/// Each metal-points failure has its error: one of the two sections missing,
+/// an element size or a length other than its shared twin's, a non-finite
+/// metal parameter, and metal points on a prior without the metal layer.
+#[test]
+fn each_metal_points_failure_has_its_error() {
+    use nuld_build_tool::sphere::brdf_prior::{BrdfPrior, PriorSpace};
+    let parts = |prior| {
+        let shape = shape(4, &[3, 2], Activation::Relu, PointWarp::BrdfTable, 2);
+        with_metal_points(
+            with_brdf_prior(conditional_parts(shape, 2, [3, 2], 7), prior),
+            8,
+        )
+    };
+    let blob = brdf_table_blob();
+    let b = blob.as_slice();
+    let count = u32::from_le_bytes(b[SECTION_COUNT..SECTION_COUNT + 4].try_into().unwrap());
+    let row_of = |tag: SectionTag| {
+        (0..count as usize)
+            .map(row)
+            .find(|&r| b[r + TAG..r + TAG + 4] == (tag as u32).to_le_bytes())
+            .unwrap()
+    };
+    let (params_row, table_row) = (
+        row_of(SectionTag::MetalNetworkParams),
+        row_of(SectionTag::MetalPointTable),
+    );
+    let params_len = get_u64(b, params_row + LEN);
+    let table_len = get_u64(b, table_row + LEN);
+    let mut bad_param = parts(small_brdf_prior());
+    bad_param.metal.as_mut().unwrap().params[5] = 0x7c00;
+    let no_layer = parts(std::sync::Arc::new(
+        BrdfPrior::new([3, 2, 2], 5, PriorSpace::HalfVector).unwrap(),
+    ));
+    let error = |p: nuld_build_tool::conditional::blob::ConditionalParts| {
+        parse_and_touch(p.to_blob(&META).unwrap().as_slice()).unwrap_err()
+    };
+    let cases = [
+        (
+            damaged(&blob, |x| put_u32(x, table_row + TAG, 77)),
+            ConditionalError::MetalPoints(SectionTag::MetalPointTable as u32),
+        ),
+        (
+            damaged(&blob, |x| put_u32(x, params_row + TAG, 78)),
+            ConditionalError::MetalPoints(SectionTag::MetalNetworkParams as u32),
+        ),
+        (
+            damaged(&blob, |x| put_u32(x, table_row + ELEM_SIZE, 2)),
+            ConditionalError::MetalElementSize {
+                tag: SectionTag::MetalPointTable as u32,
+                size: 2,
+            },
+        ),
+        (
+            damaged(&blob, |x| put_u64(x, params_row + LEN, params_len - 2)),
+            ConditionalError::MetalLength {
+                tag: SectionTag::MetalNetworkParams as u32,
+                expected: params_len / 2,
+                got: params_len / 2 - 1,
+            },
+        ),
+        (
+            damaged(&blob, |x| put_u64(x, table_row + LEN, table_len - 4)),
+            ConditionalError::MetalLength {
+                tag: SectionTag::MetalPointTable as u32,
+                expected: table_len / 4,
+                got: table_len / 4 - 1,
+            },
+        ),
+        (
+            error(bad_param),
+            ConditionalError::NonFiniteMetalParam {
+                index: 5,
+                bits: 0x7c00,
+            },
+        ),
+        (
+            error(no_layer),
+            ConditionalError::MetalPoints(SectionTag::MetalNetworkParams as u32),
+        ),
+    ];
+    for (k, (got, want)) in cases.into_iter().enumerate() {
+        assert_eq!(got, BlobError::Conditional(want), "case {k}");
+        let line = got.to_string();
+        assert!(!line.contains('\n'), "{line:?}");
+    }
+}
+
 #[test]
 fn blob_errors_convert_into_boxed_std_errors_with_question_mark() {
     fn len(bytes: &[u8]) -> Result<usize, Box<dyn std::error::Error + Send + Sync>> {
@@ -675,6 +765,7 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
         };
     (info.warp != 2 || tree_semantics_hold(&layout))
         && (info.warp != 3 || brdf_prior_semantics_hold(&layout))
+        && metal_semantics_hold(&layout, info.warp, params.len(), table.len())
         && pe.elem_size == 2
         && te.elem_size == 4
         && we.elem_size == 4
@@ -737,6 +828,32 @@ fn brdf_prior_semantics_hold(layout: &Layout<'_>) -> bool {
         && rising(&conditional)
         && marginal.chunks(s).all(|m| m[s - 1] > 0.0)
         && masses.iter().all(|m| m.is_finite() && *m > 0.0)
+}
+
+/// The metal points (core/FORMAT.md, tags 16 and 17), checked from the raw
+/// bytes: both absent, or both present on a BRDF prior (warp 3) with the metal
+/// layer (`G_m = 3`), of 2- and 4-byte elements and as many bytes as the
+/// network's (`params` bytes) and the point table's (`table` bytes), every
+/// parameter a finite f16.
+fn metal_semantics_hold(layout: &Layout<'_>, warp: u32, params: usize, table: usize) -> bool {
+    let section = |tag| layout.section(tag).ok();
+    let (metal_params, metal_table) = (
+        section(SectionTag::MetalNetworkParams),
+        section(SectionTag::MetalPointTable),
+    );
+    let (Some((pe, p)), Some((te, t))) = (metal_params, metal_table) else {
+        return metal_params.is_none() && metal_table.is_none();
+    };
+    let layer = section(SectionTag::BrdfPriorInfo)
+        .is_some_and(|(_, info)| info.len() == 16 && info[8..12] == 3u32.to_le_bytes());
+    warp == 3
+        && layer
+        && pe.elem_size == 2
+        && te.elem_size == 4
+        && p.len() == params
+        && t.len() == table
+        && p.chunks_exact(2)
+            .all(|b| f16_decode(u16::from_le_bytes([b[0], b[1]])).is_finite())
 }
 
 /// The environment prior's sections (core/FORMAT.md, tags 7-9), checked from the

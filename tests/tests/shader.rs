@@ -60,7 +60,7 @@ use nuld_runtime::shader::{kernel_wgsl, KernelMode, KernelParams, KERNEL_ENTRY_P
 use nuld_runtime::{Blob, BrdfSampler, ConditionalSampler, Sample};
 use nuld_tests::{
     as_envmap, conditional_parts, distilled_parts, fixture_tree, shape, small_brdf_prior,
-    sobol_blob, with_brdf_prior, META,
+    sobol_blob, with_brdf_prior, with_metal_points, META,
 };
 use shader_sample::Gpu;
 use std::sync::OnceLock;
@@ -561,11 +561,15 @@ fn runtime_sample(
     let info = cs.info();
     let randomized = || Vec2::from(randomized_point(info.n, info.lattice_generator, k, i, e));
     let (want, cond, point) = match mode {
-        KernelMode::Table => (cs.sample_metallic(c, m, k, i), c, cs.square_point(c, k, i)),
+        KernelMode::Table => (
+            cs.sample_metallic(c, m, k, i),
+            c,
+            cs.square_point_metallic(c, m, k, i),
+        ),
         KernelMode::Network => (
             cs.network().sample_metallic(c, m, k, i),
             c,
-            cs.network().square_point(c, k, i),
+            cs.network().square_point_metallic(c, m, k, i),
         ),
         KernelMode::TableRandomized => (
             cs.sample_randomized_metallic(c, m, k, i, e),
@@ -584,14 +588,14 @@ fn runtime_sample(
                 weight: cs.albedo(c, m),
                 ..s
             };
-            (s, c, cs.square_point(c, k, i))
+            (s, c, cs.square_point_metallic(c, m, k, i))
         }
         KernelMode::BrdfTable => {
             let cond = brdf_cond();
             (
                 brdf().sample(wo, c.x, m, k, i),
                 cond,
-                cs.square_point(cond, k, i),
+                cs.square_point_metallic(cond, m, k, i),
             )
         }
         KernelMode::BrdfNetwork => {
@@ -599,7 +603,7 @@ fn runtime_sample(
             (
                 brdf().network().sample(wo, c.x, m, k, i),
                 cond,
-                cs.network().square_point(cond, k, i),
+                cs.network().square_point_metallic(cond, m, k, i),
             )
         }
         KernelMode::BrdfTableRandomized => {
@@ -626,7 +630,7 @@ fn runtime_sample(
                 weight: brdf().albedo(wo, c.x, m),
                 ..s
             };
-            (s, cond, cs.square_point(cond, k, i))
+            (s, cond, cs.square_point_metallic(cond, m, k, i))
         }
     };
     (want, warp_gain(cs, prior, cond, m, point))
@@ -859,6 +863,11 @@ fn shader_random_samplers_of_every_shape_match_the_runtime() {
                 // prior (`BrdfPrior::shared`, as the distilled test).
                 parts = with_brdf_prior(parts, small_brdf_prior());
                 label = format!("random {s} {warp:?}, small prior");
+            }
+            if warp == PointWarp::BrdfTable && s != 1 {
+                // The metal layer's own network and table, read at metallic 1.
+                parts = with_metal_points(parts, 40 + s as u64);
+                label = format!("{label}, metal points");
             }
             let bytes = parts.to_blob(&META).unwrap();
             check_conditional(kernel, bytes.as_slice(), &label);

@@ -11,7 +11,9 @@ use std::path::PathBuf;
 /// [`TrainConfig::default`]'s, read from there.
 #[derive(Args, Debug)]
 pub struct BakeArgs {
-    /// Bake the glTF 2.0 BRDF sampler (condition: roughness, view angle).
+    /// Bake the glTF 2.0 BRDF sampler (condition: roughness, view angle; the
+    /// metallic at run time): two networks, one for metallic below 1 and one for
+    /// metals, each trained on its part of the prior.
     #[arg(long, conflicts_with = "envmap")]
     pub brdf: bool,
     /// Bake the environment-map sampler of this map (HDR, EXR; equirectangular, +z
@@ -31,7 +33,8 @@ pub struct BakeArgs {
     #[arg(long, value_delimiter = ',')]
     pub grid: Option<Vec<u32>>,
     /// Training steps after the 300 steps of pretraining on the warp [default:
-    /// 12000 for --brdf (191 s at N = 64 on 2 cores), 3000 for --envmap].
+    /// 12000 for --brdf, for each of its two networks (metallic below 1, and the
+    /// metal), 3000 for --envmap].
     #[arg(long, allow_negative_numbers = true, value_parser = super::count)]
     pub steps: Option<usize>,
     /// Seed; fixes the output bit for bit whatever the thread count.

@@ -8,15 +8,17 @@
 //! few conditions over the target, in the equal-area square; for a map, at a few
 //! normals over the sphere's square), and while training
 //! `checkpoint.bin` (every [`BakeConfig::checkpoint_every`], and at the end), from
-//! which `resume` continues bit for bit. Every file is written atomically.
+//! which `resume` continues bit for bit; a BRDF bake trains a second network for
+//! the prior's metal layer after the first ([`BakeConfig::metal_points`],
+//! `checkpoint-metal.bin`). Every file is written atomically.
 
-use super::distill::distill;
+use super::distill::{distill, distill_metal};
 use super::quality::{evaluate, instance_directions, Quality, QualityConfig};
 use crate::plot::{render_loglog, render_square_panels, Series, SquarePanel};
 use crate::progress::Progress;
 use crate::sphere::{BrdfTarget, DirectionDensity, EnvmapDensity};
 use crate::train::target::{EnvmapTarget, LoadedTarget};
-use crate::train::{Checkpoint, TrainConfig, TrainTarget, Trainer};
+use crate::train::{BrdfLayer, Checkpoint, TrainConfig, TrainTarget, Trainer};
 use anyhow::{bail, Context, Result};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::{Domain, Metadata};
@@ -44,8 +46,12 @@ pub struct BakeConfig {
     pub quality_grid: usize,
     /// Time between checkpoints.
     pub checkpoint_every: Duration,
-    /// Continue from the directory's checkpoint.
+    /// Continue from the directory's checkpoints.
     pub resume: bool,
+    /// A BRDF sampler also trains the metal layer's own network
+    /// ([`crate::train::BrdfLayer::Metal`], `checkpoint-metal.bin`), which a
+    /// query at metallic 1 reads; ignored for an environment map.
+    pub metal_points: bool,
 }
 
 impl Default for BakeConfig {
@@ -58,6 +64,7 @@ impl Default for BakeConfig {
             quality_grid: 4,
             checkpoint_every: Duration::from_secs(120),
             resume: false,
+            metal_points: true,
         }
     }
 }
@@ -152,6 +159,16 @@ impl BakeConfig {
     pub fn blob_name(&self) -> String {
         format!("{}.nuld", self.train.target.name())
     }
+
+    /// The training run of the metal layer's network: [`Self::train`] on
+    /// metals ([`BrdfLayer::Metal`]), for a BRDF sampler with
+    /// [`Self::metal_points`]; `None` otherwise.
+    pub fn metal_train(&self) -> Option<TrainConfig> {
+        (self.metal_points && self.train.target == TrainTarget::GltfBrdf).then(|| TrainConfig {
+            layer: BrdfLayer::Metal,
+            ..self.train.clone()
+        })
+    }
 }
 
 /// Instance slots of an environment sampler's network, as the BRDF sampler's: on
@@ -180,6 +197,66 @@ pub fn checkpoint_path(dir: &Path) -> PathBuf {
     dir.join("checkpoint.bin")
 }
 
+/// The metal layer's network's checkpoint in `dir` ([`BakeConfig::metal_train`]).
+pub fn metal_checkpoint_path(dir: &Path) -> PathBuf {
+    dir.join("checkpoint-metal.bin")
+}
+
+/// The checkpoint at `path` to resume a run of `config` from, if `resume`
+/// (`required`: an error if there is none); an error if it was written with
+/// other settings.
+fn resume_from(
+    path: &Path,
+    config: &TrainConfig,
+    resume: bool,
+    required: bool,
+) -> Result<Option<Checkpoint>> {
+    if !resume || (!required && !path.is_file()) {
+        return Ok(None);
+    }
+    let c = Checkpoint::load(path)?;
+    if &c.config != config {
+        bail!(
+            "{} was written with other training settings; rerun with the same options or without --resume",
+            path.display()
+        );
+    }
+    Ok(Some(c))
+}
+
+/// Trains `trainer` to its last step, saving its checkpoint at `path` every
+/// `every` and at the end; two bars named `label`, so that `--steps K` shows
+/// K training steps: the pretraining on the warp, then the cap-loss steps.
+fn train(trainer: &mut Trainer, path: &Path, every: Duration, label: &str) -> Result<()> {
+    let pretrain = trainer.config.pretrain_steps;
+    let mut last_save = Instant::now();
+    for (phase, first, end) in [
+        ("pretrain", 0, pretrain),
+        ("train", pretrain, trainer.total_steps()),
+    ] {
+        if trainer.state.step >= end {
+            continue;
+        }
+        let progress = Progress::stderr(&format!("{phase}{label}"), (end - first) as u64, "step");
+        progress.inc((trainer.state.step.max(first) - first) as u64);
+        while trainer.state.step < end {
+            let r = trainer.step();
+            progress.inc(1);
+            progress.set_message(if phase == "pretrain" {
+                format!("distance to the warp {:.3e}", r.loss)
+            } else {
+                format!("loss {:.3e}, sets/baseline {:.3}", r.loss, r.set_ratio)
+            });
+            if last_save.elapsed() >= every {
+                trainer.state.save(path)?;
+                last_save = Instant::now();
+            }
+        }
+        progress.finish();
+    }
+    trainer.state.save(path)
+}
+
 /// Runs a bake into `out` (see the module docs); progress on stderr.
 pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     let started = Instant::now();
@@ -194,21 +271,19 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     // the directory goes again if the run fails before writing into it.
     let out_dir = crate::output::NewDir::create(out)?;
     let ckpt_path = checkpoint_path(out);
-    let resume = if config.resume {
-        let c = Checkpoint::load(&ckpt_path)?;
-        if c.config != config.train {
-            bail!(
-                "{} was written with other training settings; rerun with the same options or without --resume",
-                ckpt_path.display()
-            );
-        }
-        Some(c)
-    } else {
-        None
+    let metal_path = metal_checkpoint_path(out);
+    let resume = resume_from(&ckpt_path, &config.train, config.resume, true)?;
+    let metal_config = config.metal_train();
+    let metal_resume = match &metal_config {
+        Some(c) => resume_from(&metal_path, c, config.resume, false)?,
+        None => None,
     };
     let mut timings = Timings::default();
     let t = Instant::now();
     let mut trainer = Trainer::new(config.train.clone(), resume)?;
+    let mut metal_trainer = metal_config
+        .map(|c| Trainer::new(c, metal_resume))
+        .transpose()?;
     timings.pool_s = t.elapsed().as_secs_f64();
     if let LoadedTarget::Envmap(env) = &trainer.pool.target {
         // As `optimize` does: e.g. the negative pixels of a lossy EXR, set to 0.
@@ -218,48 +293,28 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     }
 
     let t = Instant::now();
-    // Two bars, so that `--steps K` shows K training steps: the pretraining on the
-    // warp first, then the cap-loss steps.
-    let pretrain = trainer.config.pretrain_steps;
-    let mut last_save = Instant::now();
-    for (phase, first, end) in [
-        ("pretrain", 0, pretrain),
-        ("train", pretrain, trainer.total_steps()),
-    ] {
-        if trainer.state.step >= end {
-            continue;
-        }
-        let progress = Progress::stderr(phase, (end - first) as u64, "step");
-        progress.inc((trainer.state.step.max(first) - first) as u64);
-        while trainer.state.step < end {
-            let r = trainer.step();
-            progress.inc(1);
-            progress.set_message(if phase == "pretrain" {
-                format!("distance to the warp {:.3e}", r.loss)
-            } else {
-                format!("loss {:.3e}, sets/baseline {:.3}", r.loss, r.set_ratio)
-            });
-            if last_save.elapsed() >= config.checkpoint_every {
-                trainer.state.save(&ckpt_path)?;
-                last_save = Instant::now();
-            }
-        }
-        progress.finish();
+    let every = config.checkpoint_every;
+    train(&mut trainer, &ckpt_path, every, "")?;
+    if let Some(metal) = &mut metal_trainer {
+        train(metal, &metal_path, every, " metal")?;
     }
-    trainer.state.save(&ckpt_path)?;
     out_dir.keep();
     timings.train_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
     let params = trainer.params();
+    let metal_params = metal_trainer.as_ref().map(Trainer::params);
     let target = &trainer.pool.target;
-    let parts = distill(
+    let mut parts = distill(
         &params,
         target,
         config.instances,
         config.grid,
         config.weight_grid,
     );
+    parts.metal = metal_params
+        .as_ref()
+        .map(|m| distill_metal(m, config.instances, config.grid));
     let blob = parts.to_blob(&Metadata {
         generator: "bake",
         target: config.train.target.name(),
@@ -271,7 +326,7 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     let quality = (config.quality_grid > 0)
         .then(|| {
             let held_out = QualityConfig::held_out(target, config.quality_grid, 0x9a11);
-            evaluate(&params, target, &held_out)
+            evaluate(&params, metal_params.as_ref(), target, &held_out)
         })
         .transpose()?;
     timings.quality_s = t.elapsed().as_secs_f64();
@@ -446,11 +501,20 @@ mod tests {
         assert_eq!(len(SectionTag::PointTable), 4 * 2 * 3 * 3 * 8);
         // The dielectric's albedo, then the metal's.
         assert_eq!(len(SectionTag::WeightTable), 4 * 8 * 2);
+        // The metal layer's network and point table, as long as the shared ones.
+        assert_eq!(len(SectionTag::MetalNetworkParams), 2 * shape.param_len());
+        assert_eq!(len(SectionTag::MetalPointTable), 4 * 2 * 3 * 3 * 8);
         // The tabulated prior's five sections.
         let prior = crate::sphere::brdf_prior::BrdfPrior::shared();
         assert_eq!(len(SectionTag::BrdfPriorData), 4 * prior.data.len());
         assert_eq!(len(SectionTag::BrdfPriorMasses), 4 * prior.masses.len());
-        for f in ["report.json", "loss.png", "sets.png", "checkpoint.bin"] {
+        for f in [
+            "report.json",
+            "loss.png",
+            "sets.png",
+            "checkpoint.bin",
+            "checkpoint-metal.bin",
+        ] {
             assert!(dir.join(f).is_file(), "{f}");
         }
         // Instance 0's first point is served at every condition, metallic 0

@@ -6,7 +6,7 @@ use crate::sphere::brdf_prior::BrdfPrior;
 use crate::sphere::EnvmapTree;
 use anyhow::{bail, Context, Result};
 use nuld_core::blob::{encoded_len, write, BlobKind, Metadata};
-use nuld_core::conditional::{sections, ConditionalInfo};
+use nuld_core::conditional::{metal_sections, sections, ConditionalInfo};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -27,6 +27,20 @@ pub struct ConditionalParts {
     /// The prior of a sampler that warps through one, written as its sections
     /// after the four above.
     pub prior: Option<Prior>,
+    /// A BRDF sampler's metal points (on a prior with the metal layer), written
+    /// last.
+    pub metal: Option<MetalParts>,
+}
+
+/// The learned part of a BRDF prior's metal layer
+/// ([`nuld_core::conditional::metal_sections`]): a network of the sampler's
+/// shape and its point table, which a query at metallic 1 reads.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MetalParts {
+    /// The metal network's parameters as f16 bits.
+    pub params: Vec<u16>,
+    /// Its point table, laid out as [`ConditionalParts::table`].
+    pub table: Vec<u32>,
 }
 
 /// The tables of a sampler's prior.
@@ -84,6 +98,18 @@ impl ConditionalParts {
             (Some(Prior::Envmap(tree)), Some(info), _) => sections.extend(tree.sections(info)),
             (Some(Prior::Brdf(prior)), _, Some(info)) => sections.extend(prior.sections(info)),
             _ => {}
+        }
+        if let Some(metal) = &self.metal {
+            if metal.params.len() != self.params.len() || metal.table.len() != self.table.len() {
+                bail!(
+                    "metal points have {} parameters and {} table entries, the sampler's own {} and {}",
+                    metal.params.len(),
+                    metal.table.len(),
+                    self.params.len(),
+                    self.table.len()
+                );
+            }
+            sections.extend(metal_sections(&metal.params, &metal.table));
         }
         let mut out = AlignedBytes::zeroed(encoded_len(&meta_bytes, &sections));
         write(

@@ -14,9 +14,11 @@
 //!   ([`EnvmapDensity::irradiance`]);
 //! * **prior**: an environment sampler on the tree
 //!   ([`PointWarp::EnvmapTree`]) carries the map's tree, which the pool trained
-//!   through.
+//!   through;
+//! * **metal points** ([`distill_metal`]): a BRDF sampler's second network,
+//!   trained on metals through the prior's metal layer, and its point table.
 
-use super::blob::Prior;
+use super::blob::{MetalParts, Prior};
 use super::ConditionalParts;
 use crate::network::Params;
 use crate::sphere::brdf_albedo::{directional_albedo, directional_albedo_metallic};
@@ -74,27 +76,7 @@ pub fn distill(
     weight_grid: [u32; 2],
 ) -> ConditionalParts {
     let info = info(&params.shape, target, instances, grid, weight_grid);
-    let shipped = params.rounded_to_f16();
-    let n = info.n;
-    let nodes = (grid[0] * grid[1]) as usize;
-    let table: Vec<u32> = (0..nodes)
-        .into_par_iter()
-        .flat_map_iter(|node| {
-            // Node j's normalized condition is j / (nodes - 1), what the reader
-            // computes there.
-            let unit = [
-                (node as u32 % grid[0]) as f64 / (grid[0] - 1) as f64,
-                (node as u32 / grid[0]) as f64 / (grid[1] - 1) as f64,
-            ];
-            let shipped = &shipped;
-            (0..instances).flat_map(move |k| {
-                (0..n).map(move |i| {
-                    let p = shipped.square_point(unit, k, i);
-                    pack_point(unorm16_encode(p[0]), unorm16_encode(p[1]))
-                })
-            })
-        })
-        .collect();
+    let table = point_table(params, instances, grid);
     let (weights, prior) = match target {
         LoadedTarget::GltfBrdf(prior) => (
             brdf_weights(&info),
@@ -113,7 +95,47 @@ pub fn distill(
         table,
         weights,
         prior,
+        metal: None,
     }
+}
+
+/// The metal layer's learned part for `metal`, a network trained on metals
+/// ([`crate::train::BrdfLayer::Metal`]) of the same shape as the sampler's own:
+/// its f16 parameters and its point table on the sampler's `grid` for
+/// `instances` instances, as [`distill`] makes them.
+pub fn distill_metal(metal: &Params, instances: u32, grid: [u32; 2]) -> MetalParts {
+    MetalParts {
+        params: metal.to_f16_bits(),
+        table: point_table(metal, instances, grid),
+    }
+}
+
+/// The point table of `params` (see the module docs): at every node of `grid`,
+/// for instances `0..instances` and every index, the square point of the
+/// f16-rounded network as u16 unorm codes. Parallel over nodes; identical for
+/// any thread count.
+fn point_table(params: &Params, instances: u32, grid: [u32; 2]) -> Vec<u32> {
+    let shipped = params.rounded_to_f16();
+    let n = shipped.shape.n();
+    let nodes = (grid[0] * grid[1]) as usize;
+    (0..nodes)
+        .into_par_iter()
+        .flat_map_iter(|node| {
+            // Node j's normalized condition is j / (nodes - 1), what the reader
+            // computes there.
+            let unit = [
+                (node as u32 % grid[0]) as f64 / (grid[0] - 1) as f64,
+                (node as u32 / grid[0]) as f64 / (grid[1] - 1) as f64,
+            ];
+            let shipped = &shipped;
+            (0..instances).flat_map(move |k| {
+                (0..n).map(move |i| {
+                    let p = shipped.square_point(unit, k, i);
+                    pack_point(unorm16_encode(p[0]), unorm16_encode(p[1]))
+                })
+            })
+        })
+        .collect()
 }
 
 /// The irradiance `E(n)` at every weight-grid node's normal.

@@ -310,17 +310,29 @@ impl HeldOut {
     }
 }
 
-/// Scores `params` rounded to f16 on `target` (see the module docs). An error if a
-/// held-out BRDF condition lies outside the range or a lit map cannot be built.
-pub fn evaluate(params: &Params, target: &LoadedTarget, config: &QualityConfig) -> Result<Quality> {
-    let shipped = params.rounded_to_f16();
+/// Scores `params` rounded to f16 on `target` (see the module docs), and at a
+/// BRDF's metallic 1 the metal layer's network `metal` where given (what the
+/// runtime reads there, [`crate::train::BrdfLayer`]). An error if a held-out
+/// BRDF condition lies outside the range or a lit map cannot be built.
+pub fn evaluate(
+    params: &Params,
+    metal: Option<&Params>,
+    target: &LoadedTarget,
+    config: &QualityConfig,
+) -> Result<Quality> {
+    let shared = params.rounded_to_f16();
+    let metal = metal.map(Params::rounded_to_f16);
     let mut conditions = Vec::new();
     // Seconds per condition for a map (exact cap measures of the lit map).
     let progress = Progress::stderr("quality", config.conditions.len() as u64, "condition");
     for (index, &cond) in config.conditions.iter().enumerate() {
         let metallic = config.metallic.get(index).copied().unwrap_or(0.0);
         if let Some(held) = HeldOut::new(target, cond, metallic)? {
-            conditions.push(held.score(&shipped, config, index));
+            let shipped = match &metal {
+                Some(metal) if metallic >= 1.0 => metal,
+                _ => &shared,
+            };
+            conditions.push(held.score(shipped, config, index));
         }
         progress.inc(1);
     }
@@ -375,7 +387,7 @@ mod tests {
         }
         values[shape.layers().last().unwrap().weights] = 4.0;
         let same = Params { shape, values };
-        let q = evaluate(&same, &target, &config).unwrap();
+        let q = evaluate(&same, None, &target, &config).unwrap();
         let judged: Vec<[f64; 2]> = q.conditions.iter().map(|c| c.condition).collect();
         assert_eq!(judged, held_out);
         for c in &q.conditions {

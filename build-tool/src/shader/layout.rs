@@ -168,6 +168,14 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
             "NULD_TAG_BRDF_PRIOR_MASSES",
             SectionTag::BrdfPriorMasses as u64,
         ),
+        (
+            "NULD_TAG_METAL_NETWORK_PARAMS",
+            SectionTag::MetalNetworkParams as u64,
+        ),
+        (
+            "NULD_TAG_METAL_POINT_TABLE",
+            SectionTag::MetalPointTable as u64,
+        ),
         ("NULD_WARP_ENVMAP_TREE", PointWarp::EnvmapTree as u64),
         ("NULD_WARP_BRDF_TABLE", PointWarp::BrdfTable as u64),
         ("NULD_PRIOR_INFO_GRID", at!(BrdfPriorInfo, grid)),

@@ -97,6 +97,10 @@ pub struct TrainConfig {
     /// offset per instance and no per-instance embedding).
     #[serde(default)]
     pub instance_slots: u32,
+    /// Which metallic values a BRDF sampler's network serves, and so which of
+    /// the prior's squares it refines (ignored for an environment map).
+    #[serde(default)]
+    pub layer: BrdfLayer,
     /// Fixes the initialization, the pool and every draw.
     pub seed: u64,
 }
@@ -122,7 +126,38 @@ impl Default for TrainConfig {
             alpha_start: 8.0,
             alpha_end: 64.0,
             instance_slots: 64,
+            layer: BrdfLayer::Shared,
             seed: 0,
+        }
+    }
+}
+
+/// Which of the BRDF prior's squares a network's points serve
+/// ([`nuld_core::brdf_prior`]): a query below metallic 1 warps through the
+/// shared square (the blend of the metallic 0 and 1 layers), one at metallic 1
+/// through the metal layer's own square, whose primary space is another, so
+/// each gets a network of its own (`bake --brdf` trains both). Measured with
+/// `eval conditional` at N = 64 (docs/results/brdf-sampler.md): a network
+/// trained on metals alone scored 0.805 of the exact warp's Owen-Sobol at
+/// metallic 1 (worst 1.071), the one network for both 0.881 (worst 1.480).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum BrdfLayer {
+    /// Metallic below 1: the pool's metallic is `clamp(1.25 v - 0.25, 0, 1)`
+    /// for `v` uniform in `[0, 1)`, a fifth of the pool the pure dielectric
+    /// (what renderers see most), the rest uniform below 1.
+    #[default]
+    Shared,
+    /// Metallic 1 (a glTF metal), through the prior's metal layer.
+    Metal,
+}
+
+impl BrdfLayer {
+    /// A pool condition's metallic from a uniform `v` in `[0, 1)` (see the
+    /// variants).
+    pub fn pool_metallic(self, v: f64) -> f64 {
+        match self {
+            Self::Shared => (1.25 * v - 0.25).clamp(0.0, 1.0),
+            Self::Metal => 1.0,
         }
     }
 }
@@ -212,6 +247,7 @@ impl Trainer {
         let shape = config.shape().expect("valid network shape");
         let pool = ConditionPool::new(
             &config.target,
+            config.layer,
             config.pool_conditions,
             config.pool_caps,
             config.caps_per_step,

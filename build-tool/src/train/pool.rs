@@ -17,6 +17,7 @@
 //! [`crate::sphere::EnvmapDensity::cosine_weighted`].
 
 use super::target::{EnvmapTarget, LoadedTarget, TrainTarget};
+use super::BrdfLayer;
 use crate::baselines::{seeded_owen_sobol, warped_owen_sobol_directions};
 use crate::descent::local_factor;
 use crate::discrepancy::caps::epoch_caps;
@@ -262,12 +263,14 @@ pub struct ConditionPool {
 }
 
 impl ConditionPool {
-    /// `count` conditions of `target` with `caps` caps each, for the sets of a
+    /// `count` conditions of `target` (a BRDF's metallic drawn for `layer`,
+    /// [`BrdfLayer::pool_metallic`]) with `caps` caps each, for the sets of a
     /// network of `shape`, from `seed`; built in parallel, identical for any thread
     /// count. An error if a map cannot be read, or if an environment sampler's
     /// network has the BRDF mixture's lattice residual.
     pub fn new(
         target: &TrainTarget,
+        layer: BrdfLayer,
         count: usize,
         caps: usize,
         window: usize,
@@ -287,7 +290,8 @@ impl ConditionPool {
                 let cond = loaded.condition(u);
                 match &loaded {
                     LoadedTarget::GltfBrdf(prior) => {
-                        let m = pool_metallic(sobol_burley::sample(p as u32, 2, scramble) as f64);
+                        let m =
+                            layer.pool_metallic(sobol_burley::sample(p as u32, 2, scramble) as f64);
                         let cond = [cond[0], cond[1], m];
                         condition(prior, cond, caps, window, shape, seed)
                     }
@@ -312,13 +316,6 @@ impl ConditionPool {
     pub fn is_empty(&self) -> bool {
         self.conditions.is_empty()
     }
-}
-
-/// A pool condition's metallic from a uniform `v`: `clamp(1.5 v - 0.25, 0, 1)`,
-/// so that a sixth of the pool is the pure dielectric, a sixth the pure metal
-/// (the materials renderers see most), the rest uniform between.
-pub fn pool_metallic(v: f64) -> f64 {
-    (1.5 * v - 0.25).clamp(0.0, 1.0)
 }
 
 /// The pool condition `[roughness, θo, metallic]` of the BRDF.
@@ -509,8 +506,16 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("nuld-pool-envmap-{}", std::process::id()));
         let map = crate::sphere::envmap::tiny_map(&dir);
         let shape = Shape::new(8, &[4], Activation::Relu, 3).unwrap();
-        let pool =
-            ConditionPool::new(&TrainTarget::envmap(&map).unwrap(), 3, 64, 32, &shape, 5).unwrap();
+        let pool = ConditionPool::new(
+            &TrainTarget::envmap(&map).unwrap(),
+            BrdfLayer::Shared,
+            3,
+            64,
+            32,
+            &shape,
+            5,
+        )
+        .unwrap();
         let LoadedTarget::Envmap(env) = &pool.target else {
             panic!("an envmap target")
         };

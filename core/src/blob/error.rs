@@ -425,6 +425,35 @@ pub enum ConditionalError {
     },
     /// The [`SectionTag::PointTable`] elements are not 4 bytes (2 x u16).
     PointTableElementSize(u32),
+    /// Metal points ([`SectionTag::MetalNetworkParams`],
+    /// [`SectionTag::MetalPointTable`]) in a blob whose prior has no metal layer
+    /// ([`crate::brdf_prior::has_metal_layer`]), or one of the two without the
+    /// other (its tag).
+    MetalPoints(u32),
+    /// A metal-points section whose elements (tag, size in bytes) differ from
+    /// its shared twin's (2 bytes for the network, 4 for the table).
+    MetalElementSize {
+        /// The section's tag.
+        tag: u32,
+        /// Its element size.
+        size: u32,
+    },
+    /// A metal-points section whose length differs from its shared twin's.
+    MetalLength {
+        /// The section's tag.
+        tag: u32,
+        /// Entries the counts call for.
+        expected: u64,
+        /// Entries present.
+        got: u64,
+    },
+    /// A metal network parameter is an f16 infinity or NaN.
+    NonFiniteMetalParam {
+        /// Its index in the parameter array.
+        index: u64,
+        /// Its f16 bits.
+        bits: u16,
+    },
     /// `grid[0] grid[1] instances n` overflows `u64`.
     PointTableCountOverflow,
     /// The [`SectionTag::PointTable`] section does not hold exactly
@@ -561,6 +590,22 @@ impl core::fmt::Display for ConditionalError {
             Self::PointTableElementSize(s) => {
                 write!(f, "blob point table has {s}-byte elements, not 4 (2 x u16)")
             }
+            Self::MetalPoints(tag) => write!(
+                f,
+                "blob metal points (sections 16 and 17) are incomplete or have no metal layer to serve (section {tag})"
+            ),
+            Self::MetalElementSize { tag, size } => write!(
+                f,
+                "blob metal-points section {tag} has {size}-byte elements, not its shared twin's"
+            ),
+            Self::MetalLength { tag, expected, got } => write!(
+                f,
+                "blob metal-points section {tag} has {got} entries, the counts call for {expected}"
+            ),
+            Self::NonFiniteMetalParam { index, bits } => write!(
+                f,
+                "blob metal network parameter {index} is not finite (f16 bits {bits:#06x})"
+            ),
             Self::PointTableCountOverflow => {
                 write!(
                     f,

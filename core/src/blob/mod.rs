@@ -156,6 +156,15 @@ pub enum SectionTag {
     /// [`crate::conditional::PointWarp::BrdfTable`]); its tables live in the
     /// stretched half-vector square ([`crate::brdf_prior::stretch`]).
     BrdfPriorInfo = 15,
+    /// The metal layer's network ([`crate::brdf_prior::has_metal_layer`]): f16
+    /// bits in the order of [`Self::NetworkParams`], the same shape; read by a
+    /// query at metallic 1 instead of [`Self::NetworkParams`]. Optional, with
+    /// [`Self::MetalPointTable`].
+    MetalNetworkParams = 16,
+    /// The metal layer's point table, laid out as [`Self::PointTable`]; read by a
+    /// query at metallic 1 instead of it. Optional, with
+    /// [`Self::MetalNetworkParams`].
+    MetalPointTable = 17,
 }
 
 /// Contents of the [`SectionTag::PointSetInfo`] section.

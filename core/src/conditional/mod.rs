@@ -441,6 +441,27 @@ pub fn sections<'s>(
     ]
 }
 
+/// The two sections of a BRDF sampler's **metal points** (after
+/// [`sections`] and the prior's): the metal layer's own network and point
+/// table, of the same shape and layout as [`SectionTag::NetworkParams`] and
+/// [`SectionTag::PointTable`], which a query that reads the prior's metal layer
+/// ([`crate::brdf_prior::reads_metal_layer`]) takes its primary points from.
+/// Checks no length: a reader validates them.
+pub fn metal_sections<'s>(params: &'s [u16], table: &'s [u32]) -> [SectionSpec<'s>; 2] {
+    [
+        SectionSpec {
+            tag: SectionTag::MetalNetworkParams,
+            elem_size: 2,
+            bytes: bytemuck::cast_slice(params),
+        },
+        SectionSpec {
+            tag: SectionTag::MetalPointTable,
+            elem_size: 4,
+            bytes: bytemuck::cast_slice(table),
+        },
+    ]
+}
+
 /// The salts of [`randomization_shift`]'s two hashes (the shaders hold them too).
 pub const RANDOMIZE_SALTS: [u32; 2] = [0x5eed_0b1a, 0x68e3_1da4];
 

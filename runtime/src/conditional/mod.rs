@@ -78,6 +78,19 @@ pub struct ConditionalSampler<'a> {
     tree: Option<EnvmapTree<'a>>,
     /// The BRDF prior ([`PointWarp::BrdfTable`] samplers).
     brdf_prior: Option<BrdfPrior<'a, f32>>,
+    /// The metal layer's own network and point table (BRDF samplers whose
+    /// prior has the metal layer, baked with them), read at metallic 1.
+    metal: Option<MetalPoints<'a>>,
+}
+
+/// The learned part of a BRDF prior's metal layer
+/// ([`nuld_core::blob::SectionTag::MetalNetworkParams`] and
+/// [`nuld_core::blob::SectionTag::MetalPointTable`]): the same shape and
+/// layout as the sampler's own network and point table.
+#[derive(Clone, Copy, Debug)]
+struct MetalPoints<'a> {
+    params: NetworkParams<'a>,
+    table: &'a [u32],
 }
 
 /// Where network mode reads its parameters: the blob's f16 bits (zero-copy), or
@@ -213,6 +226,15 @@ impl<'a> ConditionalSampler<'a> {
         self.square_point_at(self.info.normalize(cond.to_array()), instance, i)
     }
 
+    /// [`Self::square_point`] for a BRDF query at `metallic`: the metal layer's
+    /// own point table where the query reads it ([`Self::has_metal_points`],
+    /// metallic 1), else the same. What [`Self::sample_metallic`] warps.
+    /// O(1), never panics.
+    #[inline]
+    pub fn square_point_metallic(&self, cond: Vec2, metallic: f32, instance: u32, i: u32) -> Vec2 {
+        self.at_metallic(metallic).square_point(cond, instance, i)
+    }
+
     /// [`Self::square_point`] at the normalized condition `u`.
     #[inline]
     fn square_point_at(&self, u: [f32; 2], instance: u32, i: u32) -> Vec2 {
@@ -272,10 +294,39 @@ impl<'a> ConditionalSampler<'a> {
         NetworkSampler(*self)
     }
 
+    /// Whether the blob holds the metal layer's own learned points, which a BRDF
+    /// query at metallic 1 reads instead of the shared ones (both modes): a
+    /// BRDF sampler baked on a prior with the metal layer.
+    pub fn has_metal_points(&self) -> bool {
+        self.metal.is_some()
+    }
+
+    /// The sampler whose network and point table serve a query at `metallic`:
+    /// the metal layer's ([`Self::has_metal_points`]) where the query reads the
+    /// prior's metal layer ([`nuld_core::brdf_prior::reads_metal_layer`]:
+    /// metallic 1, clamped), else this one. `O(1)`.
+    #[inline]
+    pub(crate) fn at_metallic(&self, metallic: f32) -> Self {
+        match (&self.metal, &self.brdf_prior) {
+            (Some(m), Some(prior))
+                if nuld_core::brdf_prior::reads_metal_layer(prior.grid(), metallic) =>
+            {
+                Self {
+                    params: m.params,
+                    table: m.table,
+                    ..*self
+                }
+            }
+            _ => *self,
+        }
+    }
+
     /// Length of the `f32` buffer [`Self::decode_network`] needs:
-    /// [`Shape::param_len`], 4 bytes per parameter.
+    /// [`Shape::param_len`], 4 bytes per parameter, twice with the metal
+    /// layer's network ([`Self::has_metal_points`]).
     pub fn decoded_network_len(&self) -> usize {
-        self.shape.param_len()
+        let networks = if self.metal.is_some() { 2 } else { 1 };
+        self.shape.param_len() * networks
     }
 
     /// [`Self::network`] reading the network's parameters decoded to `f32` into
@@ -302,19 +353,23 @@ impl<'a> ConditionalSampler<'a> {
     where
         'a: 'b,
     {
-        let len = self.decoded_network_len();
-        let out = buf.get_mut(..len)?;
-        match self.params {
-            NetworkParams::F16(params) => {
-                if params.len() != len {
-                    return None;
-                }
-                F16Params(params).read(0, out);
+        let len = self.shape.param_len();
+        let out = buf.get_mut(..self.decoded_network_len())?;
+        let (shared, metal_out) = out.split_at_mut(len);
+        decode_params(self.params, shared)?;
+        let metal = match self.metal {
+            Some(m) => {
+                decode_params(m.params, metal_out)?;
+                Some(MetalPoints {
+                    params: NetworkParams::F32(metal_out),
+                    table: m.table,
+                })
             }
-            NetworkParams::F32(params) => out.copy_from_slice(params.get(..len)?),
-        }
+            None => None,
+        };
         Some(NetworkSampler(ConditionalSampler {
-            params: NetworkParams::F32(out),
+            params: NetworkParams::F32(shared),
+            metal,
             ..*self
         }))
     }
@@ -343,11 +398,14 @@ impl<'a> ConditionalSampler<'a> {
 
     /// [`Self::sample`] for a BRDF of metallic `metallic` (clamped into `[0,1]`,
     /// NaN as 0): read by [`PointWarp::BrdfTable`] samplers' prior, ignored by
-    /// every other warp. O(1), never panics.
+    /// every other warp; at metallic 1 the point comes from the metal layer's
+    /// own table where the blob has one ([`Self::square_point_metallic`]).
+    /// O(1), never panics.
     #[inline]
     pub fn sample_metallic(&self, cond: Vec2, metallic: f32, instance: u32, i: u32) -> Sample {
         let u = self.info.normalize(cond.to_array());
-        self.mapped(self.square_point_at(u, instance, i), u, metallic)
+        let points = self.at_metallic(metallic);
+        self.mapped(points.square_point_at(u, instance, i), u, metallic)
     }
 
     /// The **unbiased mode**: point `i` (mod `n`) of the blob's rank-1 lattice,
@@ -474,6 +532,21 @@ impl<'a> ConditionalSampler<'a> {
             pdf: 0.0,
         }
     }
+}
+
+/// Decodes `params` (the blob's f16 bits, or a buffer decoded before) into
+/// `out`, which must be exactly as long; `None` otherwise.
+fn decode_params(params: NetworkParams<'_>, out: &mut [f32]) -> Option<()> {
+    match params {
+        NetworkParams::F16(params) => {
+            if params.len() != out.len() {
+                return None;
+            }
+            F16Params(params).read(0, out);
+        }
+        NetworkParams::F32(params) => out.copy_from_slice(params.get(..out.len())?),
+    }
+    Some(())
 }
 
 /// `v` divided by its largest absolute component, or `None` for a zero, infinite

@@ -49,6 +49,15 @@ impl<'a> NetworkSampler<'a> {
         self.0.network_square_point_at(u, instance, i)
     }
 
+    /// [`Self::square_point`] for a BRDF query at `metallic`: the metal layer's
+    /// own network where the query reads it
+    /// ([`ConditionalSampler::has_metal_points`], metallic 1), else the same.
+    /// What [`Self::sample_metallic`] warps.
+    #[inline]
+    pub fn square_point_metallic(&self, cond: Vec2, metallic: f32, instance: u32, i: u32) -> Vec2 {
+        NetworkSampler(self.0.at_metallic(metallic)).square_point(cond, instance, i)
+    }
+
     /// The direction of index `i` of instance `instance` at condition `cond` (blob
     /// units): [`Self::square_point`] through the target's warp, with the weight of
     /// [`ConditionalSampler::weight`] (as [`ConditionalSampler::sample`] does for
@@ -68,12 +77,14 @@ impl<'a> NetworkSampler<'a> {
     }
 
     /// [`Self::sample`] for a BRDF of metallic `metallic`
-    /// ([`ConditionalSampler::sample_metallic`]).
+    /// ([`ConditionalSampler::sample_metallic`]; at metallic 1 the metal layer's
+    /// own network where the blob has one, [`Self::square_point_metallic`]).
     #[inline]
     pub fn sample_metallic(&self, cond: Vec2, metallic: f32, instance: u32, i: u32) -> Sample {
         let u = self.0.info().normalize(cond.to_array());
+        let points = self.0.at_metallic(metallic);
         self.0
-            .mapped(self.0.network_square_point_at(u, instance, i), u, metallic)
+            .mapped(points.network_square_point_at(u, instance, i), u, metallic)
     }
 
     /// The unbiased mode, the same samples as

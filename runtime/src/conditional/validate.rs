@@ -1,10 +1,10 @@
 //! Validation of a conditional blob's sections against each other, once, in
 //! [`crate::Blob::parse`]: each failed check is its own [`ConditionalError`].
 
-use super::{ConditionalSampler, NetworkParams};
+use super::{ConditionalSampler, MetalPoints, NetworkParams};
 use crate::section::{record, typed_section};
 use nuld_core::blob::{BlobError, ConditionalError, Domain, Layout, SectionTag};
-use nuld_core::brdf_prior::{BrdfPrior, BrdfPriorInfo};
+use nuld_core::brdf_prior::{has_metal_layer, BrdfPrior, BrdfPriorInfo};
 use nuld_core::conditional::{ConditionalInfo, ConditionalTarget, PointWarp};
 use nuld_core::envmap_tree::{
     node_count, top_len, EnvmapTree, NodeRecord, TreeInfo, MAX_TREE_LEVELS, TOP_LEVELS,
@@ -22,7 +22,9 @@ impl<'a> ConditionalSampler<'a> {
     /// at least 2 x 2 nodes; finite condition ranges with `min < max`; a valid
     /// network shape; exactly `param_len` finite f16 parameters,
     /// `grid[0] grid[1] instances n` table entries, and `weight_grid[0]
-    /// weight_grid[1]` finite, non-negative weights.
+    /// weight_grid[1]` finite, non-negative weights; metal points, if any, on a
+    /// BRDF prior with the metal layer, as long as their shared twins, every
+    /// parameter finite.
     pub(crate) fn validate(layout: &Layout<'a>) -> Result<Self, BlobError> {
         let sampler = Self::view(layout)?;
         sampler.check_values()?;
@@ -153,6 +155,7 @@ impl<'a> ConditionalSampler<'a> {
             PointWarp::BrdfTable => Some(brdf_prior(layout, false)?),
             _ => None,
         };
+        let metal = metal_points(layout, &brdf_prior, params.len(), table.len())?;
         Ok(Self {
             info,
             shape,
@@ -164,6 +167,7 @@ impl<'a> ConditionalSampler<'a> {
             weights,
             tree,
             brdf_prior,
+            metal,
         })
     }
 
@@ -187,11 +191,66 @@ impl<'a> ConditionalSampler<'a> {
             let (index, bits) = (index as u64, w.to_bits());
             return fail(ConditionalError::BadWeight { index, bits });
         }
+        if let Some(MetalPoints {
+            params: NetworkParams::F16(params),
+            ..
+        }) = self.metal
+        {
+            let bad = params.iter().enumerate().find(|(_, &h)| !f16_is_finite(h));
+            if let Some((index, &bits)) = bad {
+                let index = index as u64;
+                return fail(ConditionalError::NonFiniteMetalParam { index, bits });
+            }
+        }
         if let Some(tree) = &self.tree {
             tree.check_values().map_err(ConditionalError::Tree)?;
         }
         Ok(())
     }
+}
+
+/// The metal layer's network and point table, if the blob has them: both
+/// sections, on a BRDF prior with the metal layer, each as long as its shared
+/// twin (`params` and `table` entries). `O(1)`.
+fn metal_points<'a>(
+    layout: &Layout<'a>,
+    prior: &Option<BrdfPrior<'a, f32>>,
+    params: usize,
+    table: usize,
+) -> Result<Option<MetalPoints<'a>>, BlobError> {
+    let tags = [SectionTag::MetalNetworkParams, SectionTag::MetalPointTable];
+    let present = tags.map(|t| layout.section(t).is_ok());
+    if present == [false; 2] {
+        return Ok(None);
+    }
+    let layer = prior.is_some_and(|p| has_metal_layer(p.grid()));
+    if let Some(i) = present.iter().position(|&p| !p || !layer) {
+        return fail(ConditionalError::MetalPoints(tags[i] as u32));
+    }
+    Ok(Some(MetalPoints {
+        params: NetworkParams::F16(metal_section(layout, tags[0], params)?),
+        table: metal_section(layout, tags[1], table)?,
+    }))
+}
+
+/// Metal-points section `tag` as `len` elements of its shared twin's type.
+fn metal_section<'a, T: bytemuck::Pod>(
+    layout: &Layout<'a>,
+    tag: SectionTag,
+    len: usize,
+) -> Result<&'a [T], BlobError> {
+    let code = tag as u32;
+    typed_section(
+        layout,
+        tag,
+        |size| ConditionalError::MetalElementSize { tag: code, size },
+        || Ok(len as u64),
+        |expected, got| ConditionalError::MetalLength {
+            tag: code,
+            expected,
+            got,
+        },
+    )
 }
 
 /// A tree section of the wrong length.

@@ -98,6 +98,7 @@ pub fn random_parts(
         table,
         weights,
         prior,
+        metal: None,
     })
 }
 /// `parts` (of a lattice-residual network) as an environment sampler on the
