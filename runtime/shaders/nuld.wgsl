@@ -495,13 +495,16 @@ fn nuld_conditional() -> NuldConditional {
 // layer (metallic 1, clamped, NaN as 0), else the blob's.
 fn nuld_conditional_at_metallic(metallic: f32) -> NuldConditional {
     var cs = nuld_conditional();
-    let params = nuld_section(NULD_TAG_METAL_NETWORK_PARAMS);
-    let table = nuld_section(NULD_TAG_METAL_POINT_TABLE);
-    // A section never starts at byte 0 (the header): 0 is "absent".
-    if cs.info.warp == NULD_WARP_BRDF_TABLE && params != 0u && table != 0u
-        && nuld_reads_metal_layer(nuld_brdf_prior(), metallic) {
-        cs.params = params;
-        cs.table = table;
+    // The sections exist only on a prior with the metal layer (validation), so
+    // metallic 1 is the whole test; below it nothing more is read.
+    if cs.info.warp == NULD_WARP_BRDF_TABLE && nuld_clamp01(metallic) >= 1.0 {
+        let params = nuld_section(NULD_TAG_METAL_NETWORK_PARAMS);
+        let table = nuld_section(NULD_TAG_METAL_POINT_TABLE);
+        // A section never starts at byte 0 (the header): 0 is "absent".
+        if params != 0u && table != 0u {
+            cs.params = params;
+            cs.table = table;
+        }
     }
     return cs;
 }

@@ -101,19 +101,14 @@ pub fn distilled_parts(
         ..config.clone()
     });
     let trainer = trained(config);
-    let mut parts = nuld_build_tool::conditional::distill::distill(
+    nuld_build_tool::conditional::distill::distill(
         &trainer.params(),
+        Some(&metal.params()),
         &trainer.pool.target,
         instances,
         grid,
         weight_grid,
-    );
-    parts.metal = Some(nuld_build_tool::conditional::distill::distill_metal(
-        &metal.params(),
-        instances,
-        grid,
-    ));
-    parts
+    )
 }
 
 /// A tree of 4 levels (top weights on 3 x 3 normals) over a closed-form light, a
@@ -158,21 +153,15 @@ pub fn small_brdf_prior() -> std::sync::Arc<nuld_build_tool::sphere::brdf_prior:
 }
 
 /// `parts` (a [`nuld_core::conditional::PointWarp::BrdfTable`] sampler on a
-/// prior with the metal layer) with random metal points, as
-/// [`conditional_parts`] makes its own: a network of the same shape with f16
-/// parameters uniform in `[-0.6, 0.6]` and a point table of random codes.
-/// Deterministic for a seed.
+/// prior with the metal layer) with random metal points
+/// ([`nuld_build_tool::lab::bench::runtime::random_metal_points`]).
 pub fn with_metal_points(
     mut parts: nuld_build_tool::conditional::blob::ConditionalParts,
     seed: u64,
 ) -> nuld_build_tool::conditional::blob::ConditionalParts {
-    use rand::{Rng, SeedableRng};
-    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
-    let params = (0..parts.params.len())
-        .map(|_| nuld_core::quantize::f16_encode(rng.random_range(-0.6f32..=0.6)))
-        .collect();
-    let table = (0..parts.table.len()).map(|_| rng.random()).collect();
-    parts.metal = Some(nuld_build_tool::conditional::blob::MetalParts { params, table });
+    parts.metal = Some(nuld_build_tool::lab::bench::runtime::random_metal_points(
+        &parts, seed,
+    ));
     parts
 }
 

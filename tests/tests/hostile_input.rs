@@ -120,10 +120,19 @@ fn envmap_blob() -> AlignedBytes {
 /// a small prior (3 x 2 x 3 conditions, 5 x 5 vertices: [`small_brdf_prior`]) so
 /// that every truncation stays cheap.
 fn brdf_table_blob() -> AlignedBytes {
-    let shape = shape(4, &[3, 2], Activation::Relu, PointWarp::BrdfTable, 2);
-    let parts = with_brdf_prior(conditional_parts(shape, 2, [3, 2], 7), small_brdf_prior());
     // The small prior has the metal layer, which its own points serve.
-    with_metal_points(parts, 8).to_blob(&META).unwrap()
+    brdf_table_parts(small_brdf_prior()).to_blob(&META).unwrap()
+}
+
+/// [`brdf_table_blob`]'s parts on `prior`, with metal points.
+fn brdf_table_parts(
+    prior: std::sync::Arc<nuld_build_tool::sphere::brdf_prior::BrdfPrior>,
+) -> nuld_build_tool::conditional::blob::ConditionalParts {
+    let shape = shape(4, &[3, 2], Activation::Relu, PointWarp::BrdfTable, 2);
+    with_metal_points(
+        with_brdf_prior(conditional_parts(shape, 2, [3, 2], 7), prior),
+        8,
+    )
 }
 
 fn valid_blobs() -> Vec<AlignedBytes> {
@@ -560,13 +569,6 @@ fn a_brdf_prior_with_four_metallic_layers_is_refused() {
 #[test]
 fn each_metal_points_failure_has_its_error() {
     use nuld_build_tool::sphere::brdf_prior::{BrdfPrior, PriorSpace};
-    let parts = |prior| {
-        let shape = shape(4, &[3, 2], Activation::Relu, PointWarp::BrdfTable, 2);
-        with_metal_points(
-            with_brdf_prior(conditional_parts(shape, 2, [3, 2], 7), prior),
-            8,
-        )
-    };
     let blob = brdf_table_blob();
     let b = blob.as_slice();
     let count = u32::from_le_bytes(b[SECTION_COUNT..SECTION_COUNT + 4].try_into().unwrap());
@@ -582,9 +584,9 @@ fn each_metal_points_failure_has_its_error() {
     );
     let params_len = get_u64(b, params_row + LEN);
     let table_len = get_u64(b, table_row + LEN);
-    let mut bad_param = parts(small_brdf_prior());
+    let mut bad_param = brdf_table_parts(small_brdf_prior());
     bad_param.metal.as_mut().unwrap().params[5] = 0x7c00;
-    let no_layer = parts(std::sync::Arc::new(
+    let no_layer = brdf_table_parts(std::sync::Arc::new(
         BrdfPrior::new([3, 2, 2], 5, PriorSpace::HalfVector).unwrap(),
     ));
     let error = |p: nuld_build_tool::conditional::blob::ConditionalParts| {

@@ -9,10 +9,10 @@
 //! normals over the sphere's square), and while training
 //! `checkpoint.bin` (every [`BakeConfig::checkpoint_every`], and at the end), from
 //! which `resume` continues bit for bit; a BRDF bake trains a second network for
-//! the prior's metal layer after the first ([`BakeConfig::metal_points`],
+//! the prior's metal layer after the first ([`BakeConfig::metal_train`],
 //! `checkpoint-metal.bin`). Every file is written atomically.
 
-use super::distill::{distill, distill_metal};
+use super::distill::distill;
 use super::quality::{evaluate, instance_directions, Quality, QualityConfig};
 use crate::plot::{render_loglog, render_square_panels, Series, SquarePanel};
 use crate::progress::Progress;
@@ -48,10 +48,6 @@ pub struct BakeConfig {
     pub checkpoint_every: Duration,
     /// Continue from the directory's checkpoints.
     pub resume: bool,
-    /// A BRDF sampler also trains the metal layer's own network
-    /// ([`crate::train::BrdfLayer::Metal`], `checkpoint-metal.bin`), which a
-    /// query at metallic 1 reads; ignored for an environment map.
-    pub metal_points: bool,
 }
 
 impl Default for BakeConfig {
@@ -64,7 +60,6 @@ impl Default for BakeConfig {
             quality_grid: 4,
             checkpoint_every: Duration::from_secs(120),
             resume: false,
-            metal_points: true,
         }
     }
 }
@@ -160,11 +155,11 @@ impl BakeConfig {
         format!("{}.nuld", self.train.target.name())
     }
 
-    /// The training run of the metal layer's network: [`Self::train`] on
-    /// metals ([`BrdfLayer::Metal`]), for a BRDF sampler with
-    /// [`Self::metal_points`]; `None` otherwise.
+    /// The training run of a BRDF sampler's second network, the metal layer's:
+    /// [`Self::train`] on metals ([`BrdfLayer::Metal`]); `None` for an
+    /// environment map.
     pub fn metal_train(&self) -> Option<TrainConfig> {
-        (self.metal_points && self.train.target == TrainTarget::GltfBrdf).then(|| TrainConfig {
+        (self.train.target == TrainTarget::GltfBrdf).then(|| TrainConfig {
             layer: BrdfLayer::Metal,
             ..self.train.clone()
         })
@@ -305,16 +300,14 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     let params = trainer.params();
     let metal_params = metal_trainer.as_ref().map(Trainer::params);
     let target = &trainer.pool.target;
-    let mut parts = distill(
+    let parts = distill(
         &params,
+        metal_params.as_ref(),
         target,
         config.instances,
         config.grid,
         config.weight_grid,
     );
-    parts.metal = metal_params
-        .as_ref()
-        .map(|m| distill_metal(m, config.instances, config.grid));
     let blob = parts.to_blob(&Metadata {
         generator: "bake",
         target: config.train.target.name(),

@@ -15,8 +15,9 @@
 //! * **prior**: an environment sampler on the tree
 //!   ([`PointWarp::EnvmapTree`]) carries the map's tree, which the pool trained
 //!   through;
-//! * **metal points** ([`distill_metal`]): a BRDF sampler's second network,
-//!   trained on metals through the prior's metal layer, and its point table.
+//! * **metal points**: a BRDF sampler's second network (`metal`, trained on
+//!   metals through the prior's metal layer, [`crate::train::BrdfLayer::Metal`]),
+//!   as f16 bits with its point table, made as the first's.
 
 use super::blob::{MetalParts, Prior};
 use super::ConditionalParts;
@@ -66,10 +67,12 @@ pub fn info(
     }
 }
 
-/// The blob's parts for `params` trained on `target` (see the module docs).
+/// The blob's parts for `params` trained on `target` (see the module docs), with
+/// the metal points of `metal` (a network of the same shape) where given.
 /// Parallel over grid nodes; identical for any thread count.
 pub fn distill(
     params: &Params,
+    metal: Option<&Params>,
     target: &LoadedTarget,
     instances: u32,
     grid: [u32; 2],
@@ -95,18 +98,10 @@ pub fn distill(
         table,
         weights,
         prior,
-        metal: None,
-    }
-}
-
-/// The metal layer's learned part for `metal`, a network trained on metals
-/// ([`crate::train::BrdfLayer::Metal`]) of the same shape as the sampler's own:
-/// its f16 parameters and its point table on the sampler's `grid` for
-/// `instances` instances, as [`distill`] makes them.
-pub fn distill_metal(metal: &Params, instances: u32, grid: [u32; 2]) -> MetalParts {
-    MetalParts {
-        params: metal.to_f16_bits(),
-        table: point_table(metal, instances, grid),
+        metal: metal.map(|metal| MetalParts {
+            params: metal.to_f16_bits(),
+            table: point_table(metal, instances, grid),
+        }),
     }
 }
 
@@ -199,7 +194,7 @@ mod tests {
     fn table_holds_the_shipped_network_and_weights_the_albedo() {
         let shape = Shape::new(5, &[6], Activation::Relu, 2).unwrap();
         let params = Params::init(shape, 4);
-        let parts = distill(&params, &LoadedTarget::gltf_brdf(), 3, [3, 2], [4, 3]);
+        let parts = distill(&params, None, &LoadedTarget::gltf_brdf(), 3, [3, 2], [4, 3]);
         assert_eq!(parts.table.len(), 3 * 2 * 3 * 5);
         assert_eq!(parts.weights.len(), 12);
         // Entry (node (2, 1), instance 2, index 4) against the network evaluated by

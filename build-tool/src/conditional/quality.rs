@@ -28,6 +28,7 @@ use crate::train::target::{EnvmapTarget, LoadedTarget};
 use anyhow::Result;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
+use nuld_core::brdf_prior::reads_metal_layer;
 use nuld_core::conditional::{randomized_point, ConditionalTarget, PointWarp};
 use nuld_core::envmap_tree::EnvmapTree as CoreTree;
 use nuld_core::sphere::square_to_sphere;
@@ -328,8 +329,12 @@ pub fn evaluate(
     for (index, &cond) in config.conditions.iter().enumerate() {
         let metallic = config.metallic.get(index).copied().unwrap_or(0.0);
         if let Some(held) = HeldOut::new(target, cond, metallic)? {
-            let shipped = match &metal {
-                Some(metal) if metallic >= 1.0 => metal,
+            let shipped = match (&metal, target) {
+                (Some(metal), LoadedTarget::GltfBrdf(prior))
+                    if reads_metal_layer(prior.grid, metallic) =>
+                {
+                    metal
+                }
                 _ => &shared,
             };
             conditions.push(held.score(shipped, config, index));

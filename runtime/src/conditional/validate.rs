@@ -177,9 +177,7 @@ impl<'a> ConditionalSampler<'a> {
         let NetworkParams::F16(params) = self.params else {
             return Ok(());
         };
-        let bad_param = params.iter().enumerate().find(|(_, &h)| !f16_is_finite(h));
-        if let Some((index, &bits)) = bad_param {
-            let index = index as u64;
+        if let Some((index, bits)) = first_non_finite(params) {
             return fail(ConditionalError::NonFiniteParam { index, bits });
         }
         let bad_weight = self
@@ -196,9 +194,7 @@ impl<'a> ConditionalSampler<'a> {
             ..
         }) = self.metal
         {
-            let bad = params.iter().enumerate().find(|(_, &h)| !f16_is_finite(h));
-            if let Some((index, &bits)) = bad {
-                let index = index as u64;
+            if let Some((index, bits)) = first_non_finite(params) {
                 return fail(ConditionalError::NonFiniteMetalParam { index, bits });
             }
         }
@@ -207,6 +203,15 @@ impl<'a> ConditionalSampler<'a> {
         }
         Ok(())
     }
+}
+
+/// The index and bits of the first f16 infinity or NaN in `params`.
+fn first_non_finite(params: &[u16]) -> Option<(u64, u16)> {
+    let (index, &bits) = params
+        .iter()
+        .enumerate()
+        .find(|(_, &h)| !f16_is_finite(h))?;
+    Some((index as u64, bits))
 }
 
 /// The metal layer's network and point table, if the blob has them: both

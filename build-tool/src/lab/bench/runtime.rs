@@ -7,7 +7,7 @@
 //! Speed does not depend on the network's or the table's values, so the samplers
 //! are timed on blobs with random contents ([`random_parts`]).
 
-use crate::conditional::blob::{ConditionalParts, Prior};
+use crate::conditional::blob::{ConditionalParts, MetalParts, Prior};
 use crate::conditional::distill::info;
 use crate::pointset::AlignedBytes;
 use crate::sphere::{BrdfTarget, DirectionDensity, EnvmapTree};
@@ -73,13 +73,10 @@ pub fn random_parts(
     if shape.lattice_residual() {
         info.warp = warp as u32;
     }
-    let params = (0..shape.param_len())
-        .map(|_| nuld_core::quantize::f16_encode(rng.random_range(-0.6f32..=0.6)))
-        .collect();
     let table_len = info
         .point_table_len()
         .ok_or_else(|| anyhow!("point table size overflows"))?;
-    let table = (0..table_len).map(|_| rng.random()).collect();
+    let MetalParts { params, table } = random_points(shape.param_len(), table_len, &mut rng);
     let nodes = info.weight_table_len();
     let weights = (0..nodes * info.weight_tables())
         .map(|e| {
@@ -100,6 +97,25 @@ pub fn random_parts(
         prior,
         metal: None,
     })
+}
+
+/// A network's f16 parameters uniform in `[-0.6, 0.6]` (`params` of them) and a
+/// point table of `table` random codes: [`random_parts`]' learned part.
+fn random_points(params: usize, table: u64, rng: &mut impl Rng) -> MetalParts {
+    MetalParts {
+        params: (0..params)
+            .map(|_| nuld_core::quantize::f16_encode(rng.random_range(-0.6f32..=0.6)))
+            .collect(),
+        table: (0..table).map(|_| rng.random()).collect(),
+    }
+}
+
+/// Random metal points for `parts` (a [`PointWarp::BrdfTable`] sampler on a
+/// prior with the metal layer): a network and point table as long as its own,
+/// drawn as [`random_parts`] draws them. Deterministic for a seed.
+pub fn random_metal_points(parts: &ConditionalParts, seed: u64) -> MetalParts {
+    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
+    random_points(parts.params.len(), parts.table.len() as u64, &mut rng)
 }
 /// `parts` (of a lattice-residual network) as an environment sampler on the
 /// prior `tree`: the sphere, conditions the normal's octahedral square `[0,1]^2`,
