@@ -29,8 +29,10 @@
 //! different sets.
 //!
 //! Deterministic for a seed whatever the thread count: every random stream is
-//! `derive_seed` of the run seed, the condition's index and a fixed stream number,
-//! and every parallel reduction runs in a fixed order.
+//! `derive_seed` of the condition's seed ([`condition_seed`]: the run seed and the
+//! condition's own values, so a condition scores the same whatever else the list
+//! holds) and a fixed stream number, and every parallel reduction runs in a fixed
+//! order.
 
 pub mod report;
 pub mod sets;
@@ -241,6 +243,15 @@ impl ConditionalSettings {
     }
 }
 
+/// The seed of condition `c = (roughness, theta_o, metallic)` under run seed
+/// `seed`: [`derive_seed`] chained over the bits of each value. It depends on
+/// the condition alone, not on its place in the list, so adding or reordering
+/// conditions (`--metallic 1` against `--metallic 0,0.5,1`) leaves every other
+/// condition's caps, scrambles and direct optimization as they were.
+pub fn condition_seed(seed: u64, c: [f64; 3]) -> u64 {
+    c.iter().fold(seed, |s, v| derive_seed(s, v.to_bits()))
+}
+
 /// Stream numbers of [`derive_seed`] under a condition's seed.
 const CAPS_L2_STREAM: u64 = 1;
 const CAPS_STAR_STREAM: u64 = 2;
@@ -317,7 +328,7 @@ pub fn evaluate(
         progress.set_context(format!(
             "roughness {roughness}, theta_o {theta}, metallic {metallic}"
         ));
-        let cond_seed = derive_seed(settings.seed, ci as u64);
+        let cond_seed = condition_seed(settings.seed, [roughness, theta, metallic]);
         let target = BrdfTarget::metallic(roughness, theta, metallic, Domain::Hemisphere)?;
         let measure = |w: DVec3, t: f64| target.cap_measure(w, t);
         let judge = Judge {
@@ -518,7 +529,7 @@ mod tests {
                 let ci = conditions.iter().position(|&c| c == [r, t, m]).unwrap();
                 let u = seeded_owen_sobol(
                     n,
-                    derive_seed(derive_seed(seed, ci as u64), SCRAMBLE_STREAM + k as u64),
+                    derive_seed(condition_seed(seed, [r, t, m]), SCRAMBLE_STREAM + k as u64),
                 );
                 warps[ci].warp_all(&u)
             }
@@ -551,6 +562,40 @@ mod tests {
         assert!(metal.summary[1].worst_ratio_exact > 1.5);
         assert_eq!(metal.summary[1].worst_condition[2], 1.0);
         assert_eq!(rep.by_metallic[0].summary[1].mean_ratio_exact, 1.0);
+    }
+
+    /// A condition scores the same alone as in a longer list: its seed is its
+    /// own, not its place in the list (the metals come last in `[0, 1]`, first
+    /// in `[1]`).
+    #[test]
+    fn a_condition_scores_the_same_whatever_the_list() {
+        let calibration = MixtureOwenSobol::new(64, 5);
+        let both = evaluate(&[&calibration], &small(&[0.0, 1.0])).unwrap();
+        let metals = evaluate(&[&calibration], &small(&[1.0])).unwrap();
+        assert_eq!(metals.conditions.len(), 2);
+        for m in &metals.conditions {
+            let b = both
+                .conditions
+                .iter()
+                .find(|b| {
+                    [b.roughness, b.theta_o_deg, b.metallic]
+                        == [m.roughness, m.theta_o_deg, m.metallic]
+                })
+                .unwrap();
+            assert_eq!(m.exact.cap_l2, b.exact.cap_l2);
+            assert_eq!(m.mixture.cap_l2, b.mixture.cap_l2);
+            assert_eq!(m.samplers[0].cap_l2, b.samplers[0].cap_l2);
+        }
+        // The seeds do differ between conditions.
+        let s = small(&[0.0, 1.0]);
+        let seeds: Vec<u64> = s
+            .conditions
+            .iter()
+            .map(|&c| condition_seed(s.seed, c))
+            .collect();
+        for (i, a) in seeds.iter().enumerate() {
+            assert!(seeds[i + 1..].iter().all(|b| b != a));
+        }
     }
 
     #[test]
