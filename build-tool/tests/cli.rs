@@ -753,6 +753,32 @@ fn shader_writes_each_language_or_fails_cleanly() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `eval brdf-prior --sets K` judges a blob's instances 0 to K-1: a K beyond
+/// the instances the blob stores (3 here) is refused in one line before
+/// anything is written.
+#[test]
+fn eval_brdf_prior_refuses_more_sets_than_the_blob_stores() {
+    let dir = scratch("eval-prior-sets");
+    let file = dir.join("brdf.nuld");
+    conditional_blob(&file);
+    let out = dir.join("eval");
+    let output = build_tool()
+        .args(["eval", "brdf-prior", "--sets", "4", "--blob"])
+        .arg(&file)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(!output.status.success());
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        err.contains("--sets 4 exceeds the 3 instances the blob stores"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// `eval conditional --blob` reads a blob file (16-byte aligned, as `Blob::parse`
 /// demands) and judges its table and network modes through the runtime: the
 /// report's first rows are those two samplers, with finite ratios.

@@ -139,7 +139,8 @@ pub struct EvalArgs {
     #[arg(long, default_value_t = 16, value_parser = super::count)]
     pub conditions: usize,
     /// brdf-prior: sets averaged per condition and method (Owen-Sobol
-    /// scrambles, lattice shifts, a blob's instances 0 to K-1; 1 to 64). More
+    /// scrambles, lattice shifts, a blob's instances 0 to K-1; 1 to 64, and
+    /// at most the instances a blob stores). More
     /// sets shrink the judge's own noise, which is largest at smooth grazing
     /// conditions, where one set's discrepancy varies most.
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=64))]
@@ -317,12 +318,23 @@ fn run_brdf_prior(a: &EvalArgs) -> Result<()> {
         Some(path) => Some(crate::pointset::AlignedBytes::read(path)?),
         None => None,
     };
-    // A blob's judge takes its N.
+    // A blob's judge takes its N, and its sets are the blob's stored instances
+    // (table mode repeats them beyond `S`, which would count a set twice).
     let n = match &blob {
-        Some(bytes) => nuld_runtime::Blob::parse(bytes.as_slice())
-            .and_then(|b| b.brdf())
-            .map_err(|e| anyhow::anyhow!("{}: {e}", a.blob.as_ref().unwrap().display()))?
-            .len(),
+        Some(bytes) => {
+            let info = *nuld_runtime::Blob::parse(bytes.as_slice())
+                .and_then(|b| b.brdf())
+                .map_err(|e| anyhow::anyhow!("{}: {e}", a.blob.as_ref().unwrap().display()))?
+                .conditional()
+                .info();
+            anyhow::ensure!(
+                a.sets <= info.instances,
+                "--sets {} exceeds the {} instances the blob stores",
+                a.sets,
+                info.instances
+            );
+            info.n
+        }
         None => u32::try_from(a.n).map_err(|_| anyhow::anyhow!("--n {} is too large", a.n))?,
     };
     let s = BrdfPriorSettings {
