@@ -487,6 +487,7 @@ fn conditional_blob(path: &Path) {
         weights,
         prior: None,
         metal: None,
+        metallic_nodes: Vec::new(),
     };
     let meta = nuld_core::blob::Metadata {
         generator: "cli-test",
@@ -666,6 +667,11 @@ fn envmap_bake_and_sample_reject_bad_input_with_one_line() {
         "{e}"
     );
     assert_eq!(e.trim().lines().count(), 1, "{e}");
+    // Metallic nodes out of order, out of [0, 1], too few, not numbers.
+    for nodes in ["0.5,0.2", "0,1.5", "0.5", "0,x"] {
+        let e = failure(&["bake", "--brdf", "--metallic-nodes", nodes], &out);
+        assert!(e.contains("--metallic-nodes"), "{nodes}: {e}");
+    }
     assert!(!out.exists());
     // A map that exists but does not decode fails in the pool, after the output
     // directory was made: it goes again.

@@ -42,6 +42,8 @@ const NULD_SECTION_ENTRY_LEN: u32 = 32u;
 // blob that fits a buffer).
 const NULD_SECTION_TAG: u32 = 0u;
 const NULD_SECTION_OFFSET: u32 = 8u;
+// `SectionEntry::len` in bytes (a u64; its high word is 0 as the offset's).
+const NULD_SECTION_LEN: u32 = 16u;
 // `MAX_SECTIONS`: rows a valid blob has at most.
 const NULD_MAX_SECTIONS: u32 = 64u;
 
@@ -67,6 +69,9 @@ const NULD_TAG_BRDF_PRIOR_CONDITIONAL: u32 = 13u;
 const NULD_TAG_BRDF_PRIOR_MASSES: u32 = 14u;
 const NULD_TAG_METAL_NETWORK_PARAMS: u32 = 16u;
 const NULD_TAG_METAL_POINT_TABLE: u32 = 17u;
+const NULD_TAG_METALLIC_NODES: u32 = 18u;
+// `MAX_METALLIC_NODES` (core/src/conditional/metallic_axis.rs).
+const NULD_MAX_METALLIC_NODES: u32 = 8u;
 
 // `Domain` codes.
 const NULD_DOMAIN_SQUARE: u32 = 0u;
@@ -190,11 +195,22 @@ fn nuld_kind() -> u32 {
 // with this tag; 0 (the header) if there is none, which a valid blob of the kind
 // that needs the section never has.
 fn nuld_section(tag: u32) -> u32 {
+    return nuld_section_field(tag, NULD_SECTION_OFFSET);
+}
+
+// The length in bytes of the first section with this tag; 0 if there is none.
+fn nuld_section_len(tag: u32) -> u32 {
+    return nuld_section_field(tag, NULD_SECTION_LEN);
+}
+
+// The u32 at byte `field` of the first section-table row with this tag; 0 if
+// there is none.
+fn nuld_section_field(tag: u32, field: u32) -> u32 {
     let count = min(nuld_u32(NULD_HEADER_SECTION_COUNT), NULD_MAX_SECTIONS);
     for (var r = 0u; r < count; r++) {
         let row = NULD_HEADER_LEN + r * NULD_SECTION_ENTRY_LEN;
         if nuld_u32(row + NULD_SECTION_TAG) == tag {
-            return nuld_u32(row + NULD_SECTION_OFFSET);
+            return nuld_u32(row + field);
         }
     }
     return 0u;
@@ -470,13 +486,16 @@ fn nuld_instances() -> u32 {
 }
 
 // Rust: `ConditionalSampler` (`ConditionalSampler::view`): the info record and the
-// byte offsets of the network, point-table and weight sections, read once per
+// byte offsets of the network, point-table and weight sections, and of the
+// metallic axis (section 18) with its node count (0: no axis), read once per
 // sample by the `nuld_sample*` functions and passed to the `*_of` functions.
 struct NuldConditional {
     info: NuldConditionalInfo,
     params: u32,
     table: u32,
     weights: u32,
+    metallic_nodes: u32,
+    metallic_count: u32,
 }
 
 // Rust: `Blob::conditional`: the sampler of the blob in `nuld_blob`.
@@ -486,6 +505,9 @@ fn nuld_conditional() -> NuldConditional {
         nuld_section(NULD_TAG_NETWORK_PARAMS),
         nuld_section(NULD_TAG_POINT_TABLE),
         nuld_section(NULD_TAG_WEIGHT_TABLE),
+        nuld_section(NULD_TAG_METALLIC_NODES),
+        // 2 to 8 in a valid blob with the section, 0 without.
+        min(nuld_section_len(NULD_TAG_METALLIC_NODES) / 4u, NULD_MAX_METALLIC_NODES),
     );
 }
 
@@ -504,6 +526,8 @@ fn nuld_conditional_at_metallic(metallic: f32) -> NuldConditional {
         if params != 0u && table != 0u {
             cs.params = params;
             cs.table = table;
+            // The metal layer's network and table have no metallic axis.
+            cs.metallic_count = 0u;
         }
     }
     return cs;
@@ -600,21 +624,63 @@ fn nuld_weight_table_lerp(cs: NuldConditional, cell: NuldGridCell, table: u32) -
 }
 
 // Rust: `ConditionalSampler::square_point` (table mode): the four stored points of
-// the cell around `cond`, interpolated bilinearly per coordinate.
+// the cell around `cond`, interpolated bilinearly per coordinate (at metallic 0
+// with a metallic axis).
 fn nuld_square_point(cond: vec2<f32>, instance: u32, i: u32) -> vec2<f32> {
     let cs = nuld_conditional();
-    return nuld_square_point_of(cs, nuld_normalize(cs.info, cond), instance, i);
+    return nuld_square_point_of(cs, nuld_normalize(cs.info, cond), 0.0, instance, i);
 }
 
-// `nuld_square_point` at the normalized condition `u` of the sampler `cs`.
-fn nuld_square_point_of(cs: NuldConditional, u: vec2<f32>, instance: u32, i: u32) -> vec2<f32> {
+// Rust: `ConditionalSampler::square_point_at`: `nuld_square_point` at the
+// normalized condition `u` of the sampler `cs`; with a metallic axis the points
+// of the two layers around `metallic` blended by `a + (b - a) t`.
+fn nuld_square_point_of(cs: NuldConditional, u: vec2<f32>, metallic: f32, instance: u32, i: u32) -> vec2<f32> {
+    if cs.metallic_count < 2u {
+        return nuld_layer_point(cs, u, 0u, instance, i);
+    }
+    let m = nuld_metallic_cell(cs, metallic);
+    let a = nuld_layer_point(cs, u, m.j0, instance, i);
+    let b = nuld_layer_point(cs, u, m.j0 + 1u, instance, i);
+    return vec2<f32>(a.x + (b.x - a.x) * m.t, a.y + (b.y - a.y) * m.t);
+}
+
+// Rust: `MetallicCell` (core/src/conditional/metallic_axis.rs).
+struct NuldMetallicCell {
+    j0: u32,
+    t: f32,
+}
+
+// Rust: `MetallicCell::locate`: `metallic` clamped into the axis (NaN as its
+// first node), the last layer below the top whose node is `<= m`, and the
+// fraction of the way to the next.
+fn nuld_metallic_cell(cs: NuldConditional, metallic: f32) -> NuldMetallicCell {
+    let first = nuld_f32(cs.metallic_nodes);
+    let last = nuld_f32(cs.metallic_nodes + 4u * (cs.metallic_count - 1u));
+    var m = first;
+    if !nuld_is_nan(metallic) {
+        m = clamp(metallic, first, last);
+    }
+    let top = cs.metallic_count - 2u;
+    var j0 = 0u;
+    while j0 < top && nuld_f32(cs.metallic_nodes + 4u * (j0 + 1u)) <= m {
+        j0 = j0 + 1u;
+    }
+    let a = nuld_f32(cs.metallic_nodes + 4u * j0);
+    let b = nuld_f32(cs.metallic_nodes + 4u * (j0 + 1u));
+    return NuldMetallicCell(j0, clamp((m - a) / (b - a), 0.0, 1.0));
+}
+
+// Rust: `ConditionalSampler::layer_point`: layer `layer`'s (0 without an axis)
+// four stored points around `u`, interpolated bilinearly per coordinate.
+fn nuld_layer_point(cs: NuldConditional, u: vec2<f32>, layer: u32, instance: u32, i: u32) -> vec2<f32> {
     let cell = nuld_locate(u, cs.info.grid);
     let k = instance % cs.info.instances;
     let j = i % cs.info.n;
-    let p00 = nuld_corner_point(cs, cell, 0u, 0u, k, j);
-    let p10 = nuld_corner_point(cs, cell, 1u, 0u, k, j);
-    let p01 = nuld_corner_point(cs, cell, 0u, 1u, k, j);
-    let p11 = nuld_corner_point(cs, cell, 1u, 1u, k, j);
+    let base = layer * cs.info.grid.x * cs.info.grid.y;
+    let p00 = nuld_corner_point(cs, cell, base, 0u, 0u, k, j);
+    let p10 = nuld_corner_point(cs, cell, base, 1u, 0u, k, j);
+    let p01 = nuld_corner_point(cs, cell, base, 0u, 1u, k, j);
+    let p11 = nuld_corner_point(cs, cell, base, 1u, 1u, k, j);
     return vec2<f32>(
         nuld_lerp(cell, p00.x, p10.x, p01.x, p11.x),
         nuld_lerp(cell, p00.y, p10.y, p01.y, p11.y),
@@ -627,10 +693,11 @@ fn nuld_point_table_index(info: NuldConditionalInfo, node: u32, instance: u32, i
     return (node * info.instances + instance) * info.n + i;
 }
 
-// Rust: the `code` closure of `ConditionalSampler::square_point_at`, decoded: the
-// point stored at corner `(dx, dy)` of `cell` for instance `k`, index `j`.
-fn nuld_corner_point(cs: NuldConditional, cell: NuldGridCell, dx: u32, dy: u32, k: u32, j: u32) -> vec2<f32> {
-    let at = nuld_point_table_index(cs.info, nuld_node(cell, dx, dy), k, j);
+// Rust: the `corner` closure of `ConditionalSampler::table_corners`, decoded:
+// the point stored at corner `(dx, dy)` of `cell` for instance `k`, index `j`,
+// in the layer whose first node is `base`.
+fn nuld_corner_point(cs: NuldConditional, cell: NuldGridCell, base: u32, dx: u32, dy: u32, k: u32, j: u32) -> vec2<f32> {
+    let at = nuld_point_table_index(cs.info, base + nuld_node(cell, dx, dy), k, j);
     let q = nuld_unpack_point(nuld_u32(cs.table + 4u * at));
     return vec2<f32>(nuld_unorm16_decode(q.x), nuld_unorm16_decode(q.y));
 }
@@ -748,8 +815,10 @@ fn nuld_embedding_row(info: NuldConditionalInfo, k: u32, i: u32) -> u32 {
 }
 
 // Rust: `input_features`: the network's 11 inputs (condition, instance offset,
-// shifted lattice point, lattice point), each mapped by `2x - 1`.
-fn nuld_input_features(info: NuldConditionalInfo, c: vec2<f32>, k: u32, i: u32) -> array<f32, 11> {
+// shifted lattice point, lattice point), each mapped by `2x - 1`; with the
+// metallic input (`metallic_input`, a blob with a metallic axis) the third is
+// the clamped metallic's (NaN as 0) instead of `u v`'s.
+fn nuld_input_features(info: NuldConditionalInfo, c: vec2<f32>, metallic: f32, metallic_input: bool, k: u32, i: u32) -> array<f32, 11> {
     let z = nuld_network_offset(info, k);
     let l = nuld_lattice_point(i, info.n, info.lattice_generator);
     // `shifted_lattice_point`: `frac(l + z)` with `frac(x) = x - floor(x)`.
@@ -758,10 +827,14 @@ fn nuld_input_features(info: NuldConditionalInfo, c: vec2<f32>, k: u32, i: u32) 
     // `condition_features`: `(u, v, u v, u^2, v^2)` of the clamped condition.
     let u = nuld_clamp01(c.x);
     let v = nuld_clamp01(c.y);
+    var third = u * v;
+    if metallic_input {
+        third = nuld_clamp01(metallic);
+    }
     return array<f32, 11>(
         2.0 * u - 1.0,
         2.0 * v - 1.0,
-        2.0 * (u * v) - 1.0,
+        2.0 * third - 1.0,
         2.0 * (u * u) - 1.0,
         2.0 * (v * v) - 1.0,
         2.0 * z.x - 1.0,
@@ -888,13 +961,15 @@ fn nuld_network_evaluate(cs: NuldConditional, row: u32, input: array<f32, 11>) -
 // outputs through the sigmoid, for any u32 instance (`nuld_instance_key`).
 fn nuld_network_square_point(cond: vec2<f32>, instance: u32, i: u32) -> vec2<f32> {
     let cs = nuld_conditional();
-    return nuld_network_square_point_of(cs, nuld_normalize(cs.info, cond), instance, i);
+    return nuld_network_square_point_of(cs, nuld_normalize(cs.info, cond), 0.0, instance, i);
 }
 
-// `nuld_network_square_point` at the normalized condition `u` of the sampler `cs`.
-fn nuld_network_square_point_of(cs: NuldConditional, u: vec2<f32>, instance: u32, i: u32) -> vec2<f32> {
+// `nuld_network_square_point` at the normalized condition `u` and `metallic`
+// (read only with a metallic axis) of the sampler `cs`.
+fn nuld_network_square_point_of(cs: NuldConditional, u: vec2<f32>, metallic: f32, instance: u32, i: u32) -> vec2<f32> {
     let row = nuld_embedding_row(cs.info, instance, i);
-    let out = nuld_network_evaluate(cs, row, nuld_input_features(cs.info, u, instance, i));
+    let input = nuld_input_features(cs.info, u, metallic, cs.metallic_count >= 2u, instance, i);
+    let out = nuld_network_evaluate(cs, row, input);
     return vec2<f32>(nuld_sigmoid(out.x), nuld_sigmoid(out.y));
 }
 
@@ -1781,7 +1856,7 @@ fn nuld_sample(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
 fn nuld_sample_metallic(cond: vec2<f32>, metallic: f32, instance: u32, i: u32) -> NuldSample {
     let cs = nuld_conditional_at_metallic(metallic);
     let u = nuld_normalize(cs.info, cond);
-    return nuld_mapped(cs, nuld_square_point_of(cs, u, instance, i), u, metallic);
+    return nuld_mapped(cs, nuld_square_point_of(cs, u, metallic, instance, i), u, metallic);
 }
 
 // Rust: `ConditionalSampler::sample_randomized` (the unbiased mode): the blob's
@@ -1809,7 +1884,7 @@ fn nuld_sample_network(cond: vec2<f32>, instance: u32, i: u32) -> NuldSample {
 fn nuld_sample_network_metallic(cond: vec2<f32>, metallic: f32, instance: u32, i: u32) -> NuldSample {
     let cs = nuld_conditional_at_metallic(metallic);
     let u = nuld_normalize(cs.info, cond);
-    return nuld_mapped(cs, nuld_network_square_point_of(cs, u, instance, i), u, metallic);
+    return nuld_mapped(cs, nuld_network_square_point_of(cs, u, metallic, instance, i), u, metallic);
 }
 
 // Rust: `NetworkSampler::sample_randomized`: the unbiased mode, the same samples

@@ -107,9 +107,9 @@ fn nuld_kernel_conditional(p: NuldKernelParams, c: vec2<f32>, instance: u32, ind
     if randomized {
         point = nuld_randomized_point(cs.info, instance, index, e);
     } else if network {
-        point = nuld_network_square_point_of(cs, u, instance, index);
+        point = nuld_network_square_point_of(cs, u, metallic, instance, index);
     } else {
-        point = nuld_square_point_of(cs, u, instance, index);
+        point = nuld_square_point_of(cs, u, metallic, instance, index);
     }
     var out = nuld_mapped(cs, point, u, metallic);
     if brdf {

@@ -100,6 +100,7 @@ pub fn distilled_parts(
         layer: nuld_build_tool::train::BrdfLayer::Metal,
         ..config.clone()
     });
+    let nodes = config.table_metallic_nodes();
     let trainer = trained(config);
     nuld_build_tool::conditional::distill::distill(
         &trainer.params(),
@@ -108,7 +109,20 @@ pub fn distilled_parts(
         instances,
         grid,
         weight_grid,
+        &nodes,
     )
+}
+
+/// `parts` (a [`nuld_core::conditional::PointWarp::BrdfTable`] sampler without
+/// a metallic axis) with the metallic axis `nodes`, the layers after the first
+/// random ([`nuld_build_tool::lab::bench::runtime::with_random_metallic_axis`]);
+/// the blob's network then reads the metallic.
+pub fn with_metallic_axis(
+    parts: nuld_build_tool::conditional::blob::ConditionalParts,
+    nodes: &[f32],
+    seed: u64,
+) -> nuld_build_tool::conditional::blob::ConditionalParts {
+    nuld_build_tool::lab::bench::runtime::with_random_metallic_axis(parts, nodes, seed)
 }
 
 /// A tree of 4 levels (top weights on 3 x 3 normals) over a closed-form light, a

@@ -14,16 +14,19 @@ use nuld_core::quantize::f16_decode;
 use nuld_core::real::Real;
 use nuld_core::sphere::square_to_hemisphere_real;
 use nuld_runtime::{Blob, ConditionalSampler};
-use nuld_tests::{as_envmap, conditional_parts, fixture_tree, shape, with_metal_points, META};
+use nuld_tests::{
+    as_envmap, conditional_parts, fixture_tree, shape, with_metal_points, with_metallic_axis, META,
+};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 /// The shapes of the runtime benchmark: n 64, hidden [32, 32], ReLU and SiLU,
 /// with the equal-area map and (ReLU) with the BRDF mixture warp and the
 /// tabulated BRDF prior, without instance slots and (the default bake's) with
-/// 64, and 7 slots (instances wrap at another count than the table's 16); and an
-/// environment sampler on its tree ([`as_envmap`]); the environment sampler
-/// last.
+/// 64, and 7 slots (instances wrap at another count than the table's 16); the
+/// tabulated prior's also with the default bake's metallic axis
+/// ([`METALLIC_NODES`]); and an environment sampler on its tree
+/// ([`as_envmap`]); the environment sampler last.
 fn fixtures() -> Vec<ConditionalParts> {
     [
         (Activation::Relu, PointWarp::EqualArea, 0, 1),
@@ -31,6 +34,7 @@ fn fixtures() -> Vec<ConditionalParts> {
         (Activation::Relu, PointWarp::BrdfMixture, 0, 3),
         (Activation::Relu, PointWarp::BrdfMixture, 64, 4),
         (Activation::Relu, PointWarp::BrdfTable, 64, 6),
+        (Activation::Relu, PointWarp::BrdfTable, 64, 7),
         (Activation::Silu, PointWarp::EnvmapTree, 64, 5),
     ]
     .into_iter()
@@ -39,11 +43,48 @@ fn fixtures() -> Vec<ConditionalParts> {
         match warp {
             PointWarp::EnvmapTree => as_envmap(parts),
             // The shared prior has the metal layer: the metal points serve it.
+            PointWarp::BrdfTable if seed == 7 => {
+                let parts = with_metal_points(parts, seed + 100);
+                with_metallic_axis(parts, &METALLIC_NODES, seed + 200)
+            }
             PointWarp::BrdfTable => with_metal_points(parts, seed + 100),
             _ => parts,
         }
     })
     .collect()
+}
+
+/// The metallic axis of the fixture that has one (the default bake's).
+const METALLIC_NODES: [f32; 3] = [0.0, 0.5, 0.95];
+
+/// A metallic drawn over `[0, 1]` and a tenth beyond on each side, with the
+/// occasional node, end or NaN.
+fn metallic(rng: &mut Pcg64Mcg) -> f32 {
+    match rng.random_range(0..10) {
+        0 => METALLIC_NODES[rng.random_range(0..3)],
+        1 => [0.0, 1.0, f32::NAN][rng.random_range(0..3)],
+        _ => rng.random_range(-0.1f32..1.1),
+    }
+}
+
+/// The metallic-axis cell of `m` as core/FORMAT.md writes it: `m` clamped into
+/// `[nodes[0], nodes[L - 1]]` (NaN as `nodes[0]`), `j0` the last layer below
+/// `L - 1` whose node is `<= m`, `t = (m - nodes[j0]) / (nodes[j0 + 1] -
+/// nodes[j0])`.
+fn metallic_cell(nodes: &[f32], m: f32) -> (usize, f32) {
+    let m = if m.is_nan() {
+        nodes[0]
+    } else {
+        m.clamp(nodes[0], nodes[nodes.len() - 1])
+    };
+    let j0 = (0..nodes.len() - 1)
+        .rev()
+        .find(|&j| nodes[j] <= m)
+        .unwrap_or(0);
+    (
+        j0,
+        ((m - nodes[j0]) / (nodes[j0 + 1] - nodes[j0])).clamp(0.0, 1.0),
+    )
 }
 
 /// The blob's condition range `(cond_min[a], cond_max[a])` of axis `a` in `T`.
@@ -109,7 +150,10 @@ fn with_sampler(parts: &ConditionalParts, f: impl FnOnce(ConditionalSampler<'_>)
 #[test]
 fn network_mode_equals_the_tools_f64_evaluation_of_the_f16_weights() {
     for parts in fixtures() {
-        let shape = parts.info.shape().unwrap();
+        let metal_shape = parts.info.shape().unwrap();
+        let axis = !parts.metallic_nodes.is_empty();
+        // The shared network reads the metallic where the blob has an axis.
+        let shape = metal_shape.with_metallic_input(axis);
         let decoded =
             |params: &[u16]| -> Vec<f64> { params.iter().map(|&h| f16_decode(h) as f64).collect() };
         let weights = decoded(&parts.params);
@@ -119,7 +163,7 @@ fn network_mode_equals_the_tools_f64_evaluation_of_the_f16_weights() {
         };
         let metal_weights = parts.metal.as_ref().map(|m| decoded(&m.params));
         let metal_tool = metal_weights.as_ref().map(|w| Network {
-            shape,
+            shape: metal_shape,
             params: &w[..],
         });
         let mut rng = Pcg64Mcg::seed_from_u64(7);
@@ -137,21 +181,35 @@ fn network_mode_equals_the_tools_f64_evaluation_of_the_f16_weights() {
                 let k: u32 = rng.random();
                 let i = rng.random_range(0..200);
                 let u = normalize::<f64>(&parts, c);
-                let input = input_features::<f64>(&shape, u, k, i);
-                let p = DVec2::from(
-                    tool.forward(shape.embedding_row(k, i), input)
-                        .square_point(),
-                );
+                let input = input_features::<f64>(&shape, u, 0.0, k, i);
+                let row = shape.embedding_row(k, i);
+                let p = DVec2::from(tool.forward(row, input).square_point());
                 let got = cs.network().square_point(c, k, i).as_dvec2();
                 worst_square = worst_square.max((got - p).abs().max_element());
+                if axis {
+                    // Below metallic 1 the shared network at the query's metallic.
+                    let m = metallic(&mut rng);
+                    if m.is_nan() || m < 1.0 {
+                        let input = input_features::<f64>(&shape, u, m as f64, k, i);
+                        let pm = DVec2::from(tool.forward(row, input).square_point());
+                        let got = cs.network().square_point_metallic(c, m, k, i).as_dvec2();
+                        worst_square = worst_square.max((got - pm).abs().max_element());
+                    }
+                }
                 if let Some(metal) = &metal_tool {
-                    // At metallic 1 the metal layer's network, at 0.99 the shared one.
-                    let row = shape.embedding_row(k, i);
+                    // At metallic 1 the metal layer's network (which reads no
+                    // metallic), at 0.99 the shared one.
+                    let input = input_features::<f64>(&metal_shape, u, 0.0, k, i);
                     let pm = DVec2::from(metal.forward(row, input).square_point());
                     let got = cs.network().square_point_metallic(c, 1.0, k, i).as_dvec2();
                     worst_square = worst_square.max((got - pm).abs().max_element());
                     let below = cs.network().square_point_metallic(c, 0.99, k, i).as_dvec2();
-                    assert_eq!(below, cs.network().square_point(c, k, i).as_dvec2());
+                    let input = input_features::<f64>(&shape, u, 0.99, k, i);
+                    let p99 = DVec2::from(tool.forward(row, input).square_point());
+                    worst_square = worst_square.max((below - p99).abs().max_element());
+                    if !axis {
+                        assert_eq!(below, cs.network().square_point(c, k, i).as_dvec2());
+                    }
                 }
                 let d = match parts.info.point_warp().unwrap() {
                     PointWarp::EqualArea => Domain::Hemisphere.to_direction(p),
@@ -243,16 +301,41 @@ fn table_mode_equals_the_reference_interpolation_bit_for_bit() {
                 let i: u32 = rng.random();
                 let (ks, is) = (k % info.instances, i % info.n);
                 let u = normalize::<f32>(&parts, c);
-                let coord = |table: &[u32], axis: u32| {
+                let layer_len = (info.grid[0] * info.grid[1]) as usize;
+                let coord_in = |table: &[u32], layer: usize, axis: u32| {
                     bilinear(u, info.grid, |node| {
+                        let node = layer * layer_len + node;
                         let at = (node * info.instances as usize + ks as usize) * info.n as usize
                             + is as usize;
                         let code = (table[at] >> (16 * axis)) & 0xffff;
                         (code as f32 + 0.5) / 65536.0
                     })
                 };
-                let p = [coord(&parts.table, 0), coord(&parts.table, 1)];
+                let coord = |table: &[u32], axis: u32| coord_in(table, 0, axis);
+                // The shared table's point at metallic `m`: with an axis the
+                // two layers around it blended as `a + (b - a) t`.
+                let point_at = |m: f32| {
+                    if parts.metallic_nodes.is_empty() {
+                        return [coord(&parts.table, 0), coord(&parts.table, 1)];
+                    }
+                    let (j0, t) = metallic_cell(&parts.metallic_nodes, m);
+                    std::array::from_fn(|a| {
+                        let (lo, hi) = (
+                            coord_in(&parts.table, j0, a as u32),
+                            coord_in(&parts.table, j0 + 1, a as u32),
+                        );
+                        lo + (hi - lo) * t
+                    })
+                };
+                let p = point_at(0.0);
                 assert_eq!(cs.square_point(c, k, i).to_array(), p, "{c} {k} {i}");
+                if !parts.metallic_nodes.is_empty() {
+                    let m = metallic(&mut rng);
+                    if m.is_nan() || m < 1.0 {
+                        let got = cs.square_point_metallic(c, m, k, i).to_array();
+                        assert_eq!(got, point_at(m), "{c} {m} {k} {i}");
+                    }
+                }
                 let d = match info.point_warp().unwrap() {
                     PointWarp::EqualArea => square_to_hemisphere_real(p),
                     PointWarp::BrdfMixture => {
@@ -268,7 +351,7 @@ fn table_mode_equals_the_reference_interpolation_bit_for_bit() {
                     PointWarp::BrdfTable => {
                         let m = 0.25;
                         let q = clamped(&parts, u);
-                        let (d, pdf) = prior.sample([q[0], q[1], m], p);
+                        let (d, pdf) = prior.sample([q[0], q[1], m], point_at(m));
                         let s = cs.sample_metallic(c, m, k, i);
                         assert_eq!(s.direction.to_array(), d);
                         assert_eq!(s.pdf, pdf);

@@ -7,14 +7,14 @@ use nuld_core::blob::{
     checksum, encoded_len, write, BlobError, ConditionalError, Domain, Layout, LayoutError,
     PointSetError, SectionSpec, SectionTag, WriteError, CHECKSUM_OFFSET, MAX_SECTIONS,
 };
-use nuld_core::conditional::{PointWarp, CONDITIONAL_INFO_LEN};
+use nuld_core::conditional::{MetallicNodesError, PointWarp, CONDITIONAL_INFO_LEN};
 use nuld_core::network::Activation;
 use nuld_core::quantize::f16_decode;
 use nuld_runtime::glam::{Vec2, Vec3};
 use nuld_runtime::{Blob, BlobKind};
 use nuld_tests::{
     as_envmap, conditional_parts, shape, small_brdf_prior, sobol_blob, with_brdf_prior,
-    with_metal_points, META,
+    with_metal_points, with_metallic_axis, META,
 };
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -122,6 +122,13 @@ fn envmap_blob() -> AlignedBytes {
 fn brdf_table_blob() -> AlignedBytes {
     // The small prior has the metal layer, which its own points serve.
     brdf_table_parts(small_brdf_prior()).to_blob(&META).unwrap()
+}
+
+/// [`brdf_table_blob`] with a metallic axis of three nodes (the default bake's).
+fn metallic_axis_blob() -> AlignedBytes {
+    with_metallic_axis(brdf_table_parts(small_brdf_prior()), &[0.0, 0.5, 0.95], 9)
+        .to_blob(&META)
+        .unwrap()
 }
 
 /// [`brdf_table_blob`]'s parts on `prior`, with metal points.
@@ -281,6 +288,16 @@ const TAG: usize = 0;
 const ELEM_SIZE: usize = 4;
 const OFFSET: usize = 8;
 const LEN: usize = 16;
+
+/// The byte offset of the section-table row of `tag` in the blob `b`, which
+/// has one.
+fn section_row(b: &[u8], tag: SectionTag) -> usize {
+    let count = u32::from_le_bytes(b[SECTION_COUNT..SECTION_COUNT + 4].try_into().unwrap());
+    (0..count as usize)
+        .map(row)
+        .find(|&r| b[r + TAG..r + TAG + 4] == (tag as u32).to_le_bytes())
+        .unwrap()
+}
 
 /// Applies `damage` to a copy of `blob`, fixes the checksum (so only the check
 /// aimed at is hit), and returns the error `Blob::parse` and the view give.
@@ -571,13 +588,7 @@ fn each_metal_points_failure_has_its_error() {
     use nuld_build_tool::sphere::brdf_prior::{BrdfPrior, PriorSpace};
     let blob = brdf_table_blob();
     let b = blob.as_slice();
-    let count = u32::from_le_bytes(b[SECTION_COUNT..SECTION_COUNT + 4].try_into().unwrap());
-    let row_of = |tag: SectionTag| {
-        (0..count as usize)
-            .map(row)
-            .find(|&r| b[r + TAG..r + TAG + 4] == (tag as u32).to_le_bytes())
-            .unwrap()
-    };
+    let row_of = |tag: SectionTag| section_row(b, tag);
     let (params_row, table_row) = (
         row_of(SectionTag::MetalNetworkParams),
         row_of(SectionTag::MetalPointTable),
@@ -754,8 +765,15 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
         fan_in = w as u128;
     }
     expected_params += 2 * (fan_in + 1);
-    let table_len =
-        info.grid[0] as u128 * info.grid[1] as u128 * info.instances as u128 * info.n as u128;
+    // A metallic axis (tag 18) multiplies the table by its node count.
+    let Some(axis) = metallic_axis_semantics(&layout, info.warp) else {
+        return false;
+    };
+    let table_len = info.grid[0] as u128
+        * info.grid[1] as u128
+        * info.instances as u128
+        * info.n as u128
+        * axis.max(1) as u128;
     // Warp 1 stores the lobe probabilities after the weights, warp 3 the metal's
     // albedo.
     let weight_len = info.weight_grid[0] as u128
@@ -767,7 +785,7 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
         };
     (info.warp != 2 || tree_semantics_hold(&layout))
         && (info.warp != 3 || brdf_prior_semantics_hold(&layout))
-        && metal_semantics_hold(&layout, info.warp, params.len(), table.len())
+        && metal_semantics_hold(&layout, info.warp, params.len(), table.len() / axis.max(1))
         && pe.elem_size == 2
         && te.elem_size == 4
         && we.elem_size == 4
@@ -830,6 +848,28 @@ fn brdf_prior_semantics_hold(layout: &Layout<'_>) -> bool {
         && rising(&conditional)
         && marginal.chunks(s).all(|m| m[s - 1] > 0.0)
         && masses.iter().all(|m| m.is_finite() && *m > 0.0)
+}
+
+/// The metallic axis (core/FORMAT.md, tag 18), checked from the raw bytes:
+/// `Some(0)` without one; `Some(L)` for one on warp 3 of 4-byte elements, 2 to
+/// 8 finite nodes in `[0, 1]`, each above the one before; `None` otherwise.
+fn metallic_axis_semantics(layout: &Layout<'_>, warp: u32) -> Option<usize> {
+    let Ok((entry, bytes)) = layout.section(SectionTag::MetallicNodes) else {
+        return Some(0);
+    };
+    let nodes: Vec<f32> = bytes
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
+    let ok = warp == 3
+        && entry.elem_size == 4
+        && bytes.len() % 4 == 0
+        && (2..=8).contains(&nodes.len())
+        && nodes
+            .iter()
+            .all(|m| m.is_finite() && (0.0..=1.0).contains(m))
+        && nodes.windows(2).all(|w| w[0] < w[1]);
+    ok.then_some(nodes.len())
 }
 
 /// The metal points (core/FORMAT.md, tags 16 and 17), checked from the raw
@@ -928,6 +968,76 @@ fn envmap_blob_mutations_are_rejected_or_harmless() {
 #[test]
 fn brdf_table_blob_mutations_are_rejected_or_harmless() {
     mutate(brdf_table_blob(), 50_000, 19);
+}
+
+/// [`conditional_blob_mutations_are_rejected_or_harmless`] for a BRDF sampler
+/// with a metallic axis (tag 18), 50k mutations.
+#[test]
+fn metallic_axis_blob_mutations_are_rejected_or_harmless() {
+    mutate(metallic_axis_blob(), 50_000, 23);
+}
+
+/// Each metallic-axis failure has its error: a node count outside 2 to 8, a
+/// node out of order, out of `[0, 1]` or not finite, an element size other
+/// than 4, the axis on another warp, and a point table short of a layer.
+#[test]
+fn each_metallic_axis_failure_has_its_error() {
+    let blob = metallic_axis_blob();
+    let b = blob.as_slice();
+    let row_of = |tag: SectionTag| section_row(b, tag);
+    let axis_row = row_of(SectionTag::MetallicNodes);
+    let axis = get_u64(b, axis_row + OFFSET) as usize;
+    let table_row = row_of(SectionTag::PointTable);
+    let table_entries = get_u64(b, table_row + LEN) / 4;
+    let info = get_u64(b, row_of(SectionTag::ConditionalInfo) + OFFSET) as usize;
+    let node = |j: usize, m: f32| move |x: &mut [u8]| put_u32(x, axis + 4 * j, m.to_bits());
+    let value = |index: u32, m: f32| {
+        ConditionalError::MetallicNodes(MetallicNodesError::Value {
+            index,
+            bits: m.to_bits(),
+        })
+    };
+    let cases = [
+        (
+            damaged(&blob, |x| put_u64(x, axis_row + LEN, 4)),
+            ConditionalError::MetallicNodes(MetallicNodesError::Count(1)),
+        ),
+        (damaged(&blob, node(2, 0.5)), value(2, 0.5)),
+        (damaged(&blob, node(1, 0.97)), value(2, 0.95)),
+        (damaged(&blob, node(2, 1.5)), value(2, 1.5)),
+        (damaged(&blob, node(0, -0.0625)), value(0, -0.0625)),
+        (damaged(&blob, node(1, f32::NAN)), value(1, f32::NAN)),
+        (
+            damaged(&blob, |x| put_u32(x, axis_row + ELEM_SIZE, 2)),
+            ConditionalError::MetallicNodesElementSize(2),
+        ),
+        (
+            // The warp field of the info record (byte 68): the equal-area map.
+            damaged(&blob, |x| {
+                put_u32(x, info + 68, PointWarp::EqualArea as u32)
+            }),
+            ConditionalError::MetallicNodesWarp(PointWarp::EqualArea as u32),
+        ),
+        (
+            // Two of the three layers.
+            damaged(&blob, |x| {
+                put_u64(x, table_row + LEN, 4 * table_entries / 3 * 2)
+            }),
+            ConditionalError::PointTableLength {
+                expected: table_entries,
+                got: table_entries / 3 * 2,
+            },
+        ),
+    ];
+    for (k, (got, want)) in cases.into_iter().enumerate() {
+        assert_eq!(got, BlobError::Conditional(want), "case {k}");
+        let line = got.to_string();
+        assert!(!line.contains('\n'), "{line:?}");
+    }
+    // The tool refuses to write a bad axis.
+    let nine: Vec<f32> = (0..9).map(|j| j as f32 / 8.0).collect();
+    let parts = with_metallic_axis(brdf_table_parts(small_brdf_prior()), &nine, 9);
+    assert!(parts.to_blob(&META).is_err());
 }
 
 /// `cases` mutations of `blob` from `seed` (see

@@ -60,7 +60,7 @@ use nuld_runtime::shader::{kernel_wgsl, KernelMode, KernelParams, KERNEL_ENTRY_P
 use nuld_runtime::{Blob, BrdfSampler, ConditionalSampler, Sample};
 use nuld_tests::{
     as_envmap, conditional_parts, distilled_parts, fixture_tree, shape, small_brdf_prior,
-    sobol_blob, with_brdf_prior, with_metal_points, META,
+    sobol_blob, with_brdf_prior, with_metal_points, with_metallic_axis, META,
 };
 use shader_sample::Gpu;
 use std::sync::OnceLock;
@@ -696,8 +696,11 @@ fn check_conditional(kernel: &Kernel, bytes: &[u8], label: &str) {
     let wide = WidePrior::of(bytes);
     let prior = wide.as_ref().map(WidePrior::prior);
     let prior = prior.as_ref();
-    // The metallic: read by the tabulated prior only.
-    let metallics: &[f32] = if table_prior {
+    // The metallic: read by the tabulated prior only; with a metallic axis
+    // also between its nodes (0, 0.5, 0.95) and beyond its last.
+    let metallics: &[f32] = if !cs.metallic_nodes().is_empty() {
+        &[0.0, 0.3, 0.5, 0.97, 1.0]
+    } else if table_prior {
         &[0.0, 0.5, 1.0]
     } else {
         &[0.0]
@@ -868,6 +871,11 @@ fn shader_random_samplers_of_every_shape_match_the_runtime() {
                 // The metal layer's own network and table, read at metallic 1.
                 parts = with_metal_points(parts, 40 + s as u64);
                 label = format!("{label}, metal points");
+            }
+            if warp == PointWarp::BrdfTable && s == 2 {
+                // A metallic axis of four nodes that starts above 0.
+                parts = with_metallic_axis(parts, &[0.1, 0.4, 0.6, 0.9], 50);
+                label = format!("{label}, metallic axis");
             }
             let bytes = parts.to_blob(&META).unwrap();
             check_conditional(kernel, bytes.as_slice(), &label);

@@ -51,6 +51,13 @@ pub struct BakeArgs {
     /// SiLU hidden units instead of ReLU.
     #[arg(long)]
     pub silu: bool,
+    /// --brdf: the metallic values the first network (metallic below 1) trains
+    /// on, comma-separated, 2 to 8 increasing values in [0, 1]; the network reads
+    /// the metallic as an input and the point table holds a layer per value,
+    /// blended linearly between them. `none`: a network that does not read the
+    /// metallic, trained on metallics spread over [0, 1) [default: 0,0.5,0.95].
+    #[arg(long, value_name = "LIST", value_parser = metallic_nodes)]
+    pub metallic_nodes: Option<MetallicNodes>,
     /// Instance slots M of the network: instance k is slot k mod M, a set with its own
     /// offset and learned per-point biases (0: every instance its own offset, no
     /// per-instance biases). Keep --instances <= M: table instances beyond M repeat
@@ -147,6 +154,9 @@ pub fn run(a: BakeArgs) -> Result<()> {
         pool_conditions,
         hidden: a.hidden,
         silu: a.silu,
+        metallic_nodes: a
+            .metallic_nodes
+            .map_or(defaults.train.metallic_nodes.clone(), |m| m.0),
         instance_slots: instance_slots as u32,
         steps,
         union_weight,
@@ -178,4 +188,32 @@ pub fn run(a: BakeArgs) -> Result<()> {
     }
     println!("{line}");
     Ok(())
+}
+
+/// The values of `--metallic-nodes` (empty for `none`).
+#[derive(Clone, Debug)]
+pub struct MetallicNodes(Vec<f64>);
+
+/// Parses `--metallic-nodes`: `none`, or 2 to 8 comma-separated increasing
+/// values in `[0, 1]` (as the blob's metallic axis requires).
+fn metallic_nodes(s: &str) -> Result<MetallicNodes, String> {
+    if s.trim() == "none" {
+        return Ok(MetallicNodes(Vec::new()));
+    }
+    let nodes = s
+        .split(',')
+        .map(|v| {
+            v.trim()
+                .parse::<f64>()
+                .map_err(|_| format!("{v:?} is not a number"))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let f32s: Vec<f32> = nodes.iter().map(|&m| m as f32).collect();
+    nuld_core::conditional::check_metallic_nodes(&f32s).map_err(|_| {
+        format!(
+            "expected `none` or 2 to {} increasing values in [0, 1], got {s:?}",
+            nuld_core::conditional::MAX_METALLIC_NODES
+        )
+    })?;
+    Ok(MetallicNodes(nodes))
 }

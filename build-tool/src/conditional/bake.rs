@@ -307,6 +307,7 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
         config.instances,
         config.grid,
         config.weight_grid,
+        &config.train.table_metallic_nodes(),
     );
     let blob = parts.to_blob(&Metadata {
         generator: "bake",
@@ -437,7 +438,7 @@ fn render_envmap_sets(
                 density: d.as_ref(),
                 points: (0..shipped.shape.n())
                     .map(|i| {
-                        let p = shipped.square_point(u, 0, i);
+                        let p = shipped.square_point(u, 0.0, 0, i);
                         let d = warp.direction(Domain::Sphere, u, 0.0, Some(&tree), p);
                         sphere_to_square(DVec3::from_array(d))
                     })

@@ -6,7 +6,9 @@ use crate::sphere::brdf_prior::BrdfPrior;
 use crate::sphere::EnvmapTree;
 use anyhow::{bail, Context, Result};
 use nuld_core::blob::{encoded_len, write, BlobKind, Metadata};
-use nuld_core::conditional::{metal_sections, sections, ConditionalInfo};
+use nuld_core::conditional::{
+    check_metallic_nodes, metal_sections, metallic_section, sections, ConditionalInfo,
+};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -18,7 +20,8 @@ pub struct ConditionalParts {
     pub info: ConditionalInfo,
     /// The network's parameters as f16 bits ([`nuld_core::network`] order).
     pub params: Vec<u16>,
-    /// The point table: `x | y << 16` u16 unorm codes, `[node][instance][index]`.
+    /// The point table: `x | y << 16` u16 unorm codes, `[node][instance][index]`;
+    /// with a metallic axis one such layer per metallic node.
     pub table: Vec<u32>,
     /// The weight table, one `f32` per weight-grid node, axis 0 fastest; for
     /// [`nuld_core::conditional::PointWarp::BrdfMixture`] followed by the lobe
@@ -30,6 +33,10 @@ pub struct ConditionalParts {
     /// A BRDF sampler's metal points (on a prior with the metal layer), written
     /// last.
     pub metal: Option<MetalParts>,
+    /// The metallic axis of a BRDF sampler's shared network and point table
+    /// ([`nuld_core::conditional::metallic_axis`]), written after everything
+    /// else; empty for none.
+    pub metallic_nodes: Vec<f32>,
 }
 
 /// The learned part of a BRDF prior's metal layer
@@ -69,11 +76,17 @@ impl ConditionalParts {
                 shape.param_len()
             );
         }
-        if Some(self.table.len() as u64) != info.point_table_len() {
+        if !self.metallic_nodes.is_empty() {
+            check_metallic_nodes(&self.metallic_nodes)
+                .map_err(|e| anyhow::anyhow!("metallic axis {:?}: {e:?}", self.metallic_nodes))?;
+        }
+        let layers = self.metallic_nodes.len().max(1) as u64;
+        let table_len = info.point_table_len().map(|len| len * layers);
+        if Some(self.table.len() as u64) != table_len {
             bail!(
                 "point table has {} entries, the counts call for {:?}",
                 self.table.len(),
-                info.point_table_len()
+                table_len
             );
         }
         let weight_len = info.weight_table_len() * info.weight_tables();
@@ -100,16 +113,20 @@ impl ConditionalParts {
             _ => {}
         }
         if let Some(metal) = &self.metal {
-            if metal.params.len() != self.params.len() || metal.table.len() != self.table.len() {
+            let layer_len = self.table.len() / layers as usize;
+            if metal.params.len() != self.params.len() || metal.table.len() != layer_len {
                 bail!(
                     "metal points have {} parameters and {} table entries, the sampler's own {} and {}",
                     metal.params.len(),
                     metal.table.len(),
                     self.params.len(),
-                    self.table.len()
+                    layer_len
                 );
             }
             sections.extend(metal_sections(&metal.params, &metal.table));
+        }
+        if !self.metallic_nodes.is_empty() {
+            sections.push(metallic_section(&self.metallic_nodes));
         }
         let mut out = AlignedBytes::zeroed(encoded_len(&meta_bytes, &sections));
         write(

@@ -5,6 +5,8 @@
 //! * **point table**: for every grid node, instance `0..S` and index `0..N`, the
 //!   network's square point evaluated in `f64` on the *f16-rounded* parameters
 //!   (exactly what ships), as u16 unorm codes ([`unorm16_encode`], [`pack_point`]);
+//!   with a metallic axis ([`nuld_core::conditional::metallic_axis`]) one such
+//!   layer per metallic node, the network evaluated at that metallic;
 //! * **weight table**: the glTF directional albedo `A` at every weight-grid node
 //!   ([`directional_albedo`]), followed for a [`PointWarp::BrdfMixture`] sampler by
 //!   the lobe probability `p_s = A_spec / A` at the same nodes (what
@@ -68,8 +70,10 @@ pub fn info(
 }
 
 /// The blob's parts for `params` trained on `target` (see the module docs), with
-/// the metal points of `metal` (a network of the same shape) where given.
-/// Parallel over grid nodes; identical for any thread count.
+/// the metal points of `metal` (a network of the same shape, without the
+/// metallic input) where given, and a point-table layer per metallic node of
+/// `metallic_nodes` (empty: one layer, at metallic 0, for a network that does
+/// not read it). Parallel over grid nodes; identical for any thread count.
 pub fn distill(
     params: &Params,
     metal: Option<&Params>,
@@ -77,9 +81,16 @@ pub fn distill(
     instances: u32,
     grid: [u32; 2],
     weight_grid: [u32; 2],
+    metallic_nodes: &[f32],
 ) -> ConditionalParts {
     let info = info(&params.shape, target, instances, grid, weight_grid);
-    let table = point_table(params, instances, grid);
+    let table = match metallic_nodes {
+        [] => point_table(params, 0.0, instances, grid),
+        nodes => nodes
+            .iter()
+            .flat_map(|&m| point_table(params, m as f64, instances, grid))
+            .collect(),
+    };
     let (weights, prior) = match target {
         LoadedTarget::GltfBrdf(prior) => (
             brdf_weights(&info),
@@ -100,16 +111,18 @@ pub fn distill(
         prior,
         metal: metal.map(|metal| MetalParts {
             params: metal.to_f16_bits(),
-            table: point_table(metal, instances, grid),
+            table: point_table(metal, 1.0, instances, grid),
         }),
+        metallic_nodes: metallic_nodes.to_vec(),
     }
 }
 
-/// The point table of `params` (see the module docs): at every node of `grid`,
-/// for instances `0..instances` and every index, the square point of the
-/// f16-rounded network as u16 unorm codes. Parallel over nodes; identical for
-/// any thread count.
-fn point_table(params: &Params, instances: u32, grid: [u32; 2]) -> Vec<u32> {
+/// One layer of the point table of `params` (see the module docs): at every
+/// node of `grid`, for instances `0..instances` and every index, the square
+/// point of the f16-rounded network at metallic `m` (read only by a network
+/// with the metallic input) as u16 unorm codes. Parallel over nodes; identical
+/// for any thread count.
+fn point_table(params: &Params, m: f64, instances: u32, grid: [u32; 2]) -> Vec<u32> {
     let shipped = params.rounded_to_f16();
     let n = shipped.shape.n();
     let nodes = (grid[0] * grid[1]) as usize;
@@ -125,7 +138,7 @@ fn point_table(params: &Params, instances: u32, grid: [u32; 2]) -> Vec<u32> {
             let shipped = &shipped;
             (0..instances).flat_map(move |k| {
                 (0..n).map(move |i| {
-                    let p = shipped.square_point(unit, k, i);
+                    let p = shipped.square_point(unit, m, k, i);
                     pack_point(unorm16_encode(p[0]), unorm16_encode(p[1]))
                 })
             })
@@ -194,7 +207,15 @@ mod tests {
     fn table_holds_the_shipped_network_and_weights_the_albedo() {
         let shape = Shape::new(5, &[6], Activation::Relu, 2).unwrap();
         let params = Params::init(shape, 4);
-        let parts = distill(&params, None, &LoadedTarget::gltf_brdf(), 3, [3, 2], [4, 3]);
+        let parts = distill(
+            &params,
+            None,
+            &LoadedTarget::gltf_brdf(),
+            3,
+            [3, 2],
+            [4, 3],
+            &[],
+        );
         assert_eq!(parts.table.len(), 3 * 2 * 3 * 5);
         assert_eq!(parts.weights.len(), 12);
         // Entry (node (2, 1), instance 2, index 4) against the network evaluated by
@@ -203,7 +224,7 @@ mod tests {
             shape,
             values: parts.params.iter().map(|&b| f16_decode(b) as f64).collect(),
         };
-        let want = decoded.trace([1.0, 1.0], 2, 4).square_point();
+        let want = decoded.trace([1.0, 1.0], 0.0, 2, 4).square_point();
         let got = unpack_point(parts.table[parts.info.point_table_index(5, 2, 4)]);
         for a in 0..2 {
             assert!((unorm16_decode_f64(got[a]) - want[a]).abs() <= 1.0 / 131072.0 + 1e-12);
@@ -215,6 +236,36 @@ mod tests {
         assert_eq!(c[1], 89.0);
         let a = directional_albedo(BrdfModel::Gltf, c[0], c[1]).total();
         assert_eq!(parts.weights[8], a as f32);
+    }
+
+    #[test]
+    fn a_metallic_axis_stores_a_layer_per_node_at_that_metallic() {
+        let shape = Shape::new(4, &[6], Activation::Relu, 3)
+            .unwrap()
+            .with_metallic_input(true);
+        let params = Params::init(shape, 9);
+        let nodes = [0.0, 0.5, 0.95];
+        let target = LoadedTarget::gltf_brdf();
+        let parts = distill(&params, None, &target, 2, [3, 2], [4, 3], &nodes);
+        let layer = 3 * 2 * 2 * 4;
+        assert_eq!(parts.table.len(), 3 * layer);
+        assert_eq!(parts.metallic_nodes, nodes);
+        let decoded = Params {
+            shape,
+            values: parts.params.iter().map(|&b| f16_decode(b) as f64).collect(),
+        };
+        // Node (1, 1) = normalized (0.5, 1), instance 1, index 3, in each layer:
+        // the network evaluated by hand at the layer's metallic.
+        for (j, &m) in nodes.iter().enumerate() {
+            let want = decoded.trace([0.5, 1.0], m as f64, 1, 3).square_point();
+            let at = j * layer + parts.info.point_table_index(4, 1, 3);
+            let got = unpack_point(parts.table[at]);
+            for a in 0..2 {
+                assert!((unorm16_decode_f64(got[a]) - want[a]).abs() <= 1.0 / 131072.0 + 1e-12);
+            }
+        }
+        // The layers differ: the network reads the metallic.
+        assert_ne!(parts.table[..layer], parts.table[layer..2 * layer]);
     }
 
     #[test]

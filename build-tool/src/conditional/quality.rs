@@ -168,11 +168,12 @@ fn directions_at(
     (k, randomized): (u32, bool),
 ) -> Vec<DVec3> {
     let (n, g) = (params.shape.n(), params.shape.lattice_generator());
+    let metallic = brdf.map_or(0.0, |(_, m)| m);
     (0..n)
         .map(|i| {
             let s = match randomized {
                 true => randomized_point(n, g, k, i, k).map(f64::from),
-                false => params.square_point(unit, k, i),
+                false => params.square_point(unit, metallic, k, i),
             };
             match (warp, brdf) {
                 (PointWarp::BrdfTable, Some((prior, m))) => {

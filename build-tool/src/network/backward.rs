@@ -136,7 +136,7 @@ mod tests {
         conds
             .iter()
             .map(|&(c, k, i)| {
-                let s = p.trace(c, k, i).square_point();
+                let s = p.trace(c, 0.0, k, i).square_point();
                 loss_of(square_to_hemisphere(DVec2::new(s[0], s[1]))).0
             })
             .sum()
@@ -171,7 +171,7 @@ mod tests {
             }
             let mut grad = vec![0.0; shape.param_len()];
             for &(c, k, i) in &conds {
-                let t = p.trace(c, k, i);
+                let t = p.trace(c, 0.0, k, i);
                 let s = t.square_point();
                 let sq = DVec2::new(s[0], s[1]);
                 let g3 = loss_of(square_to_hemisphere(sq)).1;

@@ -43,21 +43,23 @@ impl Params {
         }
     }
 
-    /// The forward pass of index `i`, instance `k`, normalized condition `c`.
-    pub fn trace(&self, c: [f64; 2], k: u32, i: u32) -> Trace<f64> {
+    /// The forward pass of index `i`, instance `k`, normalized condition `c` and
+    /// metallic `m` (read only by a shape with
+    /// [`Shape::metallic_input`]).
+    pub fn trace(&self, c: [f64; 2], m: f64, k: u32, i: u32) -> Trace<f64> {
         self.network().forward(
             self.shape.embedding_row(k, i),
-            input_features(&self.shape, c, k, i),
+            input_features(&self.shape, c, m, k, i),
         )
     }
 
     /// The point of the unit square of index `i`, instance `k`, normalized condition
-    /// `c`: [`Network::square_point`], the same bits as
-    /// `self.trace(c, k, i).square_point()` without recording a [`Trace`].
-    pub fn square_point(&self, c: [f64; 2], k: u32, i: u32) -> [f64; 2] {
+    /// `c` and metallic `m`: [`Network::square_point`], the same bits as
+    /// `self.trace(c, m, k, i).square_point()` without recording a [`Trace`].
+    pub fn square_point(&self, c: [f64; 2], m: f64, k: u32, i: u32) -> [f64; 2] {
         self.network().square_point(
             self.shape.embedding_row(k, i),
-            input_features(&self.shape, c, k, i),
+            input_features(&self.shape, c, m, k, i),
         )
     }
 

@@ -13,7 +13,7 @@ use nuld_core::blob::{
 };
 use nuld_core::brdf::{F0, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
 use nuld_core::brdf_prior::BrdfPriorInfo;
-use nuld_core::conditional::{ConditionalInfo, PointWarp, RANDOMIZE_SALTS};
+use nuld_core::conditional::{ConditionalInfo, PointWarp, MAX_METALLIC_NODES, RANDOMIZE_SALTS};
 use nuld_core::envmap_tree::{node_count, TreeInfo, TOP_FLOOR, TOP_LEVELS};
 use nuld_core::marginal2d::MAX_BLEND;
 use nuld_core::network::{
@@ -132,6 +132,7 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_SECTION_ENTRY_LEN", SECTION_ENTRY_LEN as u64),
         ("NULD_SECTION_TAG", at!(SectionEntry, tag)),
         ("NULD_SECTION_OFFSET", at!(SectionEntry, offset)),
+        ("NULD_SECTION_LEN", at!(SectionEntry, len)),
         ("NULD_MAX_SECTIONS", MAX_SECTIONS as u64),
         ("NULD_KIND_POINT_SET_2D", BlobKind::PointSet2D as u64),
         ("NULD_KIND_DIRECTION_SET", BlobKind::DirectionSet as u64),
@@ -176,6 +177,8 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
             "NULD_TAG_METAL_POINT_TABLE",
             SectionTag::MetalPointTable as u64,
         ),
+        ("NULD_TAG_METALLIC_NODES", SectionTag::MetallicNodes as u64),
+        ("NULD_MAX_METALLIC_NODES", MAX_METALLIC_NODES as u64),
         ("NULD_WARP_ENVMAP_TREE", PointWarp::EnvmapTree as u64),
         ("NULD_WARP_BRDF_TABLE", PointWarp::BrdfTable as u64),
         ("NULD_PRIOR_INFO_GRID", at!(BrdfPriorInfo, grid)),

@@ -80,6 +80,9 @@ pub struct PoolCondition {
     pub cond: [f64; 2],
     /// [`LoadedTarget::normalized`] `cond`, the network's condition input.
     pub unit: [f64; 2],
+    /// The BRDF's metallic (0 for a map): the network's metallic input where
+    /// it reads one ([`nuld_core::network::Shape::metallic_input`]).
+    pub metallic: f64,
     /// The target density's ingredients.
     pub density: ConditionDensity,
     /// Where the directions live.
@@ -263,14 +266,14 @@ pub struct ConditionPool {
 }
 
 impl ConditionPool {
-    /// `count` conditions of `target` (a BRDF's metallic drawn for `layer`,
-    /// [`BrdfLayer::pool_metallic`]) with `caps` caps each, for the sets of a
+    /// `count` conditions of `target` (a BRDF's metallic drawn for `layer` and
+    /// the metallic nodes `nodes`, [`BrdfLayer::pool_metallic`]) with `caps` caps each, for the sets of a
     /// network of `shape`, from `seed`; built in parallel, identical for any thread
     /// count. An error if a map cannot be read, or if an environment sampler's
     /// network has the BRDF mixture's lattice residual.
     pub fn new(
         target: &TrainTarget,
-        layer: BrdfLayer,
+        (layer, nodes): (BrdfLayer, &[f64]),
         count: usize,
         caps: usize,
         window: usize,
@@ -290,8 +293,8 @@ impl ConditionPool {
                 let cond = loaded.condition(u);
                 match &loaded {
                     LoadedTarget::GltfBrdf(prior) => {
-                        let m =
-                            layer.pool_metallic(sobol_burley::sample(p as u32, 2, scramble) as f64);
+                        let v = sobol_burley::sample(p as u32, 2, scramble) as f64;
+                        let m = layer.pool_metallic(nodes, v);
                         let cond = [cond[0], cond[1], m];
                         condition(prior, cond, caps, window, shape, seed)
                     }
@@ -336,6 +339,7 @@ fn condition(
     let pc = PoolCondition {
         cond,
         unit: LoadedTarget::GltfBrdf(Arc::clone(prior)).normalized(cond),
+        metallic: cond3[2],
         density: ConditionDensity::Brdf {
             wo: view_direction(cond[1]),
             metallic: cond3[2],
@@ -440,6 +444,7 @@ fn envmap_condition(
     let pc = PoolCondition {
         cond: u,
         unit: u,
+        metallic: 0.0,
         density: ConditionDensity::Envmap {
             normal,
             env: Arc::clone(env),
@@ -508,7 +513,7 @@ mod tests {
         let shape = Shape::new(8, &[4], Activation::Relu, 3).unwrap();
         let pool = ConditionPool::new(
             &TrainTarget::envmap(&map).unwrap(),
-            BrdfLayer::Shared,
+            (BrdfLayer::Shared, &[]),
             3,
             64,
             32,

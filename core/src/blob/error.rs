@@ -454,6 +454,13 @@ pub enum ConditionalError {
         /// Its f16 bits.
         bits: u16,
     },
+    /// A metallic axis ([`SectionTag::MetallicNodes`]) on a sampler whose point
+    /// warp is not [`crate::conditional::PointWarp::BrdfTable`] (its warp code).
+    MetallicNodesWarp(u32),
+    /// The metallic axis has elements of this many bytes, not 4 (`f32`).
+    MetallicNodesElementSize(u32),
+    /// The metallic axis's values ([`crate::conditional::check_metallic_nodes`]).
+    MetallicNodes(crate::conditional::MetallicNodesError),
     /// `grid[0] grid[1] instances n` overflows `u64`.
     PointTableCountOverflow,
     /// The [`SectionTag::PointTable`] section does not hold exactly
@@ -606,6 +613,25 @@ impl core::fmt::Display for ConditionalError {
                 f,
                 "blob metal network parameter {index} is not finite (f16 bits {bits:#06x})"
             ),
+            Self::MetallicNodesWarp(warp) => write!(
+                f,
+                "blob metallic axis (section 18) on a sampler of point warp {warp}; only warp 3 (the tabulated BRDF prior) has one"
+            ),
+            Self::MetallicNodesElementSize(s) => {
+                write!(f, "blob metallic axis has {s}-byte elements, not 4 (f32)")
+            }
+            Self::MetallicNodes(crate::conditional::MetallicNodesError::Count(count)) => write!(
+                f,
+                "blob metallic axis has {count} nodes, not 2 to {}",
+                crate::conditional::MAX_METALLIC_NODES
+            ),
+            Self::MetallicNodes(crate::conditional::MetallicNodesError::Value { index, bits }) => {
+                write!(
+                    f,
+                    "blob metallic node {index} ({}) is not finite, in [0, 1] and above the one before",
+                    f32::from_bits(bits)
+                )
+            }
             Self::PointTableCountOverflow => {
                 write!(
                     f,

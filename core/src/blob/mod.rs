@@ -125,7 +125,8 @@ pub enum SectionTag {
     /// (`elem_size` 2).
     NetworkParams = 4,
     /// The point table, `u32` entries `x | y << 16` of u16 unorm codes, laid out
-    /// `[grid node][instance][index]` (`elem_size` 4).
+    /// `[grid node][instance][index]` (`elem_size` 4); with
+    /// [`Self::MetallicNodes`], one such layer per metallic node.
     PointTable = 5,
     /// The weight table, `f32` per weight-grid node, axis 0 fastest (`elem_size` 4).
     WeightTable = 6,
@@ -165,6 +166,14 @@ pub enum SectionTag {
     /// query at metallic 1 instead of it. Optional, with
     /// [`Self::MetalNetworkParams`].
     MetalPointTable = 17,
+    /// The metallic axis of a BRDF sampler's learned part
+    /// ([`crate::conditional::metallic_axis`]): `L` in `2..=8` metallic nodes,
+    /// `f32` (`elem_size` 4), strictly increasing in `[0, 1]`. With it the shared
+    /// network reads the metallic as its third condition feature and
+    /// [`Self::PointTable`] holds `L` layers, `[metallic node][grid node]
+    /// [instance][index]`. Optional; only with
+    /// [`crate::conditional::PointWarp::BrdfTable`].
+    MetallicNodes = 18,
 }
 
 /// Contents of the [`SectionTag::PointSetInfo`] section.

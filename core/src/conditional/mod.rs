@@ -24,8 +24,12 @@ use crate::envmap_tree::EnvmapTree;
 use crate::network::{offset_unit, Activation, OffsetHash, Shape, MAX_HIDDEN_LAYERS};
 use crate::real::Real;
 
+pub mod metallic_axis;
 mod target;
 use bytemuck::{Pod, Zeroable};
+pub use metallic_axis::{
+    check_metallic_nodes, metallic_section, MetallicCell, MetallicNodesError, MAX_METALLIC_NODES,
+};
 pub use target::ConditionalTarget;
 
 /// How a conditional sampler turns the network's point of the unit square into a

@@ -161,21 +161,34 @@ pub fn lattice_features<T: Real>(p: [T; 2], l: [T; 2]) -> [T; 4] {
 }
 
 /// The network input of index `i`, instance `k`, normalized condition `c` (in
-/// `[0,1]^2`): `[condition_features(c), 2 z - 1, lattice_features(p, l_i)]` with
-/// `z` the offset [`Shape::instance_offset`]`(k)` (`z_k` without slots), `p` the
-/// [`shifted_lattice_point`] and `l_i` the [`lattice_point`].
+/// `[0,1]^2`) and metallic `m`: `[condition_features(c), 2 z - 1,
+/// lattice_features(p, l_i)]` with `z` the offset [`Shape::instance_offset`]`(k)`
+/// (`z_k` without slots), `p` the [`shifted_lattice_point`] and `l_i` the
+/// [`lattice_point`]. With [`Shape::metallic_input`] the third condition feature
+/// (`2 u v - 1`) is `2 m - 1` instead, `m` clamped into `[0, 1]` (NaN as 0);
+/// without, `m` is not read.
 #[inline]
-pub fn input_features<T: Real>(shape: &Shape, c: [T; 2], k: u32, i: u32) -> [T; INPUTS] {
+pub fn input_features<T: Real>(shape: &Shape, c: [T; 2], m: T, k: u32, i: u32) -> [T; INPUTS] {
     let z = shape.instance_offset::<T>(k);
     let (n, g) = (shape.n, shape.lattice_generator);
     let p = shifted_lattice_point(i, n, g, z);
     let cf = condition_features(c);
     let lf = lattice_features(p, lattice_point(i, n, g));
     let two = T::of(2.0);
+    let third = if shape.metallic_input {
+        let m = if m.is_nan() {
+            T::ZERO
+        } else {
+            m.max(T::ZERO).min(T::ONE)
+        };
+        two * m - T::ONE
+    } else {
+        cf[2]
+    };
     [
         cf[0],
         cf[1],
-        cf[2],
+        third,
         cf[3],
         cf[4],
         two * z[0] - T::ONE,

@@ -14,6 +14,7 @@ pub struct Shape {
     pub(crate) activation: Activation,
     pub(crate) lattice_generator: u32,
     pub(crate) lattice_residual: bool,
+    pub(crate) metallic_input: bool,
     pub(crate) instance_slots: u32,
     pub(crate) offset_hash: OffsetHash,
 }
@@ -46,6 +47,7 @@ impl Shape {
             activation,
             lattice_generator,
             lattice_residual: false,
+            metallic_input: false,
             instance_slots: 0,
             offset_hash: OffsetHash::Salted,
         })
@@ -138,6 +140,22 @@ impl Shape {
     /// Whether the outputs are `o + lattice_logit(input)` (module docs).
     pub fn lattice_residual(&self) -> bool {
         self.lattice_residual
+    }
+
+    /// The shape whose third condition feature is the metallic, `2 m - 1`
+    /// (`true`: the shared network of a BRDF sampler with a metallic axis,
+    /// [`crate::conditional::metallic_axis`]), or `2 u v - 1` (`false`, what
+    /// [`Shape::new`] makes). See [`input_features`](super::input_features).
+    pub fn with_metallic_input(self, metallic_input: bool) -> Self {
+        Self {
+            metallic_input,
+            ..self
+        }
+    }
+
+    /// Whether the third condition feature is the metallic.
+    pub fn metallic_input(&self) -> bool {
+        self.metallic_input
     }
 
     /// Points per set `n` (the number of per-index rows of `E` per slot).

@@ -94,7 +94,7 @@ fn lattice_residual_adds_the_logit_of_the_shifted_lattice_point() {
     for act in [Activation::Relu, Activation::Silu] {
         let s = shape(act).with_lattice_residual(true);
         let (c, k, i) = ([0.3, 0.7], 5, 6); // i wraps to row 2 of E
-        let x = input_features::<f64>(&s, c, k, i);
+        let x = input_features::<f64>(&s, c, 0.0, k, i);
         let z = salted_offset(k);
         let p = shifted_lattice_point(i, s.n(), s.lattice_generator(), z);
         // Away from the clamp at LATTICE_LOGIT_EPS, where the logit is exact.
@@ -138,9 +138,9 @@ fn instance_slots_give_each_slot_its_own_rows_and_offset() {
     assert_eq!(s.embedding_offset(s.embedding_row(k, i)), 30);
     // Instance 5 is slot 2: the same input as instance 2, not instance 5's own.
     let c = [0.3, 0.8];
-    let x = input_features::<f64>(&s, c, k, i);
-    assert_eq!(x, input_features::<f64>(&s, c, 2, i));
-    assert_ne!(x, input_features::<f64>(&base, c, k, i));
+    let x = input_features::<f64>(&s, c, 0.0, k, i);
+    assert_eq!(x, input_features::<f64>(&s, c, 0.0, 2, i));
+    assert_ne!(x, input_features::<f64>(&base, c, 0.0, k, i));
     let p: Vec<f64> = (0..s.param_len()).map(|j| noise(j) / 2.0).collect();
     let net = Network {
         shape: s,
@@ -252,7 +252,7 @@ fn lattice_is_a_permutation_and_shift_wraps() {
 #[test]
 fn input_features_hold_the_shifted_and_the_plain_lattice_point() {
     let shape = Shape::new(8, &[4], Activation::Relu, 3).unwrap();
-    let f = input_features::<f64>(&shape, [0.5, 0.25], 5, 11);
+    let f = input_features::<f64>(&shape, [0.5, 0.25], 0.7, 5, 11);
     let z = salted_offset(5);
     // Index 11 wraps to 3: l = (3/8, 1/8).
     let p = [(0.375 + z[0]) % 1.0, (0.125 + z[1]) % 1.0];
@@ -260,6 +260,33 @@ fn input_features_hold_the_shifted_and_the_plain_lattice_point() {
     assert!(f[7..].iter().zip(&want).all(|(a, b)| (a - b).abs() < 1e-15));
     assert_eq!(&f[5..7], &[2.0 * z[0] - 1.0, 2.0 * z[1] - 1.0]);
     assert_eq!(&f[..5], &condition_features([0.5, 0.25]));
+}
+
+#[test]
+fn a_metallic_input_replaces_the_product_feature_and_nothing_else() {
+    let plain = Shape::new(8, &[4], Activation::Relu, 3).unwrap();
+    let shape = plain.with_metallic_input(true);
+    assert!(shape.metallic_input() && !plain.metallic_input());
+    let c = [0.5, 0.25];
+    let f = |m: f64| input_features::<f64>(&shape, c, m, 5, 11);
+    let base = input_features::<f64>(&plain, c, 0.3, 5, 11);
+    // Without the flag the metallic is not read.
+    assert_eq!(base, input_features::<f64>(&plain, c, 0.9, 5, 11));
+    for (m, want) in [
+        (0.0, -1.0),
+        (0.25, -0.5),
+        (1.0, 1.0),
+        (3.0, 1.0),
+        (-2.0, -1.0),
+    ] {
+        let x = f(m);
+        assert_eq!(x[2], want, "m = {m}");
+        let (mut a, mut b) = (x, base);
+        a[2] = 0.0;
+        b[2] = 0.0;
+        assert_eq!(a, b, "only feature 2 differs (m = {m})");
+    }
+    assert_eq!(f(f64::NAN)[2], -1.0);
 }
 
 #[test]

@@ -11,7 +11,8 @@ use nuld_core::blob::{BlobError, Domain};
 use nuld_core::brdf::{gltf_metallic, view_direction_real};
 use nuld_core::brdf_prior::BrdfPrior;
 use nuld_core::conditional::{
-    randomized_point, unpack_point, ConditionalInfo, ConditionalTarget, GridCell, PointWarp,
+    randomized_point, unpack_point, ConditionalInfo, ConditionalTarget, GridCell, MetallicCell,
+    PointWarp,
 };
 use nuld_core::envmap_tree::EnvmapTree;
 use nuld_core::network::{input_features, F16Params, Network, Parameters, Shape};
@@ -81,6 +82,10 @@ pub struct ConditionalSampler<'a> {
     /// The metal layer's own network and point table (BRDF samplers whose
     /// prior has the metal layer, baked with them), read at metallic 1.
     metal: Option<MetalPoints<'a>>,
+    /// The metallic axis of the network and the point table
+    /// ([`nuld_core::conditional::metallic_axis`]); empty without one (and in
+    /// the metal layer's view, [`Self::at_metallic`]).
+    metallic_nodes: &'a [f32],
 }
 
 /// The learned part of a BRDF prior's metal layer
@@ -221,37 +226,66 @@ impl<'a> ConditionalSampler<'a> {
     /// `GridCell::locate(u, grid)`, the four stored u16 codes of the cell's corners
     /// decoded by `(q + 0.5) / 65536` and interpolated bilinearly
     /// ([`GridCell::lerp`]), x and y separately. In `(0,1)^2`. O(1), never panics.
+    /// With a metallic axis ([`Self::metallic_nodes`]) this reads metallic 0
+    /// ([`Self::square_point_metallic`] for others).
     #[inline]
     pub fn square_point(&self, cond: Vec2, instance: u32, i: u32) -> Vec2 {
-        self.square_point_at(self.info.normalize(cond.to_array()), instance, i)
+        self.square_point_metallic(cond, 0.0, instance, i)
     }
 
     /// [`Self::square_point`] for a BRDF query at `metallic`: the metal layer's
     /// own point table where the query reads it ([`Self::has_metal_points`],
-    /// metallic 1), else the same. What [`Self::sample_metallic`] warps.
+    /// metallic 1); else, with a metallic axis, the bilinear points of the two
+    /// layers around `metallic` blended by [`MetallicCell::lerp`] (x and y
+    /// separately); else the same. What [`Self::sample_metallic`] warps.
     /// O(1), never panics.
     #[inline]
     pub fn square_point_metallic(&self, cond: Vec2, metallic: f32, instance: u32, i: u32) -> Vec2 {
-        self.at_metallic(metallic).square_point(cond, instance, i)
+        let u = self.info.normalize(cond.to_array());
+        self.at_metallic(metallic)
+            .square_point_at(u, metallic, instance, i)
     }
 
-    /// [`Self::square_point`] at the normalized condition `u`.
+    /// The metallic nodes of the network's input and the point table's layers
+    /// ([`nuld_core::conditional::metallic_axis`]; empty without an axis).
+    pub fn metallic_nodes(&self) -> &'a [f32] {
+        self.metallic_nodes
+    }
+
+    /// [`Self::square_point`] at the normalized condition `u` and `metallic`
+    /// (read only through a metallic axis).
     #[inline]
-    fn square_point_at(&self, u: [f32; 2], instance: u32, i: u32) -> Vec2 {
-        let (cell, corner) = self.table_corners(u, instance, i);
+    fn square_point_at(&self, u: [f32; 2], metallic: f32, instance: u32, i: u32) -> Vec2 {
+        if self.metallic_nodes.is_empty() {
+            return self.layer_point(u, 0, instance, i);
+        }
+        let m = MetallicCell::locate(self.metallic_nodes, metallic);
+        let (a, b) = (
+            self.layer_point(u, m.j0, instance, i),
+            self.layer_point(u, m.j0 + 1, instance, i),
+        );
+        Vec2::new(m.lerp(a.x, b.x), m.lerp(a.y, b.y))
+    }
+
+    /// Layer `layer`'s point (0 without a metallic axis), interpolated
+    /// bilinearly in the condition.
+    #[inline]
+    fn layer_point(&self, u: [f32; 2], layer: u32, instance: u32, i: u32) -> Vec2 {
+        let (cell, corner) = self.table_corners(u, layer, instance, i);
         let (p00, p10, p01, p11) = (corner(0, 0), corner(1, 0), corner(0, 1), corner(1, 1));
         let axis = |a: usize| cell.lerp(p00[a], p10[a], p01[a], p11[a]);
         Vec2::new(axis(0), axis(1))
     }
 
     /// The point-table cell of the normalized condition `u` and the stored square
-    /// point of its corner `(dx, dy)` for index `i` (mod `n`) of instance
-    /// `instance` (mod `S`), decoded by `(q + 0.5) / 65536`: what both table
-    /// modes interpolate.
+    /// point of its corner `(dx, dy)` in layer `layer` (of a metallic axis; 0
+    /// without) for index `i` (mod `n`) of instance `instance` (mod `S`),
+    /// decoded by `(q + 0.5) / 65536`: what both table modes interpolate.
     #[inline]
     fn table_corners(
         &self,
         u: [f32; 2],
+        layer: u32,
         instance: u32,
         i: u32,
     ) -> (GridCell, impl Fn(u32, u32) -> [f32; 2] + '_) {
@@ -259,8 +293,10 @@ impl<'a> ConditionalSampler<'a> {
         let cell = GridCell::locate(u, info.grid);
         let k = instance.checked_rem(info.instances).unwrap_or(0);
         let j = i.checked_rem(info.n).unwrap_or(0);
+        // In range for every parsed blob: the table holds every layer.
+        let layer_base = layer as usize * (info.grid[0] * info.grid[1]) as usize;
         let corner = move |dx, dy| {
-            let at = info.point_table_index(cell.node(dx, dy), k, j);
+            let at = info.point_table_index(layer_base + cell.node(dx, dy), k, j);
             let q = self
                 .table
                 .get(at)
@@ -270,10 +306,17 @@ impl<'a> ConditionalSampler<'a> {
         (cell, corner)
     }
 
-    /// [`NetworkSampler::square_point`] at the normalized condition `u`.
+    /// [`NetworkSampler::square_point`] at the normalized condition `u` and
+    /// `metallic` (read only by a network with [`Shape::metallic_input`]).
     #[inline]
-    pub(crate) fn network_square_point_at(&self, u: [f32; 2], instance: u32, i: u32) -> Vec2 {
-        let input = input_features::<f32>(&self.shape, u, instance, i);
+    pub(crate) fn network_square_point_at(
+        &self,
+        u: [f32; 2],
+        metallic: f32,
+        instance: u32,
+        i: u32,
+    ) -> Vec2 {
+        let input = input_features::<f32>(&self.shape, u, metallic, instance, i);
         let shape = self.shape;
         let row = shape.embedding_row(instance, i);
         Vec2::from_array(match self.params {
@@ -314,6 +357,9 @@ impl<'a> ConditionalSampler<'a> {
                 Self {
                     params: m.params,
                     table: m.table,
+                    // The metal layer's network and table have no metallic axis.
+                    shape: self.shape.with_metallic_input(false),
+                    metallic_nodes: &[],
                     ..*self
                 }
             }
@@ -405,7 +451,11 @@ impl<'a> ConditionalSampler<'a> {
     pub fn sample_metallic(&self, cond: Vec2, metallic: f32, instance: u32, i: u32) -> Sample {
         let u = self.info.normalize(cond.to_array());
         let points = self.at_metallic(metallic);
-        self.mapped(points.square_point_at(u, instance, i), u, metallic)
+        self.mapped(
+            points.square_point_at(u, metallic, instance, i),
+            u,
+            metallic,
+        )
     }
 
     /// The **unbiased mode**: point `i` (mod `n`) of the blob's rank-1 lattice,

@@ -40,22 +40,26 @@ impl<'a> NetworkSampler<'a> {
 
     /// The point of the unit square for index `i` (mod `n`) of instance `instance`
     /// at condition `cond` (blob units): the network on
-    /// `input_features(u, instance, i)` with `u = info().normalize(cond)`, its f16
-    /// parameters decoded exactly to `f32`, then `sigmoid` per output. In
-    /// `[0,1]^2`.
+    /// `input_features(u, 0, instance, i)` (metallic 0) with
+    /// `u = info().normalize(cond)`, its f16 parameters decoded exactly to
+    /// `f32`, then `sigmoid` per output. In `[0,1]^2`.
     #[inline]
     pub fn square_point(&self, cond: Vec2, instance: u32, i: u32) -> Vec2 {
-        let u = self.0.info().normalize(cond.to_array());
-        self.0.network_square_point_at(u, instance, i)
+        self.square_point_metallic(cond, 0.0, instance, i)
     }
 
     /// [`Self::square_point`] for a BRDF query at `metallic`: the metal layer's
     /// own network where the query reads it
-    /// ([`ConditionalSampler::has_metal_points`], metallic 1), else the same.
-    /// What [`Self::sample_metallic`] warps.
+    /// ([`ConditionalSampler::has_metal_points`], metallic 1); else the network
+    /// with `metallic` as its third condition feature where it reads one
+    /// ([`ConditionalSampler::metallic_nodes`]); else the same. What
+    /// [`Self::sample_metallic`] warps.
     #[inline]
     pub fn square_point_metallic(&self, cond: Vec2, metallic: f32, instance: u32, i: u32) -> Vec2 {
-        NetworkSampler(self.0.at_metallic(metallic)).square_point(cond, instance, i)
+        let u = self.0.info().normalize(cond.to_array());
+        self.0
+            .at_metallic(metallic)
+            .network_square_point_at(u, metallic, instance, i)
     }
 
     /// The direction of index `i` of instance `instance` at condition `cond` (blob
@@ -83,8 +87,8 @@ impl<'a> NetworkSampler<'a> {
     pub fn sample_metallic(&self, cond: Vec2, metallic: f32, instance: u32, i: u32) -> Sample {
         let u = self.0.info().normalize(cond.to_array());
         let points = self.0.at_metallic(metallic);
-        self.0
-            .mapped(points.network_square_point_at(u, instance, i), u, metallic)
+        let p = points.network_square_point_at(u, metallic, instance, i);
+        self.0.mapped(p, u, metallic)
     }
 
     /// The unbiased mode, the same samples as

@@ -5,7 +5,9 @@ use super::{ConditionalSampler, MetalPoints, NetworkParams};
 use crate::section::{record, typed_section};
 use nuld_core::blob::{BlobError, ConditionalError, Domain, Layout, SectionTag};
 use nuld_core::brdf_prior::{has_metal_layer, BrdfPrior, BrdfPriorInfo};
-use nuld_core::conditional::{ConditionalInfo, ConditionalTarget, PointWarp};
+use nuld_core::conditional::{
+    check_metallic_nodes, ConditionalInfo, ConditionalTarget, MetallicNodesError, PointWarp,
+};
 use nuld_core::envmap_tree::{
     node_count, top_len, EnvmapTree, NodeRecord, TreeInfo, MAX_TREE_LEVELS, TOP_LEVELS,
 };
@@ -128,12 +130,17 @@ impl<'a> ConditionalSampler<'a> {
             },
             |expected, got| ConditionalError::ParamsLength { expected, got },
         )?;
+        let metallic_nodes = metallic_nodes(layout, warp)?;
+        let shape = shape.with_metallic_input(!metallic_nodes.is_empty());
+        // The axis's layers (at most `MAX_METALLIC_NODES`) times one layer's length.
+        let layers = metallic_nodes.len().max(1) as u64;
         let table: &[u32] = typed_section(
             layout,
             SectionTag::PointTable,
             ConditionalError::PointTableElementSize,
             || {
                 info.point_table_len()
+                    .and_then(|len| len.checked_mul(layers))
                     .ok_or(ConditionalError::PointTableCountOverflow)
             },
             |expected, got| ConditionalError::PointTableLength { expected, got },
@@ -155,7 +162,9 @@ impl<'a> ConditionalSampler<'a> {
             PointWarp::BrdfTable => Some(brdf_prior(layout, false)?),
             _ => None,
         };
-        let metal = metal_points(layout, &brdf_prior, params.len(), table.len())?;
+        // The metal layer's table has no metallic axis: one layer's length.
+        let layer_len = table.len() / layers as usize;
+        let metal = metal_points(layout, &brdf_prior, params.len(), layer_len)?;
         Ok(Self {
             info,
             shape,
@@ -168,6 +177,7 @@ impl<'a> ConditionalSampler<'a> {
             tree,
             brdf_prior,
             metal,
+            metallic_nodes,
         })
     }
 
@@ -212,6 +222,32 @@ fn first_non_finite(params: &[u16]) -> Option<(u64, u16)> {
         .enumerate()
         .find(|(_, &h)| !f16_is_finite(h))?;
     Some((index as u64, bits))
+}
+
+/// The metallic axis ([`SectionTag::MetallicNodes`]), empty if the blob has
+/// none: only on a [`PointWarp::BrdfTable`] sampler, `f32` elements, values
+/// checked by [`check_metallic_nodes`]. `O(MAX_METALLIC_NODES)`.
+fn metallic_nodes<'a>(layout: &Layout<'a>, warp: PointWarp) -> Result<&'a [f32], BlobError> {
+    let Ok((_, bytes)) = layout.section(SectionTag::MetallicNodes) else {
+        return Ok(&[]);
+    };
+    if warp != PointWarp::BrdfTable {
+        return fail(ConditionalError::MetallicNodesWarp(warp as u32));
+    }
+    let nodes: &[f32] = typed_section(
+        layout,
+        SectionTag::MetallicNodes,
+        ConditionalError::MetallicNodesElementSize,
+        // Any count of whole elements reaches the count check below, which
+        // names it.
+        || Ok((bytes.len() / 4) as u64),
+        |_, got| {
+            let got = got.min(u32::MAX as u64) as u32;
+            ConditionalError::MetallicNodes(MetallicNodesError::Count(got))
+        },
+    )?;
+    check_metallic_nodes(nodes).map_err(ConditionalError::MetallicNodes)?;
+    Ok(nodes)
 }
 
 /// The metal layer's network and point table, if the blob has them: both

@@ -96,6 +96,7 @@ pub fn random_parts(
         weights,
         prior,
         metal: None,
+        metallic_nodes: Vec::new(),
     })
 }
 
@@ -117,6 +118,24 @@ pub fn random_metal_points(parts: &ConditionalParts, seed: u64) -> MetalParts {
     let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
     random_points(parts.params.len(), parts.table.len() as u64, &mut rng)
 }
+/// `parts` (a [`PointWarp::BrdfTable`] sampler without a metallic axis) with
+/// the metallic axis `nodes` ([`nuld_core::conditional::metallic_axis`]): its
+/// point table grown to a layer per node, the layers after the first random
+/// codes drawn as [`random_parts`] draws them (deterministic for `seed`); the
+/// blob's network then reads the metallic.
+pub fn with_random_metallic_axis(
+    mut parts: ConditionalParts,
+    nodes: &[f32],
+    seed: u64,
+) -> ConditionalParts {
+    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
+    let layer = parts.table.len();
+    let more = layer * nodes.len().saturating_sub(1);
+    parts.table.extend((0..more).map(|_| rng.random::<u32>()));
+    parts.metallic_nodes = nodes.to_vec();
+    parts
+}
+
 /// `parts` (of a lattice-residual network) as an environment sampler on the
 /// prior `tree`: the sphere, conditions the normal's octahedral square `[0,1]^2`,
 /// [`PointWarp::EnvmapTree`], one weight table (the mixture's lobe probabilities
@@ -264,11 +283,15 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
             black_box(relu.sample(views[at(s)], conds[at(s)].x, 0.0, s / n, s % n));
         }),
     ));
-    // The default bake's sampler: the tabulated prior (shared, 17.8 MB), metallic
-    // 0, 0.5 and 1 in turn.
+    // The default bake's sampler: the tabulated prior (shared, 17.8 MB), the
+    // metal points and the default metallic axis (a query between two nodes
+    // reads two layers), metallic 0, 0.5 and 1 in turn.
     let table_blob = {
         let shape = random_shape(n, &[32, 32], Activation::Relu, PointWarp::BrdfTable, slots)?;
-        random_parts(shape, PointWarp::BrdfTable, 16, [10, 9], 2)?.to_blob(&meta)?
+        let mut parts = random_parts(shape, PointWarp::BrdfTable, 16, [10, 9], 2)?;
+        parts.metal = Some(random_metal_points(&parts, 3));
+        let nodes = crate::train::TrainConfig::default().table_metallic_nodes();
+        with_random_metallic_axis(parts, &nodes, 4).to_blob(&meta)?
     };
     let prior = sampler(&table_blob)?;
     let metallic = |s: u32| [0.0, 0.5, 1.0][(s / n) as usize % 3];
