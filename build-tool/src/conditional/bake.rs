@@ -492,10 +492,13 @@ mod tests {
         let len = |tag: SectionTag| layout.section(tag).unwrap().1.len();
         let shape = config.train.shape().unwrap();
         assert_eq!(len(SectionTag::NetworkParams), 2 * shape.param_len());
-        assert_eq!(len(SectionTag::PointTable), 4 * 2 * 3 * 3 * 8);
+        // A layer per metallic node (the default axis: 0, 0.5, 0.95).
+        assert_eq!(len(SectionTag::MetallicNodes), 4 * 3);
+        assert_eq!(len(SectionTag::PointTable), 3 * 4 * 2 * 3 * 3 * 8);
         // The dielectric's albedo, then the metal's.
         assert_eq!(len(SectionTag::WeightTable), 4 * 8 * 2);
-        // The metal layer's network and point table, as long as the shared ones.
+        // The metal layer's network and point table, as long as the shared
+        // network and one layer of its table.
         assert_eq!(len(SectionTag::MetalNetworkParams), 2 * shape.param_len());
         assert_eq!(len(SectionTag::MetalPointTable), 4 * 2 * 3 * 3 * 8);
         // The tabulated prior's five sections.
