@@ -293,10 +293,12 @@ impl<'a> ConditionalSampler<'a> {
         let cell = GridCell::locate(u, info.grid);
         let k = instance.checked_rem(info.instances).unwrap_or(0);
         let j = i.checked_rem(info.n).unwrap_or(0);
-        // In range for every parsed blob: the table holds every layer.
-        let layer_base = layer as usize * (info.grid[0] * info.grid[1]) as usize;
+        // In range for every parsed blob, whose table holds every layer;
+        // saturating, so that no product can panic.
+        let layer_nodes = (info.grid[0] as usize).saturating_mul(info.grid[1] as usize);
+        let layer_base = (layer as usize).saturating_mul(layer_nodes);
         let corner = move |dx, dy| {
-            let at = info.point_table_index(layer_base + cell.node(dx, dy), k, j);
+            let at = info.point_table_index(layer_base.saturating_add(cell.node(dx, dy)), k, j);
             let q = self
                 .table
                 .get(at)
