@@ -768,15 +768,8 @@ fn eval_brdf_prior_refuses_more_sets_than_the_blob_stores() {
     let file = dir.join("brdf.nuld");
     conditional_blob(&file);
     let out = dir.join("eval");
-    let output = build_tool()
-        .args(["eval", "brdf-prior", "--sets", "4", "--blob"])
-        .arg(&file)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(!output.status.success());
-    let err = String::from_utf8_lossy(&output.stderr);
+    let blob = file.to_str().unwrap();
+    let err = failure(&["eval", "brdf-prior", "--sets", "4", "--blob", blob], &out);
     assert!(
         err.contains("--sets 4 exceeds the 3 instances the blob stores"),
         "{err}"

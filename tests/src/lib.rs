@@ -115,15 +115,8 @@ pub fn distilled_parts(
 
 /// `parts` (a [`nuld_core::conditional::PointWarp::BrdfTable`] sampler without
 /// a metallic axis) with the metallic axis `nodes`, the layers after the first
-/// random ([`nuld_build_tool::lab::bench::runtime::with_random_metallic_axis`]);
-/// the blob's network then reads the metallic.
-pub fn with_metallic_axis(
-    parts: nuld_build_tool::conditional::blob::ConditionalParts,
-    nodes: &[f32],
-    seed: u64,
-) -> nuld_build_tool::conditional::blob::ConditionalParts {
-    nuld_build_tool::lab::bench::runtime::with_random_metallic_axis(parts, nodes, seed)
-}
+/// random: the benchmark's own fixture.
+pub use nuld_build_tool::lab::bench::runtime::with_random_metallic_axis as with_metallic_axis;
 
 /// A tree of 4 levels (top weights on 3 x 3 normals) over a closed-form light, a
 /// sky brighter towards `+z` and a small sun: the prior of the environment

@@ -79,12 +79,9 @@ impl MetallicCell {
     /// `O(L)`, at most [`MAX_METALLIC_NODES`] comparisons.
     #[inline]
     pub fn locate(nodes: &[f32], m: f32) -> Self {
-        let (Some(&first), Some(&last)) = (nodes.first(), nodes.last()) else {
+        let &[first, .., last] = nodes else {
             return Self { j0: 0, t: 0.0 };
         };
-        if nodes.len() < 2 {
-            return Self { j0: 0, t: 0.0 };
-        }
         let m = if m.is_nan() {
             first
         } else {
