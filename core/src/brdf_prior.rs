@@ -58,8 +58,8 @@
 //! directions: `f cos / pdf` is an unbiased estimate of the albedo.
 
 use crate::brdf::{
-    clamp_metallic, clamp_roughness, clamp_theta_o_deg, view_direction_real, MAX_METALLIC,
-    MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_METALLIC, MIN_ROUGHNESS,
+    clamp_metallic, clamp_roughness, clamp_theta_o_deg, gltf_metallic, view_direction_real,
+    MAX_METALLIC, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_METALLIC, MIN_ROUGHNESS,
 };
 use crate::marginal2d::{Blend, Marginal2D, Marginal2DError, Marginal2DShape, MAX_BLEND};
 use crate::real::Real;
@@ -452,7 +452,27 @@ impl<'a, T: Real> BrdfPrior<'a, T> {
     /// values near the float range do). `O(8 log size)`, never panics.
     #[inline]
     pub fn sample(&self, cond: [T; 3], u: [T; 2]) -> ([T; 3], T) {
+        self.sample_from(view_direction_real(cond[1]), cond, u)
+    }
+
+    /// [`Self::sample`] and the estimator weight of its direction, `f cos /
+    /// pdf` with `f` the glTF BRDF at `cond` ([`gltf_metallic`]) and `cos` the
+    /// direction's `z` (0 where the pdf is 0 or the weight is not finite): what
+    /// a sampler returns per sample, with the view direction worked out once.
+    #[inline]
+    pub fn sample_weighted(&self, cond: [T; 3], u: [T; 2]) -> ([T; 3], T, T) {
         let wo = view_direction_real(cond[1]);
+        let (wi, pdf) = self.sample_from(wo, cond, u);
+        let weight = match pdf > T::ZERO {
+            true => gltf_metallic(wo, wi, cond[0], cond[2]) * wi[2] / pdf,
+            false => T::ZERO,
+        };
+        (wi, pdf, if weight.is_finite() { weight } else { T::ZERO })
+    }
+
+    /// [`Self::sample`] for the view `wo` of `cond` (`view_direction_real(cond[1])`).
+    #[inline]
+    fn sample_from(&self, wo: [T; 3], cond: [T; 3], u: [T; 2]) -> ([T; 3], T) {
         let (p, pdf) = self.warp.sample(u, &self.blend(cond));
         let dead = ([T::ZERO, T::ZERO, T::ONE], T::ZERO);
         match half_vector_direction(wo, p, query_stretch(self.grid, cond)) {

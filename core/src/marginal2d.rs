@@ -149,32 +149,36 @@ impl<T: Real> Blend<T> {
     /// the node.
     pub fn multilinear(params: &[T], counts: &[u32]) -> Self {
         let d = params.len().min(counts.len()).min(MAX_PARAMS);
-        let mut lower = [0u32; MAX_PARAMS];
-        let mut frac = [T::ZERO; MAX_PARAMS];
-        let mut stride = [0u32; MAX_PARAMS];
+        // Per axis the lower node's share of the table index and the upper's
+        // step and both weights; an axis past `d` or of one node keeps the
+        // lower node at weight 1 (and its upper corners weigh 0).
+        let mut base = 0u32;
+        let mut step = [0u32; MAX_PARAMS];
+        let mut weights = [[T::ONE, T::ZERO]; MAX_PARAMS];
         let mut s = 1u32;
         for k in 0..d {
-            stride[k] = s;
             let c = counts[k].max(1);
-            s = s.saturating_mul(c);
-            if c < 2 {
-                continue;
+            if c >= 2 {
+                let pos = clamp_unit(params[k]) * T::of((c - 1) as f64);
+                // `pos >= 0`, so truncation is the floor (without a call to libm's).
+                let i = (pos.to_f64() as u32).min(c - 2);
+                let frac = pos - T::of(i as f64);
+                base = base.saturating_add(i.saturating_mul(s));
+                step[k] = s;
+                weights[k] = [T::ONE - frac, frac];
             }
-            let pos = clamp_unit(params[k]) * T::of((c - 1) as f64);
-            // `pos >= 0`, so truncation is the floor (without a call to libm's).
-            let i = (pos.to_f64() as u32).min(c - 2);
-            lower[k] = i;
-            frac[k] = pos - T::of(i as f64);
+            s = s.saturating_mul(c);
         }
+        // Every corner of the cube, in the order of its bits (those past `d`
+        // weigh 0): fixed trip counts, so the loops unroll.
         let mut b = Self::empty();
-        for corner in 0..(1usize << d) {
-            let mut node = 0u32;
+        for corner in 0..MAX_BLEND {
+            let mut node = base;
             let mut w = T::ONE;
-            for k in 0..d {
-                let up = (corner >> k) & 1 == 1;
-                let i = lower[k] + u32::from(up);
-                node = node.saturating_add(i.saturating_mul(stride[k]));
-                w = w * if up { frac[k] } else { T::ONE - frac[k] };
+            for k in 0..MAX_PARAMS {
+                let up = (corner >> k) & 1;
+                node = node.saturating_add(step[k] * up as u32);
+                w = w * weights[k][up];
             }
             if w > T::ZERO {
                 b.push(node, w);
@@ -338,6 +342,20 @@ fn check_lengths(
     Ok(())
 }
 
+/// `$warp.$method($arg, &picked)` with `blend`'s nodes picked into the
+/// slots of its size ([`Marginal2D::pick`]): 1, 2, 4 (for 3 or 4 nodes) or
+/// [`MAX_BLEND`].
+macro_rules! by_blend_size {
+    ($warp:ident, $blend:ident, $method:ident($arg:ident)) => {
+        match $warp.picked_len($blend) {
+            0 | 1 => $warp.$method($arg, &$warp.pick::<1>($blend)),
+            2 => $warp.$method($arg, &$warp.pick::<2>($blend)),
+            3 | 4 => $warp.$method($arg, &$warp.pick::<4>($blend)),
+            _ => $warp.$method($arg, &$warp.pick::<MAX_BLEND>($blend)),
+        }
+    };
+}
+
 /// A tabulated conditional 2D warp over borrowed tables (see the module docs).
 #[derive(Clone, Copy, Debug)]
 pub struct Marginal2D<'a, T> {
@@ -422,46 +440,63 @@ impl<'a, T: Real> Marginal2D<'a, T> {
     }
 
     /// `blend`'s nodes that have tables, with their offsets (module docs' layout),
-    /// worked out once per query rather than at each of its ~35 table reads.
+    /// worked out once per query rather than at each of its ~35 table reads,
+    /// in `N` slots: the nodes first (the first `N` of them, callers pass
+    /// `N >=` [`Self::picked_len`]), then empty slots ([`NO_TABLE`], which read
+    /// as nothing).
     #[inline]
-    fn pick(&self, blend: &Blend<T>) -> Picked<T> {
+    fn pick<const N: usize>(&self, blend: &Blend<T>) -> Picked<T, N> {
         let mut p = Picked {
-            len: 0,
-            weight: [T::ZERO; MAX_BLEND],
-            table: [0; MAX_BLEND],
-            marginal: [0; MAX_BLEND],
+            weight: [T::ZERO; N],
+            table: [NO_TABLE; N],
+            marginal: [NO_TABLE; N],
         };
+        let mut len = 0;
         for (node, w) in blend.pairs() {
             let node = node as usize;
-            if node < self.nodes && p.len < MAX_BLEND {
-                p.weight[p.len] = w;
-                p.table[p.len] = node * self.nx * self.ny;
-                p.marginal[p.len] = node * self.ny;
-                p.len += 1;
+            if node < self.nodes && len < N {
+                p.weight[len] = w;
+                p.table[len] = node * self.nx * self.ny;
+                p.marginal[len] = node * self.ny;
+                len += 1;
             }
         }
         p
     }
 
-    fn m(&self, j: usize, p: &Picked<T>) -> T {
+    /// The number of `blend`'s nodes that have tables.
+    #[inline]
+    fn picked_len(&self, blend: &Blend<T>) -> usize {
+        blend
+            .pairs()
+            .filter(|&(node, _)| (node as usize) < self.nodes)
+            .count()
+    }
+
+    #[inline(always)]
+    fn m<const N: usize>(&self, j: usize, p: &Picked<T, N>) -> T {
         p.blended(self.marginal, &p.marginal, j)
     }
 
-    fn c(&self, j: usize, i: usize, p: &Picked<T>) -> T {
+    #[inline(always)]
+    fn c<const N: usize>(&self, j: usize, i: usize, p: &Picked<T, N>) -> T {
         p.blended(self.conditional, &p.table, j * self.nx + i)
     }
 
-    fn f(&self, j: usize, i: usize, p: &Picked<T>) -> T {
+    #[inline(always)]
+    fn f<const N: usize>(&self, j: usize, i: usize, p: &Picked<T, N>) -> T {
         p.blended(self.data, &p.table, j * self.nx + i)
     }
 
     /// The blended conditional CDF at vertex `i` of the row at `y = (j + t) dy`.
-    fn c_at(&self, j: usize, t: T, i: usize, p: &Picked<T>) -> T {
+    #[inline(always)]
+    fn c_at<const N: usize>(&self, j: usize, t: T, i: usize, p: &Picked<T, N>) -> T {
         (T::ONE - t) * self.c(j, i, p) + t * self.c(j + 1, i, p)
     }
 
     /// The blended density at vertex `i` of the row at `y = (j + t) dy`.
-    fn f_at(&self, j: usize, t: T, i: usize, p: &Picked<T>) -> T {
+    #[inline(always)]
+    fn f_at<const N: usize>(&self, j: usize, t: T, i: usize, p: &Picked<T, N>) -> T {
         (T::ONE - t) * self.f(j, i, p) + t * self.f(j + 1, i, p)
     }
 
@@ -469,7 +504,14 @@ impl<'a, T: Real> Marginal2D<'a, T> {
     /// density and returns it with its density ([`Self::pdf`]). `u` outside the
     /// square is clamped into it (NaN as 0).
     pub fn sample(&self, u: [T; 2], blend: &Blend<T>) -> ([T; 2], T) {
-        let blend = &self.pick(blend);
+        // One copy per blend size, whose sums over the nodes unroll and whose
+        // weights stay in registers: the warp is bound by its ~35 blended
+        // reads. A blend of 3 nodes takes 4 slots, the last adding 0.
+        by_blend_size!(self, blend, sample_picked(u))
+    }
+
+    #[inline(always)]
+    fn sample_picked<const N: usize>(&self, u: [T; 2], blend: &Picked<T, N>) -> ([T; 2], T) {
         let (nx, ny) = (self.nx, self.ny);
         let total = self.m(ny - 1, blend);
         // y: the marginal, then the quadratic within the row interval.
@@ -504,17 +546,22 @@ impl<'a, T: Real> Marginal2D<'a, T> {
     /// [`Self::sample`] draws: the blend's bilinear value over the blend's mass
     /// (per unit area of the square).
     pub fn pdf(&self, p: [T; 2], blend: &Blend<T>) -> T {
-        let blend = &self.pick(blend);
+        by_blend_size!(self, blend, pdf_picked(p))
+    }
+
+    #[inline(always)]
+    fn pdf_picked<const N: usize>(&self, p: [T; 2], blend: &Picked<T, N>) -> T {
         self.pdf_known(p, blend, self.m(self.ny - 1, blend), None)
     }
 
     /// [`Self::pdf`] given the blend's mass `total` and, where the caller has
     /// them, the blended densities at the corners `(j, i), (j, i + 1), (j + 1,
     /// i), (j + 1, i + 1)` of cell `(i, j)`: the same values, read once.
-    fn pdf_known(
+    #[inline(always)]
+    fn pdf_known<const N: usize>(
         &self,
         p: [T; 2],
-        blend: &Picked<T>,
+        blend: &Picked<T, N>,
         total: T,
         corners: Option<((usize, usize), [T; 4])>,
     ) -> T {
@@ -535,7 +582,11 @@ impl<'a, T: Real> Marginal2D<'a, T> {
     /// The primary sample that [`Self::sample`] maps to `p` (clamped into the
     /// square): the blend's marginal CDF at `p.y` and its conditional CDF at `p.x`.
     pub fn invert(&self, p: [T; 2], blend: &Blend<T>) -> [T; 2] {
-        let blend = &self.pick(blend);
+        by_blend_size!(self, blend, invert_picked(p))
+    }
+
+    #[inline(always)]
+    fn invert_picked<const N: usize>(&self, p: [T; 2], blend: &Picked<T, N>) -> [T; 2] {
         let (nx, ny) = (self.nx, self.ny);
         let total = self.m(ny - 1, blend);
         if !positive(total) {
@@ -558,30 +609,43 @@ impl<'a, T: Real> Marginal2D<'a, T> {
     }
 }
 
-/// A blend's nodes that have tables: weights and the offsets of their tables
-/// (`node nx ny`) and marginals (`node ny`), in the blend's order.
-struct Picked<T> {
-    len: usize,
-    weight: [T; MAX_BLEND],
-    table: [usize; MAX_BLEND],
-    marginal: [usize; MAX_BLEND],
+/// The offset of an empty [`Picked`] slot: past every table, so that its reads
+/// find nothing and add nothing (and `NO_TABLE + at` cannot overflow for any
+/// index of a table that fits in memory).
+const NO_TABLE: usize = usize::MAX / 2;
+
+/// A blend's nodes that have tables, in `N` slots: weights and the offsets of
+/// their tables (`node nx ny`) and marginals (`node ny`), in the blend's
+/// order, then empty slots ([`NO_TABLE`], weight 0).
+struct Picked<T, const N: usize> {
+    weight: [T; N],
+    table: [usize; N],
+    marginal: [usize; N],
 }
 
-impl<T: Real> Picked<T> {
-    /// `Σ weight values[offset + at]` over the picked nodes, in order (an offset
-    /// past `values` counts as 0: tables of checked lengths never are). A
-    /// pairwise sum, fewer additions deep, measured slower: the warp is bound by
-    /// the number of reads, not by their latency.
-    #[inline]
-    fn blended(&self, values: &[T], offsets: &[usize; MAX_BLEND], at: usize) -> T {
-        let mut s = T::ZERO;
-        let len = self.len.min(MAX_BLEND);
-        for (&w, &offset) in self.weight[..len].iter().zip(&offsets[..len]) {
-            if let Some(&v) = values.get(offset + at) {
-                s = s + w * v;
+impl<T: Real, const N: usize> Picked<T, N> {
+    /// `Σ weight values[offset + at]` over the slots (an offset past `values`
+    /// counts as 0: empty slots; tables of checked lengths never are), summed
+    /// pairwise: `log2 N` additions deep instead of `N`, which is what a
+    /// search step waits for. `N` is a power of two (the warp's dispatch); the
+    /// order of the sums depends only on `N`, so every caller of a blend of a
+    /// given size rounds alike.
+    #[inline(always)]
+    fn blended(&self, values: &[T], offsets: &[usize; N], at: usize) -> T {
+        let mut terms = [T::ZERO; N];
+        for k in 0..N {
+            if let Some(&v) = values.get(offsets[k] + at) {
+                terms[k] = self.weight[k] * v;
             }
         }
-        s
+        let mut width = N;
+        while width > 1 {
+            width /= 2;
+            for k in 0..width {
+                terms[k] = terms[2 * k] + terms[2 * k + 1];
+            }
+        }
+        terms[0]
     }
 }
 
@@ -605,7 +669,9 @@ fn cell<T: Real>(x: T, n: usize) -> (usize, T) {
 /// and `cdf(k)`.
 fn search<T: Real>(n: usize, target: T, cdf: impl Fn(usize) -> T) -> (usize, T) {
     // The largest k in 0..=n-2 with cdf(k) <= target (0 if none), without
-    // branches on the values.
+    // branches on the values. (A four-way search, three independent reads a
+    // step and half as many steps, measured faster for a single node's table
+    // but slower for blends of 4 and 8, whose reads fill the machine.)
     let (mut k, mut len) = (0usize, n - 1);
     while len > 1 {
         let half = len / 2;

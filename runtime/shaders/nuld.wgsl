@@ -1444,17 +1444,16 @@ fn nuld_brdf_blend(pr: NuldBrdfPrior, cond: vec3<f32>) -> NuldBlend {
 }
 
 // Rust: `Picked::blended` (in `Marginal2D`): the blend of the `f32` at element `at` of each
-// node's block of `block` elements of the section at byte `section`, summed in
-// corner order.
+// node's block of `block` elements of the section at byte `section`, summed pairwise in
+// corner order, ((0 + 1) + (2 + 3)) + ((4 + 5) + (6 + 7)). Corners of weight 0 add 0, so
+// this is the Rust's pairwise sum over the nodes it keeps, which form a sub-cube.
 fn nuld_blended(b: NuldBlend, section: u32, block: u32, at: u32) -> f32 {
-    var s = 0.0;
+    var p: array<f32, 8>;
     for (var k = 0u; k < 4u; k++) {
-        s = s + b.weights_lo[k] * nuld_f32(section + 4u * (b.nodes_lo[k] * block + at));
+        p[k] = b.weights_lo[k] * nuld_f32(section + 4u * (b.nodes_lo[k] * block + at));
+        p[k + 4u] = b.weights_hi[k] * nuld_f32(section + 4u * (b.nodes_hi[k] * block + at));
     }
-    for (var k = 0u; k < 4u; k++) {
-        s = s + b.weights_hi[k] * nuld_f32(section + 4u * (b.nodes_hi[k] * block + at));
-    }
-    return s;
+    return ((p[0] + p[1]) + (p[2] + p[3])) + ((p[4] + p[5]) + (p[6] + p[7]));
 }
 
 // Rust: `Marginal2D::m`: the blend's marginal CDF at row `j`.

@@ -187,6 +187,55 @@ fn invert_undoes_sample_and_sample_undoes_invert() {
     assert!(worst < 1e-9, "worst round trip {worst}");
 }
 
+/// The warp keeps one copy per blend size (1, 2, 4 and 8 slots, 3 and 5 to 7
+/// nodes padded with empty slots): every size samples its own pdf, which is the
+/// weighted average of the nodes' densities computed here from the data alone,
+/// and a node of weight 0 appended to a blend changes no bit of it.
+#[test]
+fn blends_of_every_size_sample_their_own_pdf() {
+    let t = Tables::new(9, 7, 8, |k, x, y| {
+        let c = (k as f64 + 0.5) / 8.0;
+        0.05 + (-(6.0 + k as f64) * ((x - c).powi(2) + (y - 1.0 + c).powi(2))).exp()
+            + x * y * (k % 3) as f64
+    });
+    let w = t.warp();
+    let mut r = Rng(21);
+    for size in 1..=8usize {
+        for _ in 0..20 {
+            let pairs: Vec<(u32, f64)> = (0..size)
+                .map(|k| ((k * 5 % 8) as u32, 0.05 + r.next()))
+                .collect();
+            let blend = Blend::from_pairs(&pairs);
+            let mut padded = pairs.clone();
+            padded.push((3, 0.0));
+            let padded = Blend::from_pairs(&padded);
+            let mass: f64 = pairs.iter().map(|p| p.1).sum();
+            for _ in 0..50 {
+                let u = [r.next(), r.next()];
+                let (p, pdf) = w.sample(u, &blend);
+                let want: f64 = pairs
+                    .iter()
+                    .map(|&(k, wk)| wk * t.node_density(k as usize, p[0], p[1]))
+                    .sum::<f64>()
+                    / mass;
+                assert!(
+                    (pdf - want).abs() <= 1e-12 * want.max(1.0),
+                    "size {size}: {pdf} vs {want}"
+                );
+                let back = w.invert(p, &blend);
+                assert!(
+                    (back[0] - u[0]).abs() < 1e-9 && (back[1] - u[1]).abs() < 1e-9,
+                    "size {size}: {u:?} came back as {back:?}"
+                );
+                if size < 8 {
+                    assert_eq!(w.sample(u, &padded), (p, pdf), "size {size}");
+                    assert_eq!(w.pdf(p, &padded), w.pdf(p, &blend), "size {size}");
+                }
+            }
+        }
+    }
+}
+
 /// A chi-square test of 10^6 samples against the pdf on 16 x 16 bins, at a blend
 /// of all four nodes: each bin lies inside one table cell, where the density is
 /// bilinear and the midpoint rule gives the bin's mass exactly.

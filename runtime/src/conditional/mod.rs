@@ -8,7 +8,6 @@
 
 use glam::{Vec2, Vec3};
 use nuld_core::blob::{BlobError, Domain};
-use nuld_core::brdf::{gltf_metallic, view_direction_real};
 use nuld_core::brdf_prior::BrdfPrior;
 use nuld_core::conditional::{
     randomized_point, unpack_point, ConditionalInfo, ConditionalTarget, GridCell, MetallicCell,
@@ -260,6 +259,12 @@ impl<'a> ConditionalSampler<'a> {
             return self.layer_point(u, 0, instance, i);
         }
         let m = MetallicCell::locate(self.metallic_nodes, metallic);
+        if m.t == 0.0 {
+            // At a node (metallic 0, the common material): `a + (b - a) 0` is
+            // `a` bit for bit (stored points are positive and finite), so the
+            // second layer is not read.
+            return self.layer_point(u, m.j0, instance, i);
+        }
         let (a, b) = (
             self.layer_point(u, m.j0, instance, i),
             self.layer_point(u, m.j0 + 1, instance, i),
@@ -543,16 +548,10 @@ impl<'a> ConditionalSampler<'a> {
             // The clamped condition in blob units, as the prior's nodes see it.
             let [roughness, theta] = self.info.denormalize(u);
             let cond = [roughness, theta, metallic];
-            let (direction, pdf) = prior.sample(cond, p.to_array());
-            let f = gltf_metallic(view_direction_real(theta), direction, roughness, metallic);
-            let weight = if pdf > 0.0 {
-                f * direction[2] / pdf
-            } else {
-                0.0
-            };
+            let (direction, pdf, weight) = prior.sample_weighted(cond, p.to_array());
             return Sample {
                 direction: Vec3::from_array(direction),
-                weight: if weight.is_finite() { weight } else { 0.0 },
+                weight,
                 pdf,
             };
         }
