@@ -379,6 +379,29 @@ pub fn gltf_metallic<T: Real>(wo: [T; 3], wi: [T; 3], roughness: T, metallic: T)
     gltf_metallic_parts(wo, wi, roughness, metallic).total()
 }
 
+/// [`gltf_metallic`] at metallic 0 and at metallic 1, `[f_0, f_1]`, for one pair
+/// of directions: bit for bit the two calls' values, with the pair's cosines
+/// worked out once (a tabulation of both ends of the metallic axis at the same
+/// directions, whose blend is every metallic, needs both).
+///
+/// ```
+/// # use nuld_core::brdf::{gltf_metallic, gltf_metallic_ends};
+/// let (wo, wi) = ([0.6, 0.0, 0.8], [-0.28, 0.0, 0.96]);
+/// let [f0, f1] = gltf_metallic_ends(wo, wi, 0.3f64);
+/// assert_eq!(f0, gltf_metallic(wo, wi, 0.3, 0.0));
+/// assert_eq!(f1, gltf_metallic(wo, wi, 0.3, 1.0));
+/// ```
+#[inline]
+pub fn gltf_metallic_ends<T: Real>(wo: [T; 3], wi: [T; 3], roughness: T) -> [T; 2] {
+    match pair_cosines(wo, wi) {
+        Some(c) => {
+            let a = alpha(roughness);
+            [T::ZERO, T::ONE].map(|m| gltf_metallic_parts_of(c, a, m).total())
+        }
+        None => [BrdfParts::ZERO.total(); 2],
+    }
+}
+
 /// The glTF 2.0 BRDF `f(wo, wi) = (1 - F)/pi + F D Vis` (per steradian): the sum of
 /// [`gltf_parts`], with its domain.
 #[inline]

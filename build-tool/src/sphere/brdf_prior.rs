@@ -29,7 +29,7 @@
 
 use super::envmap_prior::tabulated;
 use glam::{DVec2, DVec3};
-use nuld_core::brdf::{gltf_metallic, view_direction};
+use nuld_core::brdf::{gltf_metallic, gltf_metallic_ends, view_direction};
 use nuld_core::brdf_prior::{
     half_vector_direction, half_vector_point, is_metal_layer_node, mass_weighted_blend,
     metal_stretch, node_condition, reads_metal_layer, stretch, stretch_with, BrdfPriorInfo,
@@ -196,16 +196,32 @@ impl BrdfPrior {
         let s = size as usize;
         let k = SUPERSAMPLED_AXIS.div_ceil(size).max(1) as usize;
         let h = 1.0 / (s - 1) as f64;
-        let tables: Vec<Vec<f32>> = (0..nodes)
-            .into_par_iter()
-            .map(|node| {
-                let [r, t, m] = node_condition(grid, node);
-                let metal_layer = is_metal_layer_node(grid, node);
+        // Layers 0 and 1 (metallic 0 and 1) share the square, so a node of
+        // layer 0 and the node above it in layer 1 are tabulated together, at
+        // the same directions, each BRDF value the one `gltf_metallic` gives
+        // ([`gltf_metallic_ends`]); the metal layer's nodes one by one.
+        let layer = grid[0] * grid[1];
+        let jobs: Vec<Vec<u32>> = (0..layer)
+            .map(|n| vec![n, n + layer])
+            .chain((2 * layer..nodes).map(|n| vec![n]))
+            .collect();
+        let tabulated_jobs: Vec<Vec<Vec<f32>>> = jobs
+            .par_iter()
+            .map(|job| {
+                let [r, t, _] = node_condition(grid, job[0]);
+                let metal_layer = is_metal_layer_node(grid, job[0]);
+                let ends = job.len() == 2;
+                debug_assert!(
+                    !ends
+                        || (node_condition(grid, job[0])[2] == 0.0
+                            && node_condition(grid, job[1])[2] == 1.0)
+                );
+                let m = node_condition(grid, job[0])[2];
                 let wo = view_direction(t);
-                let mut out = vec![0.0f32; s * s];
+                let mut out = vec![vec![0.0f32; s * s]; job.len()];
                 for j in 0..s {
                     for i in 0..s {
-                        let mut sum = 0.0;
+                        let mut sum = [0.0; 2];
                         for b in 0..k {
                             for a in 0..k {
                                 // The dual cell of vertex (i, j), clipped to the square.
@@ -215,18 +231,32 @@ impl BrdfPrior {
                                 };
                                 let p = DVec2::new(at(i, a), at(j, b));
                                 if let Some((wi, jac)) = space.direction(wo, (r, metal_layer), p) {
-                                    sum += gltf_metallic(wo.to_array(), wi.to_array(), r, m)
-                                        * wi.z
-                                        * jac;
+                                    let (wo, wi) = (wo.to_array(), wi.to_array());
+                                    let f = match ends {
+                                        true => gltf_metallic_ends(wo, wi, r),
+                                        false => [gltf_metallic(wo, wi, r, m), 0.0],
+                                    };
+                                    for (sum, f) in sum.iter_mut().zip(f) {
+                                        *sum += f * wi[2] * jac;
+                                    }
                                 }
                             }
                         }
-                        out[j * s + i] = (sum / (k * k) as f64) as f32;
+                        for (table, sum) in out.iter_mut().zip(sum) {
+                            table[j * s + i] = (sum / (k * k) as f64) as f32;
+                        }
                     }
                 }
                 out
             })
             .collect();
+        // Back in node order: layer 0, layer 1, then the metal layer.
+        let mut tables = vec![Vec::new(); nodes as usize];
+        for (job, out) in jobs.iter().zip(tabulated_jobs) {
+            for (&node, table) in job.iter().zip(out) {
+                tables[node as usize] = table;
+            }
+        }
         let ([data, marginal, conditional], masses) = tabulated(shape, &tables)?;
         let widen = |v: &Vec<f32>| v.iter().map(|&x| x as f64).collect();
         let wide = [
@@ -417,6 +447,44 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The prior's tables, whose metallic-0 and metallic-1 nodes are tabulated
+    /// in pairs, are bit for bit those of each node tabulated alone at its own
+    /// condition with `gltf_metallic` (written out here), metal layer included.
+    #[test]
+    fn paired_nodes_tabulate_as_each_node_alone() {
+        let (grid, size) = ([2, 3, 3], 6);
+        let prior = BrdfPrior::new(grid, size, PriorSpace::HalfVector).unwrap();
+        let s = size as usize;
+        let k = SUPERSAMPLED_AXIS.div_ceil(size) as usize;
+        let h = 1.0 / (s - 1) as f64;
+        let alone: Vec<Vec<f32>> = (0..prior.shape.nodes)
+            .map(|node| {
+                let [r, t, m] = node_condition(grid, node);
+                let wo = view_direction(t);
+                let key = (r, is_metal_layer_node(grid, node));
+                let mut out = vec![0.0f32; s * s];
+                for (v, value) in out.iter_mut().enumerate() {
+                    let (i, j) = (v % s, v / s);
+                    let mut sum = 0.0;
+                    for q in 0..k * k {
+                        let at = |v: usize, q: usize| {
+                            ((v as f64 - 0.5 + (q as f64 + 0.5) / k as f64) * h).clamp(0.0, 1.0)
+                        };
+                        let p = DVec2::new(at(i, q % k), at(j, q / k));
+                        if let Some((wi, jac)) = PriorSpace::HalfVector.direction(wo, key, p) {
+                            sum += gltf_metallic(wo.to_array(), wi.to_array(), r, m) * wi.z * jac;
+                        }
+                    }
+                    *value = (sum / (k * k) as f64) as f32;
+                }
+                out
+            })
+            .collect();
+        let (tables, masses) = tabulated(prior.shape, &alone).unwrap();
+        assert_eq!(tables, [prior.data, prior.marginal, prior.conditional]);
+        assert_eq!(masses, prior.masses);
     }
 
     #[test]

@@ -239,6 +239,22 @@ impl SplitMix {
 }
 
 #[test]
+fn both_ends_of_the_metallic_axis_are_the_two_calls_bit_for_bit() {
+    let mut rng = SplitMix(0x656e_6473);
+    for _ in 0..100_000 {
+        let (wo, wi) = (rng.direction(), rng.direction());
+        let r = 1.2 * rng.unit() - 0.05;
+        let [f0, f1] = gltf_metallic_ends(wo, wi, r);
+        assert_eq!(f0.to_bits(), gltf_metallic(wo, wi, r, 0.0).to_bits());
+        assert_eq!(f1.to_bits(), gltf_metallic(wo, wi, r, 1.0).to_bits());
+        let (wo, wi) = (wo.map(|x| x as f32), wi.map(|x| x as f32));
+        let [f0, f1] = gltf_metallic_ends(wo, wi, r as f32);
+        assert_eq!(f0.to_bits(), gltf_metallic(wo, wi, r as f32, 0.0).to_bits());
+        assert_eq!(f1.to_bits(), gltf_metallic(wo, wi, r as f32, 1.0).to_bits());
+    }
+}
+
+#[test]
 fn metallic_zero_is_the_dielectric_bit_for_bit() {
     let mut rng = SplitMix(0x6d65_7461_6c6c_6963);
     let mut counted = 0usize;
