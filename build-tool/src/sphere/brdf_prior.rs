@@ -208,15 +208,10 @@ impl BrdfPrior {
         let tabulated_jobs: Vec<Vec<Vec<f32>>> = jobs
             .par_iter()
             .map(|job| {
-                let [r, t, _] = node_condition(grid, job[0]);
+                let [r, t, m] = node_condition(grid, job[0]);
                 let metal_layer = is_metal_layer_node(grid, job[0]);
                 let ends = job.len() == 2;
-                debug_assert!(
-                    !ends
-                        || (node_condition(grid, job[0])[2] == 0.0
-                            && node_condition(grid, job[1])[2] == 1.0)
-                );
-                let m = node_condition(grid, job[0])[2];
+                debug_assert!(!ends || (m == 0.0 && node_condition(grid, job[1])[2] == 1.0));
                 let wo = view_direction(t);
                 let mut out = vec![vec![0.0f32; s * s]; job.len()];
                 for j in 0..s {
