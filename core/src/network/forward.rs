@@ -34,6 +34,10 @@ impl<T: Real> Trace<T> {
 /// trainer, f16 bits decoded to `f32` in the runtime ([`F16Params`]). Reads past
 /// the end give 0 (never a panic).
 pub trait Parameters<T: Real> {
+    /// Whether the storage holds `T` and dots rows where they lie: a forward pass
+    /// then needs one row of scratch, not a block of decoded rows (see
+    /// [`Parameters::block_dot`]), and clears only that.
+    const IN_PLACE: bool = false;
     /// Parameter `j`.
     fn get(&self, j: usize) -> T;
     /// Parameters `start..start + out.len()` into `out`.
@@ -84,6 +88,7 @@ fn read_dot<T: Real, W: Parameters<T> + ?Sized>(
 }
 
 impl<T: Real> Parameters<T> for &[T] {
+    const IN_PLACE: bool = true;
     #[inline]
     fn get(&self, j: usize) -> T {
         <[T]>::get(self, j).copied().unwrap_or(T::ZERO)
@@ -222,6 +227,30 @@ impl<W> Network<W> {
         &self,
         row: u32,
         input: &[T; INPUTS],
+        record: impl FnMut(usize, usize, T),
+    ) -> [T; OUTPUTS]
+    where
+        W: Parameters<T>,
+    {
+        // Rows decoded from storage that does not hold `T` (one block at a time),
+        // cleared once per evaluation rather than per layer; storage that holds
+        // `T` reads its rows in place and needs a row at most.
+        if W::IN_PLACE {
+            let mut scratch = [T::ZERO; MAX_WIDTH];
+            self.run_with(row, input, &mut scratch, record)
+        } else {
+            let mut scratch = [T::ZERO; UNIT_BLOCK * MAX_WIDTH];
+            self.run_with(row, input, &mut scratch, record)
+        }
+    }
+
+    /// [`Network::run`] with its scratch buffer.
+    #[inline(always)]
+    fn run_with<T: Real>(
+        &self,
+        row: u32,
+        input: &[T; INPUTS],
+        scratch: &mut [T],
         mut record: impl FnMut(usize, usize, T),
     ) -> [T; OUTPUTS]
     where
@@ -230,27 +259,25 @@ impl<W> Network<W> {
         let shape = &self.shape;
         let w = &self.params;
         let act = shape.activation;
-        // Two buffers used in turn as a layer's input and output.
-        let mut a = [T::ZERO; MAX_WIDTH];
-        let mut b = [T::ZERO; MAX_WIDTH];
-        // Rows decoded from storage that does not hold `T` (one block at a time),
-        // cleared once per evaluation rather than per layer.
-        let mut scratch = [T::ZERO; UNIT_BLOCK * MAX_WIDTH];
-        a[..INPUTS].copy_from_slice(input);
+        // Two buffers used in turn as a layer's input and output (by parity, not
+        // swapped: a swap copies both).
+        let mut buffers = [[T::ZERO; MAX_WIDTH]; 2];
+        buffers[0][..INPUTS].copy_from_slice(input);
         let embedding = shape.embedding_offset(row);
         let hidden = shape.layers as usize;
         let mut out = [T::ZERO; OUTPUTS];
         for (l, span) in shape.layers().enumerate() {
+            let [even, odd] = &mut buffers;
+            let (a, b) = if l % 2 == 0 { (even, odd) } else { (odd, even) };
             let (x, width) = (&a[..span.fan_in], span.width);
             if l < hidden {
                 let first = (l == 0).then_some(embedding);
-                layer(w, span, first, x, &mut b[..width], &mut scratch, |o, z| {
+                layer(w, span, first, x, &mut b[..width], scratch, |o, z| {
                     record(l, o, z);
                     act.apply(z)
                 });
-                core::mem::swap(&mut a, &mut b);
             } else {
-                layer(w, span, None, x, &mut out, &mut scratch, |_, z| z);
+                layer(w, span, None, x, &mut out, scratch, |_, z| z);
             }
         }
         if shape.lattice_residual {
@@ -274,7 +301,7 @@ fn layer<T: Real>(
     extra: Option<usize>,
     x: &[T],
     out: &mut [T],
-    scratch: &mut [T; UNIT_BLOCK * MAX_WIDTH],
+    scratch: &mut [T],
     mut finish: impl FnMut(usize, T) -> T,
 ) {
     let (off, bias) = (span.weights, span.bias);
@@ -284,7 +311,8 @@ fn layer<T: Real>(
     // bounds-checked decode per unit: `out` holds each unit's `acc` until its dot.
     w.read(bias, out);
     if let Some(e) = extra {
-        let extra = &mut scratch[..out.len().min(MAX_WIDTH)];
+        let len = out.len().min(scratch.len());
+        let extra = &mut scratch[..len];
         w.read(e, extra);
         for (acc, &v) in out.iter_mut().zip(extra.iter()) {
             *acc = *acc + v;

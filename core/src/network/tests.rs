@@ -391,3 +391,57 @@ fn blocks_of_units_give_each_unit_its_own_dot() {
     .evaluate(i, input32);
     assert_eq!(from_f16.map(f32::to_bits), from_f32.map(f32::to_bits));
 }
+
+/// Parameters cut short read as zeros in either storage: a network of three
+/// hidden layers (each buffer used as input and output in turn) whose array ends
+/// inside a layer evaluates, in place (`&[f32]`, a row of scratch) and decoded
+/// (f16, a block of scratch), to the bits of the same array padded with zeros.
+#[test]
+fn parameters_cut_short_read_as_zeros_in_either_storage() {
+    let shape = Shape::new(5, &[9, 6, 7], Activation::Relu, 3).unwrap();
+    let bits: Vec<u16> = (0..shape.param_len())
+        .map(|j| crate::quantize::f16_encode((noise(j) / 2.0) as f32))
+        .collect();
+    let input: [f32; INPUTS] = core::array::from_fn(|k| noise(k + 99) as f32);
+    let spans: Vec<LayerSpan> = shape.layers().collect();
+    // Cuts inside the first, second and last layers' weights and in the biases.
+    let cuts = [
+        spans[0].weights + 13,
+        spans[1].weights + 20,
+        spans[3].weights + 9,
+        spans[3].bias + 1,
+    ];
+    for cut in cuts {
+        let short = &bits[..cut];
+        let decoded: Vec<f32> = short.iter().map(|&h| f16_decode_finite(h)).collect();
+        let mut padded = decoded.clone();
+        padded.resize(shape.param_len(), 0.0);
+        for i in [0u32, 3] {
+            let want = Network {
+                shape,
+                params: &padded[..],
+            }
+            .evaluate(i, input);
+            let in_place = Network {
+                shape,
+                params: &decoded[..],
+            }
+            .evaluate(i, input);
+            let from_f16 = Network {
+                shape,
+                params: F16Params(short),
+            }
+            .evaluate(i, input);
+            assert_eq!(
+                in_place.map(f32::to_bits),
+                want.map(f32::to_bits),
+                "cut {cut}"
+            );
+            assert_eq!(
+                from_f16.map(f32::to_bits),
+                want.map(f32::to_bits),
+                "cut {cut}"
+            );
+        }
+    }
+}
