@@ -282,11 +282,11 @@ const TOURNAMENT: usize = 4;
 
 impl Trainer {
     /// A fresh trainer (parameters from the seed) or one resuming `resume`; an
-    /// error if the target's data cannot be read ([`ConditionPool::new`]).
+    /// error if the target's data cannot be read ([`ConditionPool::new`]) or
+    /// `resume` was written for another configuration.
     ///
     /// # Panics
-    /// If the configuration's shape is invalid, or `resume` was written for another
-    /// configuration.
+    /// If the configuration's shape is invalid.
     pub fn new(config: TrainConfig, resume: Option<Checkpoint>) -> anyhow::Result<Self> {
         let shape = config.shape().expect("valid network shape");
         let pool = ConditionPool::new(
@@ -300,7 +300,10 @@ impl Trainer {
         )?;
         let state = match resume {
             Some(c) => {
-                assert_eq!(c.config, config, "checkpoint of another configuration");
+                anyhow::ensure!(
+                    c.config == config,
+                    "the checkpoint was written with other training settings"
+                );
                 c
             }
             None => {
@@ -658,7 +661,18 @@ mod tests {
         let path = dir.join("checkpoint.bin");
         first.state.save(&path).unwrap();
         drop(first);
-        let mut resumed = Trainer::new(cfg, Some(Checkpoint::load(&path).unwrap())).unwrap();
+        let saved = Checkpoint::load(&path).unwrap();
+        // A checkpoint resumes only the configuration that wrote it.
+        let other = TrainConfig {
+            seed: cfg.seed + 1,
+            ..cfg.clone()
+        };
+        let refused = Trainer::new(other, Some(saved.clone())).err().unwrap();
+        assert!(
+            refused.to_string().contains("other training settings"),
+            "{refused}"
+        );
+        let mut resumed = Trainer::new(cfg, Some(saved)).unwrap();
         assert_eq!(resumed.state.step, 4);
         while !resumed.done() {
             resumed.step();
