@@ -197,22 +197,37 @@ pub fn top_normal(grid: u32, j: [u32; 2]) -> [f64; 3] {
 
 /// One row of a top-weight table, for the unit normal `n`: the exact weight
 /// `Σ_leaves max(0, n.m1)` of each node of levels `1..=TOP_LEVELS`, summed from
-/// the leaf records of `nodes` (a tree of `levels >= TOP_LEVELS` levels). `row`
-/// holds [`node_count`]`(TOP_LEVELS)` values. `O(4^L)`.
+/// the leaf records of `nodes` (a tree of `levels >= TOP_LEVELS` levels) in `f64`,
+/// each node of the deepest top level over its leaves, every node above over its
+/// four children. `row` holds [`node_count`]`(TOP_LEVELS)` values (zeros for a
+/// tree of no levels). `O(4^L)`.
 pub fn top_row(levels: u32, nodes: &[NodeRecord], n: [f64; 3], row: &mut [f32]) {
     let mut sums = [0.0f64; 84];
-    let side = 1u32 << levels;
-    for y in 0..side {
-        for x in 0..side {
-            let Some(r) = nodes.get(node_index(levels, x, y)) else {
-                continue;
-            };
-            let m = r.moment;
-            let w = (n[0] * m[0] as f64 + n[1] * m[1] as f64 + n[2] * m[2] as f64).max(0.0);
-            for l in 1..=TOP_LEVELS.min(levels) {
-                let s = levels - l;
-                sums[node_index(l, x >> s, y >> s)] += w;
-            }
+    if levels == 0 {
+        row.iter_mut().for_each(|v| *v = 0.0);
+        return;
+    }
+    let deepest = TOP_LEVELS.min(levels);
+    let first_leaf = quadtree::level_offset(levels) - 1;
+    let leaves = nodes.get(first_leaf..).unwrap_or(&[]);
+    // The leaves in their Morton order, which is the records' order (a bake asks
+    // for thousands of rows of a tree of megabytes): leaf `k`'s ancestor on level
+    // `l` is node `k >> 2 (L - l)` of that level.
+    let shift = 2 * (levels - deepest);
+    let base = quadtree::level_offset(deepest) - 1;
+    for (k, r) in leaves.iter().take(1 << (2 * levels)).enumerate() {
+        let m = r.moment;
+        let w = (n[0] * m[0] as f64 + n[1] * m[1] as f64 + n[2] * m[2] as f64).max(0.0);
+        sums[base + (k >> shift)] += w;
+    }
+    for l in (1..deepest).rev() {
+        let (parents, children) = (
+            quadtree::level_offset(l) - 1,
+            quadtree::level_offset(l + 1) - 1,
+        );
+        for q in 0..1usize << (2 * l) {
+            let c = children + 4 * q;
+            sums[parents + q] = sums[c] + sums[c + 1] + sums[c + 2] + sums[c + 3];
         }
     }
     for (out, v) in row.iter_mut().zip(sums) {

@@ -110,6 +110,15 @@ impl EnvmapDensity {
         let mut sum = 0.0;
         // Integration breakpoints of the current row, reused across rows.
         let mut cuts: Vec<f64> = Vec::new();
+        // Per column edge, the polar angles `delta -+ spread` about which the rim
+        // crosses it (NaN: never), computed once per cap: they do not depend on
+        // the row, and a map with many bright pixels asks for the same edges row
+        // after row.
+        let mut edge_crossings: Vec<Option<[f64; 2]>> = if self.has_bright {
+            vec![None; self.width + 1]
+        } else {
+            Vec::new()
+        };
         for r in 0..self.height {
             let rm = self.row_mass(r);
             let dz = self.z_hi[r] - self.z_lo[r];
@@ -146,16 +155,21 @@ impl EnvmapDensity {
                 cuts.extend([p0, p1]);
                 for &c in bright {
                     for edge in [c, c + 1] {
-                        let phi_c = TAU * edge as f64 / self.width as f64;
-                        let d = (phi_c - phi_w).rem_euclid(TAU);
-                        let cos_d = d.min(TAU - d).cos();
-                        // The arc's half width is d where t = cg cos(alpha) + sg cos(d) sin(alpha).
-                        let (x, y) = (cg, sg * cos_d);
-                        let big_r = (x * x + y * y).sqrt();
-                        if big_r <= 0.0 || t.abs() > big_r {
+                        let [delta, spread] = *edge_crossings[edge].get_or_insert_with(|| {
+                            let phi_c = TAU * edge as f64 / self.width as f64;
+                            let d = (phi_c - phi_w).rem_euclid(TAU);
+                            let cos_d = d.min(TAU - d).cos();
+                            // The arc's half width is d where t = cg cos(alpha) + sg cos(d) sin(alpha).
+                            let (x, y) = (cg, sg * cos_d);
+                            let big_r = (x * x + y * y).sqrt();
+                            if big_r <= 0.0 || t.abs() > big_r {
+                                return [f64::NAN; 2];
+                            }
+                            [y.atan2(x), (t / big_r).acos()]
+                        });
+                        if delta.is_nan() {
                             continue;
                         }
-                        let (delta, spread) = (y.atan2(x), (t / big_r).acos());
                         for al in [delta - spread, delta + spread, delta - spread + TAU] {
                             if al > pa && al < pb {
                                 cuts.push(psi(al));

@@ -30,11 +30,23 @@ impl EnvmapDensity {
             .filter(|&(c, r)| self.mass[r * w + c] > 0.0)
             .map(|(c, r)| (self.pixel_center(c, r), self.mass[r * w + c]))
             .collect();
+        // Normals in groups, each pixel read once per group: every normal's sum is
+        // still one chain in pixel order (the same bits as summing it alone), and
+        // the group's chains overlap where one would wait on each addition.
+        const GROUP: usize = 4;
         normals
-            .par_iter()
-            .map(|n| {
-                let share: f64 = lit.iter().map(|(d, m)| m * n.dot(*d).max(0.0)).sum();
-                self.integral * share
+            .par_chunks(GROUP)
+            .flat_map_iter(|group| {
+                let mut share = [-0.0f64; GROUP];
+                for (d, m) in &lit {
+                    for (s, n) in share.iter_mut().zip(group) {
+                        *s += m * n.dot(*d).max(0.0);
+                    }
+                }
+                share
+                    .into_iter()
+                    .take(group.len())
+                    .map(|s| self.integral * s)
             })
             .collect()
     }

@@ -55,6 +55,7 @@ use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
 use std::f64::consts::{PI, TAU};
 use std::path::Path;
+use std::sync::OnceLock;
 
 /// Points of the rule used for cap-measure profiles.
 const PROFILE_POINTS: usize = 1 << 15;
@@ -104,7 +105,16 @@ pub struct EnvmapDensity {
     row_cdf: Vec<f64>,
     /// Per row, the columns of its bright pixels (see [`BRIGHT_PIXEL`]).
     bright_cols: Vec<Vec<usize>>,
-    profile_rule: Vec<(DVec3, f64)>,
+    /// Whether any row has a bright pixel.
+    has_bright: bool,
+    /// Per column, `[cos phi, sin phi]` of its centre; per row, `[z, sqrt(1 - z^2)]`
+    /// of its centre: [`Self::pixel_center`] without a sine or cosine per pixel
+    /// (the lit maps of a bake light every pixel of hundreds of normals).
+    col_trig: Vec<[f64; 2]>,
+    row_trig: Vec<[f64; 2]>,
+    /// The rule of [`Self::cap_measure_profile`], built on first use: a bake
+    /// builds a lit map per normal and never asks most of them for a profile.
+    profile_rule: OnceLock<Vec<(DVec3, f64)>>,
     negative: NegativePixels,
 }
 
@@ -211,7 +221,19 @@ impl EnvmapDensity {
                 (0..w).filter(|&c| row[c] > floor).collect()
             })
             .collect();
-        let mut d = Self {
+        let col_trig = (0..w)
+            .map(|c| {
+                let phi = TAU * (c as f64 + 0.5) / w as f64;
+                [phi.cos(), phi.sin()]
+            })
+            .collect();
+        let row_trig = (0..h)
+            .map(|r| {
+                let z = 0.5 * (z_lo[r] + z_hi[r]);
+                [z, (1.0 - z * z).max(0.0).sqrt()]
+            })
+            .collect();
+        Ok(Self {
             name: name.to_string(),
             width: w,
             height: h,
@@ -222,12 +244,13 @@ impl EnvmapDensity {
             integral: total,
             col_cum,
             row_cdf,
+            has_bright: bright_cols.iter().any(|b| !b.is_empty()),
             bright_cols,
-            profile_rule: Vec::new(),
+            col_trig,
+            row_trig,
+            profile_rule: OnceLock::new(),
             negative,
-        };
-        d.profile_rule = d.quadrature(PROFILE_POINTS);
-        Ok(d)
+        })
     }
 
     /// Loads `path` like [`Self::from_file`], as [`Self::from_luminance_filtered`].
@@ -299,11 +322,11 @@ impl EnvmapDensity {
     }
 
     /// Direction of the centre of pixel `(c, r)`.
+    #[inline]
     fn pixel_center(&self, c: usize, r: usize) -> DVec3 {
-        let z = 0.5 * (self.z_lo[r] + self.z_hi[r]);
-        let phi = TAU * (c as f64 + 0.5) / self.width as f64;
-        let s = (1.0 - z * z).max(0.0).sqrt();
-        DVec3::new(s * phi.cos(), s * phi.sin(), z)
+        let [z, s] = self.row_trig[r];
+        let [cos_phi, sin_phi] = self.col_trig[c];
+        DVec3::new(s * cos_phi, s * sin_phi, z)
     }
 }
 
@@ -368,7 +391,10 @@ impl DirectionDensity for EnvmapDensity {
     }
 
     fn cap_measure_profile(&self, center: DVec3, cos_thetas: &[f64]) -> Vec<f64> {
-        profile_of_rule(self.profile_rule.iter().copied(), center, cos_thetas)
+        let rule = self
+            .profile_rule
+            .get_or_init(|| self.quadrature(PROFILE_POINTS));
+        profile_of_rule(rule.iter().copied(), center, cos_thetas)
     }
 
     /// The mass-adaptive rule of [`EnvmapDensity::mass_rule`].

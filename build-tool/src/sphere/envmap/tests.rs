@@ -85,6 +85,53 @@ fn filtered_map_integrates_the_bilinear_luminance() {
     }
 }
 
+/// Irradiances of many normals, summed in groups that share each pixel's read,
+/// are bit for bit each normal's own sum in pixel order over the pixel centres
+/// written out here with their sines and cosines (counts that fill no group
+/// exactly, and a normal that no light reaches).
+#[test]
+fn irradiances_of_many_normals_are_each_normals_own_sum() {
+    let img = image(
+        40,
+        20,
+        |c, r| if r < 8 { 1.0 + (c * r) as f64 } else { 0.0 },
+    );
+    let d = EnvmapDensity::from_luminance(&img, Domain::Sphere, "t").unwrap();
+    let all: Vec<DVec3> = (0..7)
+        .map(|k| {
+            DVec3::new(
+                (k as f64).cos(),
+                0.3 * k as f64 - 1.0,
+                (2.0 * k as f64).sin(),
+            )
+            .normalize()
+        })
+        .chain([DVec3::NEG_Z])
+        .collect();
+    for count in [1, 3, 4, 5, 8] {
+        let normals = &all[..count];
+        let got = d.irradiances(normals);
+        for (n, got) in normals.iter().zip(got) {
+            let mut sum = -0.0;
+            for r in 0..d.height() {
+                let (lo, hi) = d.row_z_range(r);
+                let z = 0.5 * (lo + hi);
+                let s = (1.0 - z * z).max(0.0).sqrt();
+                for c in 0..d.width() {
+                    let m = d.pixel_mass(c, r);
+                    if m > 0.0 {
+                        let phi = TAU * (c as f64 + 0.5) / d.width() as f64;
+                        let center = DVec3::new(s * phi.cos(), s * phi.sin(), z);
+                        sum += m * n.dot(center).max(0.0);
+                    }
+                }
+            }
+            assert_eq!(got.to_bits(), (d.integral() * sum).to_bits(), "{count} {n}");
+        }
+    }
+    assert_eq!(d.irradiance(DVec3::NEG_Z), 0.0);
+}
+
 #[test]
 fn constant_map_reproduces_uniform_cap_measures() {
     let img = image(64, 32, |_, _| 2.5);
