@@ -1,52 +1,155 @@
 //! How low one normal's set can go on a map, on the judge of `bake --envmap`'s
-//! held-out check: `cargo run --release -p nuld-build-tool --example
-//! envmap_bounds -- MAP [N] [STEPS] [STEP]`.
+//! held-out check, and whether sets fitted at the table's nodes still serve
+//! between them: `cargo run --release -p nuld-build-tool --example
+//! envmap_bounds -- MAP [N] [STEPS] [STEP] [GRID]`.
 //!
 //! At the check's 16 held-out normals (the cell centres of a 4 x 4 grid on the
 //! octahedral square), with the check's own 4096 caps and exact cap measures
 //! and its baseline (the mean cap L2 of 8 Owen-Sobol sets through each normal's
-//! exact inverse CDF), prints three ratios to that baseline:
+//! exact inverse CDF), prints four ratios to that baseline:
 //!
 //! * `lattice`: instance 0's shifted rank-1 lattice through the prior (the tree
 //!   at that normal), what a network with a zero residual gives;
-//! * `primary`: that lattice optimized for this one normal in the tree's primary
+//! * `primary`: that lattice fitted to this one normal in the tree's primary
 //!   space, as training moves points (cap loss with per-point sharpness in local
 //!   units, gradients through the tree's exact slopes, 256 of 2048 caps measured on
 //!   the lit map's mass rule per step, sharpness 8 to 64 inverse spacings), by
 //!   Adam on the points themselves, `STEPS` steps (default 3000) of size `STEP /
 //!   sqrt(N)` in the square (default 0.02) with cosine decay to 3 %;
+//! * `blend`: the lattice fitted so at each of the four nodes around the normal
+//!   of a `GRID x GRID` table (default 13, the bake's), those four primary sets
+//!   blended bilinearly (table mode's arithmetic, in `f64`) and warped at the
+//!   normal itself;
 //! * `direct`: the direction optimizer of `optimize --domain sphere` (its
 //!   defaults, seed 0) on the lit map, no prior at all.
 //!
 //! What a conditional sampler trained in the prior's primary space could reach
-//! at one normal, against what it reaches across all of them
-//! ([docs/results/envmap.md](../../docs/results/envmap.md)).
+//! at one normal, and in a table fitted node by node, against what the bake's
+//! network reaches across all normals (docs/results/envmap.md, "bounds").
 use glam::{DVec2, DVec3};
 use nuld_build_tool::baselines::warped_owen_sobol_directions;
+use nuld_build_tool::descent::local_factor;
 use nuld_build_tool::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use nuld_build_tool::discrepancy::GradientPath;
 use nuld_build_tool::optimize::directions::{optimize_directions, DirectionConfig};
 use nuld_build_tool::seeding::derive_seed;
 use nuld_build_tool::sphere::metrics::{CapRadius, MeasuredCaps};
-use nuld_build_tool::sphere::{CapMeasureTable, DirectionDensity};
+use nuld_build_tool::sphere::{CapMeasureTable, DirectionDensity, EnvmapDensity};
 use nuld_build_tool::train::target::LoadedTarget;
 use nuld_build_tool::train::{TrainConfig, TrainTarget};
+use nuld_core::envmap_tree::EnvmapTree;
 use nuld_core::network::shifted_lattice_point;
-use nuld_core::sphere::square_to_sphere;
+use nuld_core::sphere::{square_to_sphere, square_to_sphere_real};
 use rayon::prelude::*;
+use std::f64::consts::PI;
 use std::path::PathBuf;
 
 /// The held-out check's seed (`QualityConfig::held_out` in `bake`).
 const CHECK_SEED: u64 = 0x9a11;
 
+/// The fit's settings.
+struct Fit {
+    n: usize,
+    steps: usize,
+    step: f64,
+}
+
+/// The tree's warp at the normal of octahedral point `u`, and its Jacobian: the
+/// sphere map's (smooth, by central differences) times the descent's exact
+/// slopes.
+fn warp(tree: &EnvmapTree<'_>, u: [f64; 2], p: DVec2) -> (DVec3, DVec3, DVec3) {
+    let (q, _, slopes) = tree.sample_square_with_slopes(u, p.to_array());
+    let q = DVec2::from(q);
+    let h = 1e-7;
+    let at = |a: DVec2| square_to_sphere(a.clamp(DVec2::ZERO, DVec2::ONE));
+    let jx = (at(q + DVec2::X * h) - at(q - DVec2::X * h)) / (2.0 * h);
+    let jy = (at(q + DVec2::Y * h) - at(q - DVec2::Y * h)) / (2.0 * h);
+    (at(q), jx * slopes[0], jy * slopes[1])
+}
+
+/// `start` fitted in the primary space of the normal of octahedral point `u`
+/// (see the module docs); `stream` seeds its caps.
+fn fit(
+    tree: &EnvmapTree<'_>,
+    map: &EnvmapDensity,
+    u: [f64; 2],
+    start: &[DVec2],
+    how: &Fit,
+    stream: u32,
+) -> Vec<DVec2> {
+    let n = how.n;
+    let (lit, _) = map
+        .cosine_weighted(square_to_sphere(DVec2::from(u)))
+        .unwrap();
+    let table = CapMeasureTable::new(&lit.mass_rule(1 << 14));
+    let caps: Vec<Cap> = (0..2048)
+        .map(|k| {
+            let s = |d| sobol_burley::sample(k, d, stream) as f64;
+            Cap::new(
+                DVec3::from_array(square_to_sphere_real([s(0), s(1)])),
+                PI * s(2),
+            )
+        })
+        .collect();
+    let measures: Vec<f64> = caps
+        .iter()
+        .map(|c| table.measure(c.center, c.cos_theta))
+        .collect();
+    let mut p = start.to_vec();
+    let (mut m, mut v) = (vec![DVec2::ZERO; n], vec![DVec2::ZERO; n]);
+    let spacing = (4.0 * PI / n as f64).sqrt();
+    let mut grad = vec![DVec3::ZERO; n];
+    for t in 0..how.steps {
+        let f = t as f64 / how.steps as f64;
+        let alpha = 8.0 * 8f64.powf(f) / spacing;
+        let lr = how.step / (n as f64).sqrt() * (0.03 + 0.97 * 0.5 * (1.0 + (PI * f).cos()));
+        let w: Vec<_> = p.iter().map(|&q| warp(tree, u, q)).collect();
+        let dirs: Vec<DVec3> = w.iter().map(|x| x.0).collect();
+        let local: Vec<f64> = dirs
+            .iter()
+            .map(|&x| local_factor(4.0 * PI, lit.pdf(x)))
+            .collect();
+        let window: Vec<usize> = (0..256).map(|j| (256 * t + j) % caps.len()).collect();
+        let c: Vec<Cap> = window.iter().map(|&j| caps[j]).collect();
+        let mu: Vec<f64> = window.iter().map(|&j| measures[j]).collect();
+        cap_loss_and_gradient(
+            &dirs,
+            &c,
+            CapArea::Precomputed(&mu),
+            alpha,
+            Some(&local),
+            GradientPath::Fast,
+            &mut grad,
+        );
+        let (b1, b2) = (
+            1.0 - 0.9f64.powi(t as i32 + 1),
+            1.0 - 0.999f64.powi(t as i32 + 1),
+        );
+        for i in 0..n {
+            let gi = DVec2::new(w[i].1.dot(grad[i]), w[i].2.dot(grad[i]));
+            m[i] = 0.9 * m[i] + 0.1 * gi;
+            v[i] = 0.999 * v[i] + 0.001 * gi * gi;
+            let s = lr * (m[i] / b1) / ((v[i] / b2).powf(0.5) + DVec2::splat(1e-12));
+            p[i] = (p[i] - s).clamp(DVec2::ZERO, DVec2::splat(1.0 - 1e-12));
+        }
+    }
+    p
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    if !(2..=5).contains(&args.len()) {
-        eprintln!("usage: envmap_bounds MAP [N] [STEPS] [STEP]");
+    if !(2..=6).contains(&args.len()) {
+        eprintln!("usage: envmap_bounds MAP [N] [STEPS] [STEP] [GRID]");
         std::process::exit(2);
     }
     let arg = |k: usize, default: f64| args.get(k).map_or(default, |s| s.parse().unwrap());
-    let (n, steps, step) = (arg(2, 64.0) as usize, arg(3, 3000.0) as usize, arg(4, 0.02));
+    let how = Fit {
+        n: arg(2, 64.0) as usize,
+        steps: arg(3, 3000.0) as usize,
+        step: arg(4, 0.02),
+    };
+    let grid = arg(5, 13.0) as usize;
+    let n = how.n;
     let target = TrainTarget::envmap(&PathBuf::from(&args[1])).unwrap();
     let shape = TrainConfig {
         target: target.clone(),
@@ -63,7 +166,7 @@ fn main() {
     let lattice: Vec<DVec2> = (0..n as u32)
         .map(|i| DVec2::from(shifted_lattice_point(i, n as u32, g, z)))
         .collect();
-    let rows: Vec<[f64; 3]> = (0..16usize)
+    let rows: Vec<[f64; 4]> = (0..16usize)
         .into_par_iter()
         .filter_map(|index| {
             let u = [
@@ -86,73 +189,50 @@ fn main() {
                 .map(|s| d(&warped_owen_sobol_directions(&lit, n, CHECK_SEED ^ (s + 1))))
                 .sum::<f64>()
                 / 8.0;
-            // The tree's warp and its Jacobian: the sphere map's (smooth, by
-            // central differences) times the descent's exact slopes.
-            let warp = |p: DVec2| {
-                let (q, _, slopes) = tree.sample_square_with_slopes(u, p.to_array());
-                let q = DVec2::from(q);
-                let h = 1e-7;
-                let at = |a: DVec2| square_to_sphere(a.clamp(DVec2::ZERO, DVec2::ONE));
-                let jx = (at(q + DVec2::X * h) - at(q - DVec2::X * h)) / (2.0 * h);
-                let jy = (at(q + DVec2::Y * h) - at(q - DVec2::Y * h)) / (2.0 * h);
-                (at(q), jx * slopes[0], jy * slopes[1])
-            };
-            let directions = |p: &[DVec2]| p.iter().map(|&q| warp(q).0).collect::<Vec<_>>();
+            let directions =
+                |p: &[DVec2]| p.iter().map(|&q| warp(&tree, u, q).0).collect::<Vec<_>>();
             let start = d(&directions(&lattice)) / baseline;
+            let primary = fit(&tree, &env.map, u, &lattice, &how, index as u32);
+            let primary = d(&directions(&primary)) / baseline;
 
-            let table = CapMeasureTable::new(&lit.mass_rule(1 << 14));
-            let caps: Vec<Cap> = (0..2048)
-                .map(|k| {
-                    let s = nuld_core::sphere::square_to_sphere_real([
-                        sobol_burley::sample(k, 0, index as u32) as f64,
-                        sobol_burley::sample(k, 1, index as u32) as f64,
-                    ]);
-                    let theta = std::f64::consts::PI * sobol_burley::sample(k, 2, index as u32) as f64;
-                    Cap::new(DVec3::from_array(s), theta)
-                })
-                .collect();
-            let measures: Vec<f64> = caps.iter().map(|c| table.measure(c.center, c.cos_theta)).collect();
-            let mut p = lattice.clone();
-            let (mut m, mut v) = (vec![DVec2::ZERO; n], vec![DVec2::ZERO; n]);
-            let spacing = (4.0 * std::f64::consts::PI / n as f64).sqrt();
-            let mut grad = vec![DVec3::ZERO; n];
-            for t in 0..steps {
-                let f = t as f64 / steps as f64;
-                let alpha = 8.0 * 8f64.powf(f) / spacing;
-                let lr = step / (n as f64).sqrt()
-                    * (0.03 + 0.97 * 0.5 * (1.0 + (std::f64::consts::PI * f).cos()));
-                let w: Vec<_> = p.iter().map(|&q| warp(q)).collect();
-                let dirs: Vec<DVec3> = w.iter().map(|x| x.0).collect();
-                let local: Vec<f64> = dirs
-                    .iter()
-                    .map(|&x| nuld_build_tool::descent::local_factor(4.0 * std::f64::consts::PI, lit.pdf(x)))
-                    .collect();
-                let window: Vec<usize> = (0..256).map(|j| (256 * t + j) % caps.len()).collect();
-                let c: Vec<Cap> = window.iter().map(|&j| caps[j]).collect();
-                let mu: Vec<f64> = window.iter().map(|&j| measures[j]).collect();
-                cap_loss_and_gradient(&dirs, &c, CapArea::Precomputed(&mu), alpha, Some(&local), GradientPath::Fast, &mut grad);
-                let (b1, b2) = (1.0 - 0.9f64.powi(t as i32 + 1), 1.0 - 0.999f64.powi(t as i32 + 1));
-                for i in 0..n {
-                    let gi = DVec2::new(w[i].1.dot(grad[i]), w[i].2.dot(grad[i]));
-                    m[i] = 0.9 * m[i] + 0.1 * gi;
-                    v[i] = 0.999 * v[i] + 0.001 * gi * gi;
-                    let s = lr * (m[i] / b1) / ((v[i] / b2).powf(0.5) + DVec2::splat(1e-12));
-                    p[i] = (p[i] - s).clamp(DVec2::ZERO, DVec2::splat(1.0 - 1e-12));
+            // The four table nodes around `u` and their bilinear weights.
+            let cell = u.map(|x| {
+                let s = x * (grid - 1) as f64;
+                let j = (s.floor() as usize).min(grid - 2);
+                (j, s - j as f64)
+            });
+            let mut blend = vec![DVec2::ZERO; n];
+            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let node = [
+                    (cell[0].0 + dx) as f64 / (grid - 1) as f64,
+                    (cell[1].0 + dy) as f64 / (grid - 1) as f64,
+                ];
+                let w = if dx == 0 { 1.0 - cell[0].1 } else { cell[0].1 }
+                    * if dy == 0 { 1.0 - cell[1].1 } else { cell[1].1 };
+                let stream = 1000 + (index * 4 + 2 * dy + dx) as u32;
+                for (b, q) in blend
+                    .iter_mut()
+                    .zip(fit(&tree, &env.map, node, &lattice, &how, stream))
+                {
+                    *b += w * q;
                 }
             }
-            let primary = d(&directions(&p)) / baseline;
+            let blend = d(&directions(&blend)) / baseline;
 
             let direct = optimize_directions(&lit, n, &DirectionConfig::default(), &mut |_| {});
             let direct: Vec<DVec3> = direct.iter().map(|&q| square_to_sphere(q)).collect();
             let direct = d(&direct) / baseline;
-            println!("normal {index:2} {normal:.3}: lattice {start:.3}  primary {primary:.3}  direct {direct:.3}");
-            Some([start, primary, direct])
+            println!(
+                "normal {index:2} {normal:.3}: lattice {start:.3}  primary {primary:.3}  \
+                 blend {blend:.3}  direct {direct:.3}"
+            );
+            Some([start, primary, blend, direct])
         })
         .collect();
     let k = rows.len() as f64;
-    let mean = |j: usize| rows.iter().map(|r| r[j]).sum::<f64>() / k;
-    let worst = |j: usize| rows.iter().map(|r| r[j]).fold(0.0, f64::max);
-    for (j, name) in ["lattice", "primary", "direct"].iter().enumerate() {
-        println!("{name}: mean {:.3}, worst {:.3}", mean(j), worst(j));
+    for (j, name) in ["lattice", "primary", "blend", "direct"].iter().enumerate() {
+        let mean = rows.iter().map(|r| r[j]).sum::<f64>() / k;
+        let worst = rows.iter().map(|r| r[j]).fold(0.0, f64::max);
+        println!("{name}: mean {mean:.3}, worst {worst:.3}");
     }
 }
