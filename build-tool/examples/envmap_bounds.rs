@@ -6,7 +6,7 @@
 //! At the check's 16 held-out normals (the cell centres of a 4 x 4 grid on the
 //! octahedral square), with the check's own 4096 caps and exact cap measures
 //! and its baseline (the mean cap L2 of 8 Owen-Sobol sets through each normal's
-//! exact inverse CDF), prints four ratios to that baseline:
+//! exact inverse CDF), prints six ratios to that baseline:
 //!
 //! * `lattice`: instance 0's shifted rank-1 lattice through the prior (the tree
 //!   at that normal), what a network with a zero residual gives;
@@ -20,6 +20,13 @@
 //!   of a `GRID x GRID` table (default 13, the bake's), those four primary sets
 //!   blended bilinearly (table mode's arithmetic, in `f64`) and warped at the
 //!   normal itself;
+//! * `joint`: one set fitted to those four nodes at once (the sum of their
+//!   losses), warped at the normal: what a family of sets that changes
+//!   smoothly across the cell could keep;
+//! * `joint directions`: the same in the sphere's equal-area square (the
+//!   lattice through the tree at the normal, fitted to the four nodes'
+//!   targets as directions, read at the normal as they are): the family in
+//!   the space where the lights stay put as the normal moves;
 //! * `direct`: the direction optimizer of `optimize --domain sphere` (its
 //!   defaults, seed 0) on the lit map, no prior at all.
 //!
@@ -56,10 +63,16 @@ struct Fit {
 
 /// The tree's warp at the normal of octahedral point `u`, and its Jacobian: the
 /// sphere map's (smooth, by central differences) times the descent's exact
-/// slopes.
-fn warp(tree: &EnvmapTree<'_>, u: [f64; 2], p: DVec2) -> (DVec3, DVec3, DVec3) {
-    let (q, _, slopes) = tree.sample_square_with_slopes(u, p.to_array());
-    let q = DVec2::from(q);
+/// slopes; without a tree, the sphere's equal-area map alone (`p` a point of the
+/// sphere's square, the same direction at every normal).
+fn warp(tree: Option<&EnvmapTree<'_>>, u: [f64; 2], p: DVec2) -> (DVec3, DVec3, DVec3) {
+    let (q, slopes) = match tree {
+        Some(tree) => {
+            let (q, _, slopes) = tree.sample_square_with_slopes(u, p.to_array());
+            (DVec2::from(q), slopes)
+        }
+        None => (p, [1.0; 2]),
+    };
     let h = 1e-7;
     let at = |a: DVec2| square_to_sphere(a.clamp(DVec2::ZERO, DVec2::ONE));
     let jx = (at(q + DVec2::X * h) - at(q - DVec2::X * h)) / (2.0 * h);
@@ -67,34 +80,49 @@ fn warp(tree: &EnvmapTree<'_>, u: [f64; 2], p: DVec2) -> (DVec3, DVec3, DVec3) {
     (at(q), jx * slopes[0], jy * slopes[1])
 }
 
-/// `start` fitted in the primary space of the normal of octahedral point `u`
-/// (see the module docs); `stream` seeds its caps.
-fn fit(
-    tree: &EnvmapTree<'_>,
-    map: &EnvmapDensity,
+/// What a fit reads at one normal: its octahedral point, lit map, caps and their
+/// measures on the lit map's mass rule.
+struct Site {
     u: [f64; 2],
-    start: &[DVec2],
-    how: &Fit,
-    stream: u32,
-) -> Vec<DVec2> {
+    lit: EnvmapDensity,
+    caps: Vec<Cap>,
+    measures: Vec<f64>,
+}
+
+impl Site {
+    /// The normal of octahedral point `u`, its 2048 caps from `stream`.
+    fn new(map: &EnvmapDensity, u: [f64; 2], stream: u32) -> Self {
+        let (lit, _) = map
+            .cosine_weighted(square_to_sphere(DVec2::from(u)))
+            .unwrap();
+        let table = CapMeasureTable::new(&lit.mass_rule(1 << 14));
+        let caps: Vec<Cap> = (0..2048)
+            .map(|k| {
+                let s = |d| sobol_burley::sample(k, d, stream) as f64;
+                Cap::new(
+                    DVec3::from_array(square_to_sphere_real([s(0), s(1)])),
+                    PI * s(2),
+                )
+            })
+            .collect();
+        let measures = caps
+            .iter()
+            .map(|c| table.measure(c.center, c.cos_theta))
+            .collect();
+        Self {
+            u,
+            lit,
+            caps,
+            measures,
+        }
+    }
+}
+
+/// `start` fitted in the primary space of the normals `sites` at once (the sum
+/// of their losses; see the module docs), or without a tree in the sphere's
+/// equal-area square.
+fn fit(tree: Option<&EnvmapTree<'_>>, sites: &[Site], start: &[DVec2], how: &Fit) -> Vec<DVec2> {
     let n = how.n;
-    let (lit, _) = map
-        .cosine_weighted(square_to_sphere(DVec2::from(u)))
-        .unwrap();
-    let table = CapMeasureTable::new(&lit.mass_rule(1 << 14));
-    let caps: Vec<Cap> = (0..2048)
-        .map(|k| {
-            let s = |d| sobol_burley::sample(k, d, stream) as f64;
-            Cap::new(
-                DVec3::from_array(square_to_sphere_real([s(0), s(1)])),
-                PI * s(2),
-            )
-        })
-        .collect();
-    let measures: Vec<f64> = caps
-        .iter()
-        .map(|c| table.measure(c.center, c.cos_theta))
-        .collect();
     let mut p = start.to_vec();
     let (mut m, mut v) = (vec![DVec2::ZERO; n], vec![DVec2::ZERO; n]);
     let spacing = (4.0 * PI / n as f64).sqrt();
@@ -103,32 +131,37 @@ fn fit(
         let f = t as f64 / how.steps as f64;
         let alpha = 8.0 * 8f64.powf(f) / spacing;
         let lr = how.step / (n as f64).sqrt() * (0.03 + 0.97 * 0.5 * (1.0 + (PI * f).cos()));
-        let w: Vec<_> = p.iter().map(|&q| warp(tree, u, q)).collect();
-        let dirs: Vec<DVec3> = w.iter().map(|x| x.0).collect();
-        let local: Vec<f64> = dirs
-            .iter()
-            .map(|&x| local_factor(4.0 * PI, lit.pdf(x)))
-            .collect();
-        let window: Vec<usize> = (0..256).map(|j| (256 * t + j) % caps.len()).collect();
-        let c: Vec<Cap> = window.iter().map(|&j| caps[j]).collect();
-        let mu: Vec<f64> = window.iter().map(|&j| measures[j]).collect();
-        cap_loss_and_gradient(
-            &dirs,
-            &c,
-            CapArea::Precomputed(&mu),
-            alpha,
-            Some(&local),
-            GradientPath::Fast,
-            &mut grad,
-        );
+        let mut g = vec![DVec2::ZERO; n];
+        for site in sites {
+            let w: Vec<_> = p.iter().map(|&q| warp(tree, site.u, q)).collect();
+            let dirs: Vec<DVec3> = w.iter().map(|x| x.0).collect();
+            let local: Vec<f64> = dirs
+                .iter()
+                .map(|&x| local_factor(4.0 * PI, site.lit.pdf(x)))
+                .collect();
+            let window: Vec<usize> = (0..256).map(|j| (256 * t + j) % site.caps.len()).collect();
+            let c: Vec<Cap> = window.iter().map(|&j| site.caps[j]).collect();
+            let mu: Vec<f64> = window.iter().map(|&j| site.measures[j]).collect();
+            cap_loss_and_gradient(
+                &dirs,
+                &c,
+                CapArea::Precomputed(&mu),
+                alpha,
+                Some(&local),
+                GradientPath::Fast,
+                &mut grad,
+            );
+            for i in 0..n {
+                g[i] += DVec2::new(w[i].1.dot(grad[i]), w[i].2.dot(grad[i]));
+            }
+        }
         let (b1, b2) = (
             1.0 - 0.9f64.powi(t as i32 + 1),
             1.0 - 0.999f64.powi(t as i32 + 1),
         );
         for i in 0..n {
-            let gi = DVec2::new(w[i].1.dot(grad[i]), w[i].2.dot(grad[i]));
-            m[i] = 0.9 * m[i] + 0.1 * gi;
-            v[i] = 0.999 * v[i] + 0.001 * gi * gi;
+            m[i] = 0.9 * m[i] + 0.1 * g[i];
+            v[i] = 0.999 * v[i] + 0.001 * g[i] * g[i];
             let s = lr * (m[i] / b1) / ((v[i] / b2).powf(0.5) + DVec2::splat(1e-12));
             p[i] = (p[i] - s).clamp(DVec2::ZERO, DVec2::splat(1.0 - 1e-12));
         }
@@ -166,7 +199,7 @@ fn main() {
     let lattice: Vec<DVec2> = (0..n as u32)
         .map(|i| DVec2::from(shifted_lattice_point(i, n as u32, g, z)))
         .collect();
-    let rows: Vec<[f64; 4]> = (0..16usize)
+    let rows: Vec<[f64; 6]> = (0..16usize)
         .into_par_iter()
         .filter_map(|index| {
             let u = [
@@ -189,10 +222,18 @@ fn main() {
                 .map(|s| d(&warped_owen_sobol_directions(&lit, n, CHECK_SEED ^ (s + 1))))
                 .sum::<f64>()
                 / 8.0;
-            let directions =
-                |p: &[DVec2]| p.iter().map(|&q| warp(&tree, u, q).0).collect::<Vec<_>>();
+            let directions = |p: &[DVec2]| {
+                p.iter()
+                    .map(|&q| warp(Some(&tree), u, q).0)
+                    .collect::<Vec<_>>()
+            };
             let start = d(&directions(&lattice)) / baseline;
-            let primary = fit(&tree, &env.map, u, &lattice, &how, index as u32);
+            let primary = fit(
+                Some(&tree),
+                &[Site::new(&env.map, u, index as u32)],
+                &lattice,
+                &how,
+            );
             let primary = d(&directions(&primary)) / baseline;
 
             // The four table nodes around `u` and their bilinear weights.
@@ -201,36 +242,64 @@ fn main() {
                 let j = (s.floor() as usize).min(grid - 2);
                 (j, s - j as f64)
             });
+            let corners = [(0, 0), (1, 0), (0, 1), (1, 1)];
+            let nodes: Vec<Site> = corners
+                .iter()
+                .map(|&(dx, dy)| {
+                    let node = [
+                        (cell[0].0 + dx) as f64 / (grid - 1) as f64,
+                        (cell[1].0 + dy) as f64 / (grid - 1) as f64,
+                    ];
+                    Site::new(&env.map, node, 1000 + (index * 4 + 2 * dy + dx) as u32)
+                })
+                .collect();
             let mut blend = vec![DVec2::ZERO; n];
-            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                let node = [
-                    (cell[0].0 + dx) as f64 / (grid - 1) as f64,
-                    (cell[1].0 + dy) as f64 / (grid - 1) as f64,
-                ];
+            for (&(dx, dy), site) in corners.iter().zip(&nodes) {
                 let w = if dx == 0 { 1.0 - cell[0].1 } else { cell[0].1 }
                     * if dy == 0 { 1.0 - cell[1].1 } else { cell[1].1 };
-                let stream = 1000 + (index * 4 + 2 * dy + dx) as u32;
-                for (b, q) in blend
-                    .iter_mut()
-                    .zip(fit(&tree, &env.map, node, &lattice, &how, stream))
-                {
+                let fitted = fit(Some(&tree), std::slice::from_ref(site), &lattice, &how);
+                for (b, q) in blend.iter_mut().zip(fitted) {
                     *b += w * q;
                 }
             }
             let blend = d(&directions(&blend)) / baseline;
+            let joint = d(&directions(&fit(Some(&tree), &nodes, &lattice, &how))) / baseline;
+            // The same in directions: the lattice through the tree at the normal,
+            // fitted to the four nodes on the sphere's square.
+            let from: Vec<DVec2> = directions(&lattice)
+                .iter()
+                .map(|&x| nuld_core::sphere::sphere_to_square(x))
+                .collect();
+            let joint_directions = fit(None, &nodes, &from, &how);
+            let joint_directions: Vec<DVec3> = joint_directions
+                .iter()
+                .map(|&q| square_to_sphere(q))
+                .collect();
+            let joint_directions = d(&joint_directions) / baseline;
 
             let direct = optimize_directions(&lit, n, &DirectionConfig::default(), &mut |_| {});
             let direct: Vec<DVec3> = direct.iter().map(|&q| square_to_sphere(q)).collect();
             let direct = d(&direct) / baseline;
             println!(
                 "normal {index:2} {normal:.3}: lattice {start:.3}  primary {primary:.3}  \
-                 blend {blend:.3}  direct {direct:.3}"
+                 blend {blend:.3}  joint {joint:.3}  joint directions {joint_directions:.3}  \
+                 direct {direct:.3}"
             );
-            Some([start, primary, blend, direct])
+            Some([start, primary, blend, joint, joint_directions, direct])
         })
         .collect();
     let k = rows.len() as f64;
-    for (j, name) in ["lattice", "primary", "blend", "direct"].iter().enumerate() {
+    for (j, name) in [
+        "lattice",
+        "primary",
+        "blend",
+        "joint",
+        "joint directions",
+        "direct",
+    ]
+    .iter()
+    .enumerate()
+    {
         let mean = rows.iter().map(|r| r[j]).sum::<f64>() / k;
         let worst = rows.iter().map(|r| r[j]).fold(0.0, f64::max);
         println!("{name}: mean {mean:.3}, worst {worst:.3}");
