@@ -208,23 +208,21 @@ pub fn top_row(levels: u32, nodes: &[NodeRecord], n: [f64; 3], row: &mut [f32]) 
         return;
     }
     let deepest = TOP_LEVELS.min(levels);
-    let first_leaf = quadtree::level_offset(levels) - 1;
-    let leaves = nodes.get(first_leaf..).unwrap_or(&[]);
+    // Level `l`'s records start at its node (0, 0), each level in Morton order.
+    let first = |l: u32| node_index(l, 0, 0);
+    let leaves = nodes.get(first(levels)..).unwrap_or(&[]);
     // The leaves in their Morton order, which is the records' order (a bake asks
     // for thousands of rows of a tree of megabytes): leaf `k`'s ancestor on level
     // `l` is node `k >> 2 (L - l)` of that level.
     let shift = 2 * (levels - deepest);
-    let base = quadtree::level_offset(deepest) - 1;
+    let base = first(deepest);
     for (k, r) in leaves.iter().take(1 << (2 * levels)).enumerate() {
         let m = r.moment;
         let w = (n[0] * m[0] as f64 + n[1] * m[1] as f64 + n[2] * m[2] as f64).max(0.0);
         sums[base + (k >> shift)] += w;
     }
     for l in (1..deepest).rev() {
-        let (parents, children) = (
-            quadtree::level_offset(l) - 1,
-            quadtree::level_offset(l + 1) - 1,
-        );
+        let (parents, children) = (first(l), first(l + 1));
         for q in 0..1usize << (2 * l) {
             let c = children + 4 * q;
             sums[parents + q] = sums[c] + sums[c + 1] + sums[c + 2] + sums[c + 3];

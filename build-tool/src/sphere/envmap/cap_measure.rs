@@ -113,12 +113,8 @@ impl EnvmapDensity {
         // Per column edge, the polar angles `delta -+ spread` about which the rim
         // crosses it (NaN: never), computed once per cap: they do not depend on
         // the row, and a map with many bright pixels asks for the same edges row
-        // after row.
-        let mut edge_crossings: Vec<Option<[f64; 2]>> = if self.has_bright {
-            vec![None; self.width + 1]
-        } else {
-            Vec::new()
-        };
+        // after row. Sized at the first row with a bright pixel.
+        let mut edge_crossings: Vec<Option<[f64; 2]>> = Vec::new();
         for r in 0..self.height {
             let rm = self.row_mass(r);
             let dz = self.z_hi[r] - self.z_lo[r];
@@ -153,6 +149,9 @@ impl EnvmapDensity {
                 let bright = &self.bright_cols[r];
                 cuts.clear();
                 cuts.extend([p0, p1]);
+                if !bright.is_empty() {
+                    edge_crossings.resize(self.width + 1, None);
+                }
                 for &c in bright {
                     for edge in [c, c + 1] {
                         let [delta, spread] = *edge_crossings[edge].get_or_insert_with(|| {

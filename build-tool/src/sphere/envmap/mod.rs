@@ -105,8 +105,6 @@ pub struct EnvmapDensity {
     row_cdf: Vec<f64>,
     /// Per row, the columns of its bright pixels (see [`BRIGHT_PIXEL`]).
     bright_cols: Vec<Vec<usize>>,
-    /// Whether any row has a bright pixel.
-    has_bright: bool,
     /// Per column, `[cos phi, sin phi]` of its centre; per row, `[z, sqrt(1 - z^2)]`
     /// of its centre: [`Self::pixel_center`] without a sine or cosine per pixel
     /// (the lit maps of a bake light every pixel of hundreds of normals).
@@ -244,7 +242,6 @@ impl EnvmapDensity {
             integral: total,
             col_cum,
             row_cdf,
-            has_bright: bright_cols.iter().any(|b| !b.is_empty()),
             bright_cols,
             col_trig,
             row_trig,
