@@ -13,9 +13,10 @@
 //! * `primary`: that lattice fitted to this one normal in the tree's primary
 //!   space, as training moves points (cap loss with per-point sharpness in local
 //!   units, gradients through the tree's exact slopes, 256 of 2048 caps measured on
-//!   the lit map's mass rule per step, sharpness 8 to 64 inverse spacings), by
-//!   Adam on the points themselves, `STEPS` steps (default 3000) of size `STEP /
-//!   sqrt(N)` in the square (default 0.02) with cosine decay to 3 %;
+//!   the lit map's mass rule per step, the trainer's schedule: sharpness 8 to 64
+//!   inverse spacings, the step's cosine decay to 3 %), by Adam on the points
+//!   themselves, `STEPS` steps (default 3000) of size `STEP / sqrt(N)` in the
+//!   square (default 0.02);
 //! * `blend`: the lattice fitted so at each of the four nodes around the normal
 //!   of a `GRID x GRID` table (default 13, the bake's), those four primary sets
 //!   blended bilinearly (table mode's arithmetic, in `f64`) and warped at the
@@ -35,18 +36,20 @@
 //! network reaches across all normals (docs/results/envmap.md, "bounds").
 use glam::{DVec2, DVec3};
 use nuld_build_tool::baselines::warped_owen_sobol_directions;
-use nuld_build_tool::descent::local_factor;
+use nuld_build_tool::descent::{epoch_schedule, local_factor, Adam};
 use nuld_build_tool::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use nuld_build_tool::discrepancy::GradientPath;
 use nuld_build_tool::optimize::directions::{optimize_directions, DirectionConfig};
 use nuld_build_tool::seeding::derive_seed;
+use nuld_build_tool::sphere::geometry::{fold, map_jacobian};
 use nuld_build_tool::sphere::metrics::{CapRadius, MeasuredCaps};
 use nuld_build_tool::sphere::{CapMeasureTable, DirectionDensity, EnvmapDensity};
 use nuld_build_tool::train::target::LoadedTarget;
 use nuld_build_tool::train::{TrainConfig, TrainTarget};
+use nuld_core::blob::Domain;
 use nuld_core::envmap_tree::EnvmapTree;
 use nuld_core::network::shifted_lattice_point;
-use nuld_core::sphere::{square_to_sphere, square_to_sphere_real};
+use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::path::PathBuf;
@@ -62,9 +65,10 @@ struct Fit {
 }
 
 /// The tree's warp at the normal of octahedral point `u`, and its Jacobian: the
-/// sphere map's (smooth, by central differences) times the descent's exact
-/// slopes; without a tree, the sphere's equal-area map alone (`p` a point of the
-/// sphere's square, the same direction at every normal).
+/// sphere map's times the descent's exact slopes (what the trainer's
+/// `PoolCondition::direction` does); without a tree, the sphere's equal-area map
+/// alone (`p` a point of the sphere's square, the same direction at every
+/// normal).
 fn warp(tree: Option<&EnvmapTree<'_>>, u: [f64; 2], p: DVec2) -> (DVec3, DVec3, DVec3) {
     let (q, slopes) = match tree {
         Some(tree) => {
@@ -73,11 +77,8 @@ fn warp(tree: Option<&EnvmapTree<'_>>, u: [f64; 2], p: DVec2) -> (DVec3, DVec3, 
         }
         None => (p, [1.0; 2]),
     };
-    let h = 1e-7;
-    let at = |a: DVec2| square_to_sphere(a.clamp(DVec2::ZERO, DVec2::ONE));
-    let jx = (at(q + DVec2::X * h) - at(q - DVec2::X * h)) / (2.0 * h);
-    let jy = (at(q + DVec2::Y * h) - at(q - DVec2::Y * h)) / (2.0 * h);
-    (at(q), jx * slopes[0], jy * slopes[1])
+    let (jx, jy) = map_jacobian(Domain::Sphere, q);
+    (square_to_sphere(q), jx * slopes[0], jy * slopes[1])
 }
 
 /// What a fit reads at one normal: its octahedral point, lit map, caps and their
@@ -99,10 +100,7 @@ impl Site {
         let caps: Vec<Cap> = (0..2048)
             .map(|k| {
                 let s = |d| sobol_burley::sample(k, d, stream) as f64;
-                Cap::new(
-                    DVec3::from_array(square_to_sphere_real([s(0), s(1)])),
-                    PI * s(2),
-                )
+                Cap::from_unit_cube(DVec3::new(s(0), s(1), s(2)))
             })
             .collect();
         let measures = caps
@@ -124,13 +122,14 @@ impl Site {
 fn fit(tree: Option<&EnvmapTree<'_>>, sites: &[Site], start: &[DVec2], how: &Fit) -> Vec<DVec2> {
     let n = how.n;
     let mut p = start.to_vec();
-    let (mut m, mut v) = (vec![DVec2::ZERO; n], vec![DVec2::ZERO; n]);
+    let mut adam = Adam::new(n);
+    adam.epsilon = 1e-12;
     let spacing = (4.0 * PI / n as f64).sqrt();
     let mut grad = vec![DVec3::ZERO; n];
     for t in 0..how.steps {
-        let f = t as f64 / how.steps as f64;
-        let alpha = 8.0 * 8f64.powf(f) / spacing;
-        let lr = how.step / (n as f64).sqrt() * (0.03 + 0.97 * 0.5 * (1.0 + (PI * f).cos()));
+        // The trainer's schedule: sharpness 8 to 64 inverse spacings, the step's
+        // cosine decay to 3 %.
+        let (alpha, ratio) = epoch_schedule(t, how.steps, (8.0, 64.0), 0.03);
         let mut g = vec![DVec2::ZERO; n];
         for site in sites {
             let w: Vec<_> = p.iter().map(|&q| warp(tree, site.u, q)).collect();
@@ -146,7 +145,7 @@ fn fit(tree: Option<&EnvmapTree<'_>>, sites: &[Site], start: &[DVec2], how: &Fit
                 &dirs,
                 &c,
                 CapArea::Precomputed(&mu),
-                alpha,
+                alpha / spacing,
                 Some(&local),
                 GradientPath::Fast,
                 &mut grad,
@@ -155,15 +154,13 @@ fn fit(tree: Option<&EnvmapTree<'_>>, sites: &[Site], start: &[DVec2], how: &Fit
                 g[i] += DVec2::new(w[i].1.dot(grad[i]), w[i].2.dot(grad[i]));
             }
         }
-        let (b1, b2) = (
-            1.0 - 0.9f64.powi(t as i32 + 1),
-            1.0 - 0.999f64.powi(t as i32 + 1),
-        );
-        for i in 0..n {
-            m[i] = 0.9 * m[i] + 0.1 * g[i];
-            v[i] = 0.999 * v[i] + 0.001 * g[i] * g[i];
-            let s = lr * (m[i] / b1) / ((v[i] / b2).powf(0.5) + DVec2::splat(1e-12));
-            p[i] = (p[i] - s).clamp(DVec2::ZERO, DVec2::splat(1.0 - 1e-12));
+        adam.step(&mut p, &g, how.step / (n as f64).sqrt() * ratio);
+        for q in &mut p {
+            // The primary square is clamped; the sphere's square wraps at its seam.
+            *q = match tree {
+                Some(_) => q.clamp(DVec2::ZERO, DVec2::splat(1.0 - 1e-12)),
+                None => fold(Domain::Sphere, *q),
+            };
         }
     }
     p

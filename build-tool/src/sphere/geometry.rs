@@ -148,7 +148,7 @@ pub fn tangent_frame(w: DVec3) -> (DVec3, DVec3) {
 
 /// Brings a square point that left `[0,1]^2` back: across the octahedral seam for
 /// the sphere, clamped onto the equator's square boundary for the hemisphere.
-pub(crate) fn fold(domain: Domain, p: DVec2) -> DVec2 {
+pub fn fold(domain: Domain, p: DVec2) -> DVec2 {
     match domain {
         Domain::Hemisphere => p.clamp(DVec2::ZERO, DVec2::ONE),
         _ => wrap_octahedral(p),
@@ -158,7 +158,7 @@ pub(crate) fn fold(domain: Domain, p: DVec2) -> DVec2 {
 /// Jacobian columns `(d dir / d p.x, d dir / d p.y)` of the domain's equal-area
 /// map at `p`, by central differences through [`fold`] (so the seam is crossed
 /// continuously): the chain rule from a direction's gradient to its square point.
-pub(crate) fn map_jacobian(domain: Domain, p: DVec2) -> (DVec3, DVec3) {
+pub fn map_jacobian(domain: Domain, p: DVec2) -> (DVec3, DVec3) {
     let h = 1e-7;
     let f = |q: DVec2| domain.to_direction(fold(domain, q));
     (
