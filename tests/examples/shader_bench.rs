@@ -16,8 +16,10 @@ mod shader_sample;
 
 use nuld_core::conditional::PointWarp;
 use nuld_core::network::Activation;
-use nuld_runtime::shader::{kernel_wgsl, KernelMode, KernelParams, KERNEL_ENTRY_POINT};
-use nuld_tests::{conditional_parts, shape, META};
+use nuld_runtime::shader::{
+    kernel_wgsl, KernelMode, KernelParams, KERNEL_ENTRY_POINT, SAMPLE_STRIDE,
+};
+use nuld_tests::{as_envmap, conditional_parts, shape, META};
 use shader_sample::Gpu;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -32,19 +34,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "mode", "samples", "seconds", "samples/s"
     );
     // The table modes read no network: they run on the [32, 32] blob.
-    let blob = |hidden: &[u32], act| {
+    let parts = |hidden: &[u32], act| {
         conditional_parts(
             shape(64, hidden, act, PointWarp::BrdfMixture, 64),
             16,
             [10, 9],
             2,
         )
-        .to_blob(&META)
     };
-    let relu = blob(&[32, 32], Activation::Relu)?;
-    let silu = blob(&[64, 64], Activation::Silu)?;
+    let relu = parts(&[32, 32], Activation::Relu).to_blob(&META)?;
+    let silu = parts(&[64, 64], Activation::Silu).to_blob(&META)?;
+    // An environment sampler on the tests' small tree (the sphere, the tree's warp
+    // with its pdf): the sampler that reads the most sections.
+    let envmap = as_envmap(parts(&[32, 32], Activation::Relu)).to_blob(&META)?;
     let cases = [
         ("table: nuld_sample", &relu, KernelMode::Table, 1 << 8),
+        (
+            "table: nuld_sample, environment tree",
+            &envmap,
+            KernelMode::Table,
+            1 << 8,
+        ),
         (
             "table: nuld_sample_brdf",
             &relu,
@@ -65,21 +75,31 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ),
     ];
     for (label, bytes, mode, instances) in cases {
-        // 16 x 16 conditions over the blob's range, `instances` instances, 64 indices.
-        let mut p = KernelParams::new(mode, [0.1, 0.0], [0.06, 5.9], [16, 16], 0..instances, 0..64);
+        // 16 x 16 conditions over the blob's range (the BRDF's roughness and view
+        // angle; the normal's square point), `instances` instances, 64 indices.
+        let (first, step) = if std::ptr::eq(bytes, &envmap) {
+            ([0.02, 0.02], [0.06, 0.06])
+        } else {
+            ([0.1, 0.0], [0.06, 5.9])
+        };
+        let mut p = KernelParams::new(mode, first, step, [16, 16], 0..instances, 0..64);
         p.view = [0.3, 0.4, 0.866, 0.0];
         let count = p.sample_count().ok_or("range too large")?;
+        // A sample is `SAMPLE_STRIDE / 16` vec4 slots of the buffer.
+        let slots = SAMPLE_STRIDE / 16;
         let (out, seconds) = gpu.run(
             &pipeline,
             bytes.as_slice(),
             Some(bytemuck::bytes_of(&p)),
-            count as u64,
+            slots * count as u64,
             p.workgroups(),
             3,
         );
-        // Every sample written: a unit direction (guards against timing a no-op).
+        // Every sample written: a unit direction in its first slot (guards
+        // against timing a no-op).
         let bad = out
             .iter()
+            .step_by(slots as usize)
             .filter(|s| ((s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt() - 1.0).abs() > 1e-4)
             .count();
         if bad > 0 {
