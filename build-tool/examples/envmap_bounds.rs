@@ -34,6 +34,9 @@
 //! What a conditional sampler trained in the prior's primary space could reach
 //! at one normal, and in a table fitted node by node, against what the bake's
 //! network reaches across all normals (docs/results/envmap.md, "bounds").
+mod check;
+
+use check::CHECK_SEED;
 use glam::{DVec2, DVec3};
 use nuld_build_tool::baselines::warped_owen_sobol_directions;
 use nuld_build_tool::descent::{epoch_schedule, local_factor, Adam};
@@ -44,18 +47,12 @@ use nuld_build_tool::seeding::derive_seed;
 use nuld_build_tool::sphere::geometry::{fold, map_jacobian};
 use nuld_build_tool::sphere::metrics::{CapRadius, MeasuredCaps};
 use nuld_build_tool::sphere::{CapMeasureTable, DirectionDensity, EnvmapDensity};
-use nuld_build_tool::train::target::LoadedTarget;
-use nuld_build_tool::train::{TrainConfig, TrainTarget};
 use nuld_core::blob::Domain;
 use nuld_core::envmap_tree::EnvmapTree;
 use nuld_core::network::shifted_lattice_point;
 use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
 use std::f64::consts::PI;
-use std::path::PathBuf;
-
-/// The held-out check's seed (`QualityConfig::held_out` in `bake`).
-const CHECK_SEED: u64 = 0x9a11;
 
 /// The fit's settings.
 struct Fit {
@@ -180,29 +177,16 @@ fn main() {
     };
     let grid = arg(5, 13.0) as usize;
     let n = how.n;
-    let target = TrainTarget::envmap(&PathBuf::from(&args[1])).unwrap();
-    let shape = TrainConfig {
-        target: target.clone(),
-        n: n as u32,
-        ..TrainConfig::default()
-    }
-    .shape()
-    .unwrap();
-    let LoadedTarget::Envmap(env) = target.load().unwrap() else {
-        unreachable!("an environment map")
-    };
+    let (shape, env) = check::load(&args[1], n as u32);
     let tree = env.tree.tree();
     let (g, z) = (shape.lattice_generator(), shape.instance_offset::<f64>(0));
     let lattice: Vec<DVec2> = (0..n as u32)
         .map(|i| DVec2::from(shifted_lattice_point(i, n as u32, g, z)))
         .collect();
-    let rows: Vec<[f64; 6]> = (0..16usize)
+    let rows: Vec<[f64; 6]> = (0..check::NORMALS)
         .into_par_iter()
         .filter_map(|index| {
-            let u = [
-                ((index % 4) as f64 + 0.5) / 4.0,
-                ((index / 4) as f64 + 0.5) / 4.0,
-            ];
+            let u = check::held_out(index);
             let normal = square_to_sphere(DVec2::from(u));
             let (lit, irradiance) = env.map.cosine_weighted(normal).unwrap();
             if irradiance <= 0.0 {

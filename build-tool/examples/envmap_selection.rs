@@ -1,0 +1,198 @@
+//! Whether choosing, per normal of a table, which untrained shifted lattice to
+//! warp through the environment prior beats the bake's network:
+//! `cargo run --release -p nuld-build-tool --example envmap_selection -- MAP [N] [K] [PRIOR]`.
+//!
+//! The candidates are the `K` (default 256) instance offsets of the bake's shape
+//! (its lattice generator, shifted by `Shape::instance_offset(k)`), each a set of
+//! `N` (default 64) points through the prior (the map's tree at the normal): what
+//! the unbiased mode draws, with no learned part. `PRIOR` is `tree` (default,
+//! the sampler's) or `table` (`sphere::EnvmapPrior`, the marginal-conditional
+//! warp of `L cos` tabulated on 33 x 33 normals and 64 x 64 vertices, blended
+//! between the four normals around the query). At each of the check's 16
+//! held-out normals (the cell centres of a 4 x 4 grid on the octahedral square)
+//! and on the check's judge (4096 caps with exact measures, over 8 Owen-Sobol
+//! sets through the normal's exact inverse CDF), prints:
+//!
+//! * `mean`: the mean over all `K` candidates (a random instance's lattice);
+//! * `oracle 1`, `oracle 8`: the best one, and the mean of the best 8, chosen by
+//!   the held-out judge itself (a bound no table reaches);
+//! * `other caps 1`, `other caps 8`: the same, chosen at the held-out normal
+//!   itself by a judge of other caps (what the judges' own noise leaves);
+//! * `G: 1`, `G: 8`: the best one and the best 8 chosen at a node of a `G x G`
+//!   table of normals (G = 13, the bake's, 25, 49 and 97) by that node's own judge
+//!   (other caps, other baseline), then scored at the held-out normal. The node
+//!   is half a cell away along both axes of the octahedral square, the farthest a
+//!   nearest-node lookup reads from, so these are a table's worst case.
+//!
+//! On stderr, for candidate 0 and each grid, how far the normal moves from the
+//! held-out normal to the node and how far the set's points move with it
+//! (median, 90th percentile, most): whether the prior's warp is continuous in the
+//! normal for a fixed primary point; and the seconds a node's choice took (its
+//! judge, then the `K` candidates scored), one thread of two.
+//!
+//! A table of such choices holds one small integer per node and instance; a
+//! sample reads it, shifts the lattice and warps (no blend of points, no
+//! network). Results: docs/results/envmap.md#selection.
+mod check;
+
+use check::CHECK_SEED;
+use glam::{DVec2, DVec3};
+use nuld_build_tool::lab::eval::prior_judge::{Judge, JudgeSettings};
+use nuld_build_tool::sphere::{DirectionDensity, EnvmapDensity, EnvmapPrior};
+use nuld_core::network::shifted_lattice_point;
+use nuld_core::sphere::square_to_sphere;
+use rayon::prelude::*;
+
+/// Table sizes whose nodes choose: the bake's grid and two finer ones.
+const GRIDS: [usize; 4] = [13, 25, 49, 97];
+
+/// How many chosen candidates a table keeps per node besides the best one
+/// (instances).
+const KEPT: usize = 8;
+
+/// The judge of the map lit at the normal of octahedral point `u`; `None` where
+/// the normal receives no light.
+fn judge(map: &EnvmapDensity, u: [f64; 2], n: u32, index: u64) -> Option<Judge<[f64; 2]>> {
+    let (lit, irradiance) = map.cosine_weighted(square_to_sphere(DVec2::from(u))).ok()?;
+    if irradiance <= 0.0 {
+        return None;
+    }
+    let settings = JudgeSettings {
+        n,
+        instances: 8,
+        caps: 4096,
+        seed: CHECK_SEED,
+    };
+    // A lit map's own warp is its exact inverse CDF.
+    let exact = |p| lit.sample(p);
+    Some(Judge::new(u, &lit, &exact, &settings, index))
+}
+
+/// Indices of `scores` from best (lowest) to worst.
+fn ranking(scores: &[f64]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..scores.len()).collect();
+    order.sort_by(|&a, &b| scores[a].total_cmp(&scores[b]));
+    order
+}
+
+/// Mean of `scores` at the first `count` indices of `order`.
+fn mean_of(scores: &[f64], order: &[usize], count: usize) -> f64 {
+    order[..count].iter().map(|&k| scores[k]).sum::<f64>() / count as f64
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if !(2..=5).contains(&args.len()) {
+        eprintln!("usage: envmap_selection MAP [N] [K] [tree|table]");
+        std::process::exit(2);
+    }
+    let arg = |k: usize, default: usize| args.get(k).map_or(default, |s| s.parse().unwrap());
+    let (n, k_count) = (arg(2, 64) as u32, arg(3, 256) as u32);
+    let (shape, env) = check::load(&args[1], n);
+    let tree = env.tree.tree();
+    let table = match args.get(4).map_or("tree", |s| s.as_str()) {
+        "tree" => None,
+        "table" => Some(EnvmapPrior::new(&env.map, 33, 64).unwrap()),
+        other => panic!("PRIOR is tree or table, not {other}"),
+    };
+    let table_warp = table.as_ref().map(|t| t.warp());
+    // The prior's direction of primary point `p` at the normal of octahedral point `u`.
+    let warp = |u: [f64; 2], p: DVec2| -> DVec3 {
+        match (&table, &table_warp) {
+            (Some(t), Some(w)) => t.sample(w, square_to_sphere(DVec2::from(u)), p).0,
+            _ => DVec3::from(tree.sample_square(u, p.to_array()).0),
+        }
+    };
+    let g = shape.lattice_generator();
+    let candidates: Vec<Vec<DVec2>> = (0..k_count)
+        .map(|k| {
+            let z = shape.instance_offset::<f64>(k);
+            (0..n)
+                .map(|i| DVec2::from(shifted_lattice_point(i, n, g, z)))
+                .collect()
+        })
+        .collect();
+    // Every candidate at the normal of octahedral point `u`, over `judge`'s baseline.
+    let scores = |u: [f64; 2], judge: &Judge<[f64; 2]>| -> Vec<f64> {
+        candidates
+            .iter()
+            .map(|set| {
+                let dirs: Vec<DVec3> = set.iter().map(|&p| warp(u, p)).collect();
+                judge.d(&dirs) / judge.baseline()
+            })
+            .collect()
+    };
+    let rows: Vec<Vec<f64>> = (0..check::NORMALS)
+        .into_par_iter()
+        .filter_map(|index| {
+            let u = check::held_out(index);
+            let held_out = judge(&env.map, u, n, index as u64)?;
+            let at_u = scores(u, &held_out);
+            let best = ranking(&at_u);
+            let mut row = vec![
+                at_u.iter().sum::<f64>() / at_u.len() as f64,
+                at_u[best[0]],
+                mean_of(&at_u, &best, KEPT),
+            ];
+            // The same normal judged on other caps: what the judge's own noise
+            // leaves of a choice.
+            let other = judge(&env.map, u, n, 2000 + index as u64)?;
+            let chosen = ranking(&scores(u, &other));
+            row.push(at_u[chosen[0]]);
+            row.push(mean_of(&at_u, &chosen, KEPT));
+            for (j, grid) in GRIDS.iter().enumerate() {
+                let half = 0.5 / (grid - 1) as f64;
+                let node = [u[0] + half, u[1] + half];
+                // How far candidate 0's points move from the normal to the node
+                // (radians): the warp's own change across the half cell.
+                let moved: Vec<f64> = candidates[0]
+                    .iter()
+                    .map(|&p| {
+                        let a = warp(u, p);
+                        let b = warp(node, p);
+                        a.angle_between(b)
+                    })
+                    .collect();
+                let mut sorted = moved.clone();
+                sorted.sort_by(f64::total_cmp);
+                eprintln!(
+                    "normal {index:2} grid {grid}: normal moves {:.2} deg; points move median {:.3} deg, 90% {:.3}, max {:.3}",
+                    square_to_sphere(DVec2::from(u)).angle_between(square_to_sphere(DVec2::from(node))).to_degrees(),
+                    sorted[sorted.len() / 2].to_degrees(),
+                    sorted[sorted.len() * 9 / 10].to_degrees(),
+                    sorted[sorted.len() - 1].to_degrees()
+                );
+                let clock = std::time::Instant::now();
+                let node_judge = judge(&env.map, node, n, 1000 + (16 * j + index) as u64)?;
+                let judged = clock.elapsed().as_secs_f64();
+                let chosen = ranking(&scores(node, &node_judge));
+                eprintln!(
+                    "normal {index:2} grid {grid}: a node's choice took {:.3} s (judge {judged:.3} s)",
+                    clock.elapsed().as_secs_f64()
+                );
+                row.push(at_u[chosen[0]]);
+                row.push(mean_of(&at_u, &chosen, KEPT));
+            }
+            let cells: Vec<String> = row.iter().map(|x| format!("{x:.3}")).collect();
+            println!("normal {index:2}: {}", cells.join(" "));
+            Some(row)
+        })
+        .collect();
+    let mut names = vec![
+        "mean".to_string(),
+        "oracle 1".to_string(),
+        format!("oracle {KEPT}"),
+        "other caps 1".to_string(),
+        format!("other caps {KEPT}"),
+    ];
+    for grid in GRIDS {
+        names.push(format!("{grid}: 1"));
+        names.push(format!("{grid}: {KEPT}"));
+    }
+    println!("{} normals, N = {n}, K = {k_count}", rows.len());
+    for (j, name) in names.iter().enumerate() {
+        let mean = rows.iter().map(|r| r[j]).sum::<f64>() / rows.len() as f64;
+        let worst = rows.iter().map(|r| r[j]).fold(0.0, f64::max);
+        println!("{name:>10}: mean {mean:.3}, worst {worst:.3}");
+    }
+}
