@@ -24,6 +24,10 @@
 //!   is half a cell away along both axes of the octahedral square, the farthest a
 //!   nearest-node lookup reads from, so these are a table's worst case.
 //!
+//! * `49 fast: 1`, `49 fast: 8`: the same on 49 x 49 with a cheaper judge at the
+//!   node (1024 caps measured on the lit map's mass rule of `2^14` points, as the
+//!   bake's training pool measures them).
+//!
 //! On stderr, for candidate 0 and each grid, how far the normal moves from the
 //! held-out normal to the node and how far the set's points move with it
 //! (median, 90th percentile, most): whether the prior's warp is continuous in the
@@ -38,13 +42,22 @@ mod check;
 use check::CHECK_SEED;
 use glam::{DVec2, DVec3};
 use nuld_build_tool::lab::eval::prior_judge::{Judge, JudgeSettings};
-use nuld_build_tool::sphere::{DirectionDensity, EnvmapDensity, EnvmapPrior};
+use nuld_build_tool::sphere::metrics::{CapRadius, MeasuredCaps};
+use nuld_build_tool::sphere::{CapMeasureTable, DirectionDensity, EnvmapDensity, EnvmapPrior};
 use nuld_core::network::shifted_lattice_point;
 use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
 
 /// Table sizes whose nodes choose: the bake's grid and two finer ones.
 const GRIDS: [usize; 4] = [13, 25, 49, 97];
+
+/// The grid whose nodes also choose by a cheaper judge: [`FAST_CAPS`] caps
+/// measured on the lit map's mass rule of `2^14` points, as the bake's pool
+/// measures its caps.
+const FAST_GRID: usize = 49;
+
+/// Caps of the cheaper judge.
+const FAST_CAPS: usize = 1024;
 
 /// How many chosen candidates a table keeps per node besides the best one
 /// (instances).
@@ -122,6 +135,30 @@ fn main() {
             })
             .collect()
     };
+    // The cap L2 of every candidate at `u` on caps measured by the lit map's mass
+    // rule (the bake's pool measures), for ranking only: no baseline.
+    let fast_scores = |u: [f64; 2], seed: u64| -> Option<Vec<f64>> {
+        let (lit, irradiance) = env
+            .map
+            .cosine_weighted(square_to_sphere(DVec2::from(u)))
+            .ok()?;
+        if irradiance <= 0.0 {
+            return None;
+        }
+        let table = CapMeasureTable::new(&lit.mass_rule(1 << 14));
+        let caps = MeasuredCaps::draw(FAST_CAPS, seed, CapRadius::ThetaUniform, |w, t| {
+            table.measure(w, t)
+        });
+        Some(
+            candidates
+                .iter()
+                .map(|set| {
+                    let dirs: Vec<DVec3> = set.iter().map(|&p| warp(u, p)).collect();
+                    caps.l2_squared(&dirs, CapRadius::ThetaUniform).0
+                })
+                .collect(),
+        )
+    };
     let rows: Vec<Vec<f64>> = (0..check::NORMALS)
         .into_par_iter()
         .filter_map(|index| {
@@ -172,6 +209,16 @@ fn main() {
                 );
                 row.push(at_u[chosen[0]]);
                 row.push(mean_of(&at_u, &chosen, KEPT));
+                if *grid == FAST_GRID {
+                    let clock = std::time::Instant::now();
+                    let chosen = ranking(&fast_scores(node, 3000 + index as u64)?);
+                    eprintln!(
+                        "normal {index:2} grid {grid}: a node's fast choice took {:.3} s",
+                        clock.elapsed().as_secs_f64()
+                    );
+                    row.push(at_u[chosen[0]]);
+                    row.push(mean_of(&at_u, &chosen, KEPT));
+                }
             }
             let cells: Vec<String> = row.iter().map(|x| format!("{x:.3}")).collect();
             println!("normal {index:2}: {}", cells.join(" "));
@@ -188,6 +235,10 @@ fn main() {
     for grid in GRIDS {
         names.push(format!("{grid}: 1"));
         names.push(format!("{grid}: {KEPT}"));
+        if grid == FAST_GRID {
+            names.push(format!("{grid} fast: 1"));
+            names.push(format!("{grid} fast: {KEPT}"));
+        }
     }
     println!("{} normals, N = {n}, K = {k_count}", rows.len());
     for (j, name) in names.iter().enumerate() {
