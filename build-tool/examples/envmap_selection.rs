@@ -2,8 +2,9 @@
 //! warp through the environment prior beats the bake's network:
 //! `cargo run --release -p nuld-build-tool --example envmap_selection -- MAP [N] [K] [PRIOR]`.
 //!
-//! The candidates are the `K` (default 256) instance offsets of the bake's shape
-//! (its lattice generator, shifted by `Shape::instance_offset(k)`), each a set of
+//! The candidates are the bake's rank-1 lattice (its shape's generator) shifted
+//! by the first `K` (default 256) offsets of its instance hash
+//! (`OffsetHash::Salted`, unwrapped by the 64 instance slots), each a set of
 //! `N` (default 64) points through the prior (the map's tree at the normal): what
 //! the unbiased mode draws, with no learned part. `PRIOR` is `tree` (default,
 //! the sampler's) or `table` (`sphere::EnvmapPrior`, the marginal-conditional
@@ -44,7 +45,7 @@ use glam::{DVec2, DVec3};
 use nuld_build_tool::lab::eval::prior_judge::{Judge, JudgeSettings};
 use nuld_build_tool::sphere::metrics::{CapRadius, MeasuredCaps};
 use nuld_build_tool::sphere::{CapMeasureTable, DirectionDensity, EnvmapDensity, EnvmapPrior};
-use nuld_core::network::shifted_lattice_point;
+use nuld_core::network::{shifted_lattice_point, OffsetHash};
 use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
 
@@ -119,7 +120,9 @@ fn main() {
     let g = shape.lattice_generator();
     let candidates: Vec<Vec<DVec2>> = (0..k_count)
         .map(|k| {
-            let z = shape.instance_offset::<f64>(k);
+            // The hash itself, not `shape.instance_offset`, which wraps at the
+            // shape's instance slots (64): every candidate its own shift.
+            let z = OffsetHash::Salted.offset::<f64>(k);
             (0..n)
                 .map(|i| DVec2::from(shifted_lattice_point(i, n, g, z)))
                 .collect()
