@@ -27,7 +27,10 @@
 //!
 //! * `49 fast: 1`, `49 fast: 8`: the same on 49 x 49 with a cheaper judge at the
 //!   node (1024 caps measured on the lit map's mass rule of `2^14` points, as the
-//!   bake's training pool measures them).
+//!   bake's training pool measures them);
+//! * `49 cell: 1`, `49 cell: 8`: chosen by that cheaper judge over the node's
+//!   cell: the sum, over the node and four normals a quarter cell from it along
+//!   the square's axes, of each normal's scores over their mean.
 //!
 //! On stderr, for candidate 0 and each grid, how far the normal moves from the
 //! held-out normal to the node and how far the set's points move with it
@@ -221,6 +224,24 @@ fn main() {
                     );
                     row.push(at_u[chosen[0]]);
                     row.push(mean_of(&at_u, &chosen, KEPT));
+                    // Over the node's own cell: the node and four normals a
+                    // quarter cell from it, each point's scores over their mean.
+                    let quarter = 0.5 * half;
+                    let mut total = vec![0.0; candidates.len()];
+                    for (e, [dx, dy]) in [[0.0, 0.0], [1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]]
+                        .into_iter()
+                        .enumerate()
+                    {
+                        let at = [node[0] + dx * quarter, node[1] + dy * quarter];
+                        let sc = fast_scores(at, 4000 + 8 * index as u64 + e as u64)?;
+                        let mean = sc.iter().sum::<f64>() / sc.len() as f64;
+                        for (t, v) in total.iter_mut().zip(&sc) {
+                            *t += v / mean;
+                        }
+                    }
+                    let chosen = ranking(&total);
+                    row.push(at_u[chosen[0]]);
+                    row.push(mean_of(&at_u, &chosen, KEPT));
                 }
             }
             let cells: Vec<String> = row.iter().map(|x| format!("{x:.3}")).collect();
@@ -241,6 +262,8 @@ fn main() {
         if grid == FAST_GRID {
             names.push(format!("{grid} fast: 1"));
             names.push(format!("{grid} fast: {KEPT}"));
+            names.push(format!("{grid} cell: 1"));
+            names.push(format!("{grid} cell: {KEPT}"));
         }
     }
     println!("{} normals, N = {n}, K = {k_count}", rows.len());
