@@ -4,7 +4,7 @@
 //!
 //! The candidates are the bake's rank-1 lattice (its shape's generator) shifted
 //! by the first `K` (default 256) offsets of its instance hash
-//! (`OffsetHash::Salted`, unwrapped by the 64 instance slots), each a set of
+//! (`OffsetHash::Salted`, not wrapped at the shape's 64 instance slots), each a set of
 //! `N` (default 64) points through the prior (the map's tree at the normal): what
 //! the unbiased mode draws, with no learned part. `PRIOR` is `tree` (default,
 //! the sampler's) or `table` (`sphere::EnvmapPrior`, the marginal-conditional
@@ -23,8 +23,7 @@
 //!   table of normals (G = 13, the bake's, 25, 49 and 97) by that node's own judge
 //!   (other caps, other baseline), then scored at the held-out normal. The node
 //!   is half a cell away along both axes of the octahedral square, the farthest a
-//!   nearest-node lookup reads from, so these are a table's worst case.
-//!
+//!   nearest-node lookup reads from, so these are a table's worst case;
 //! * `49 fast: 1`, `49 fast: 8`: the same on 49 x 49 with a cheaper judge at the
 //!   node (1024 caps measured on the lit map's mass rule of `2^14` points, as the
 //!   bake's training pool measures them);
@@ -52,7 +51,7 @@ use nuld_core::network::{shifted_lattice_point, OffsetHash};
 use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
 
-/// Table sizes whose nodes choose: the bake's grid and two finer ones.
+/// Table sizes whose nodes choose: the bake's grid and three finer ones.
 const GRIDS: [usize; 4] = [13, 25, 49, 97];
 
 /// The grid whose nodes also choose by a cheaper judge: [`FAST_CAPS`] caps
@@ -63,8 +62,7 @@ const FAST_GRID: usize = 49;
 /// Caps of the cheaper judge.
 const FAST_CAPS: usize = 1024;
 
-/// How many chosen candidates a table keeps per node besides the best one
-/// (instances).
+/// How many chosen candidates a table keeps per node (its instances).
 const KEPT: usize = 8;
 
 /// The judge of the map lit at the normal of octahedral point `u`; `None` where
@@ -141,8 +139,8 @@ fn main() {
             })
             .collect()
     };
-    // The cap L2 of every candidate at `u` on caps measured by the lit map's mass
-    // rule (the bake's pool measures), for ranking only: no baseline.
+    // The squared cap L2 of every candidate at `u` on caps measured by the lit
+    // map's mass rule (as the bake's pool measures), for ranking only: no baseline.
     let fast_scores = |u: [f64; 2], seed: u64| -> Option<Vec<f64>> {
         let (lit, irradiance) = env
             .map
