@@ -47,41 +47,43 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // An environment sampler on the tests' small tree (the sphere, the tree's warp
     // with its pdf): the sampler that reads the most sections.
     let envmap = as_envmap(parts(&[32, 32], Activation::Relu)).to_blob(&META)?;
+    // 16 x 16 conditions over a blob's range from `first` by `step`: the BRDF's
+    // roughness and view angle, or the normal's square point.
+    let brdf = ([0.1, 0.0], [0.06, 5.9]);
+    let normals = ([0.02, 0.02], [0.06, 0.06]);
     let cases = [
-        ("table: nuld_sample", &relu, KernelMode::Table, 1 << 8),
+        ("table: nuld_sample", &relu, brdf, KernelMode::Table, 1 << 8),
         (
             "table: nuld_sample, environment tree",
             &envmap,
+            normals,
             KernelMode::Table,
             1 << 8,
         ),
         (
             "table: nuld_sample_brdf",
             &relu,
+            brdf,
             KernelMode::BrdfTable,
             1 << 8,
         ),
         (
             "network [32,32] relu: nuld_sample_network",
             &relu,
+            brdf,
             KernelMode::Network,
             1 << 4,
         ),
         (
             "network [64,64] silu: nuld_sample_network",
             &silu,
+            brdf,
             KernelMode::Network,
             1 << 2,
         ),
     ];
-    for (label, bytes, mode, instances) in cases {
-        // 16 x 16 conditions over the blob's range (the BRDF's roughness and view
-        // angle; the normal's square point), `instances` instances, 64 indices.
-        let (first, step) = if std::ptr::eq(bytes, &envmap) {
-            ([0.02, 0.02], [0.06, 0.06])
-        } else {
-            ([0.1, 0.0], [0.06, 5.9])
-        };
+    for (label, bytes, (first, step), mode, instances) in cases {
+        // 16 x 16 conditions, `instances` instances, 64 indices.
         let mut p = KernelParams::new(mode, first, step, [16, 16], 0..instances, 0..64);
         p.view = [0.3, 0.4, 0.866, 0.0];
         let count = p.sample_count().ok_or("range too large")?;
