@@ -36,16 +36,12 @@
 //! network reaches across all normals (docs/results/envmap.md, "bounds").
 mod check;
 
-use check::CHECK_SEED;
 use glam::{DVec2, DVec3};
-use nuld_build_tool::baselines::warped_owen_sobol_directions;
 use nuld_build_tool::descent::{epoch_schedule, local_factor, Adam};
 use nuld_build_tool::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use nuld_build_tool::discrepancy::GradientPath;
 use nuld_build_tool::optimize::directions::{optimize_directions, DirectionConfig};
-use nuld_build_tool::seeding::derive_seed;
 use nuld_build_tool::sphere::geometry::{fold, map_jacobian};
-use nuld_build_tool::sphere::metrics::{CapRadius, MeasuredCaps};
 use nuld_build_tool::sphere::{CapMeasureTable, DirectionDensity, EnvmapDensity};
 use nuld_core::blob::Domain;
 use nuld_core::envmap_tree::EnvmapTree;
@@ -188,34 +184,22 @@ fn main() {
         .filter_map(|index| {
             let u = check::held_out(index);
             let normal = square_to_sphere(DVec2::from(u));
-            let (lit, irradiance) = env.map.cosine_weighted(normal).unwrap();
-            if irradiance <= 0.0 {
-                return None;
-            }
-            let judge = MeasuredCaps::draw(
-                4096,
-                derive_seed(CHECK_SEED, index as u64),
-                CapRadius::ThetaUniform,
-                |w, t| lit.cap_measure(w, t),
-            );
-            let d = |x: &[DVec3]| judge.l2_squared(x, CapRadius::ThetaUniform).0.sqrt();
-            let baseline = (0..8u64)
-                .map(|s| d(&warped_owen_sobol_directions(&lit, n, CHECK_SEED ^ (s + 1))))
-                .sum::<f64>()
-                / 8.0;
+            let lit = check::lit(&env.map, u)?;
+            let judge = check::judge(&lit, u, n as u32, index as u64);
+            let d = |x: &[DVec3]| judge.d(x) / judge.baseline();
             let directions = |p: &[DVec2]| {
                 p.iter()
                     .map(|&q| warp(Some(&tree), u, q).0)
                     .collect::<Vec<_>>()
             };
-            let start = d(&directions(&lattice)) / baseline;
+            let start = d(&directions(&lattice));
             let primary = fit(
                 Some(&tree),
                 &[Site::new(&env.map, u, index as u32)],
                 &lattice,
                 &how,
             );
-            let primary = d(&directions(&primary)) / baseline;
+            let primary = d(&directions(&primary));
 
             // The four table nodes around `u` and their bilinear weights.
             let cell = u.map(|x| {
@@ -243,8 +227,8 @@ fn main() {
                     *b += w * q;
                 }
             }
-            let blend = d(&directions(&blend)) / baseline;
-            let joint = d(&directions(&fit(Some(&tree), &nodes, &lattice, &how))) / baseline;
+            let blend = d(&directions(&blend));
+            let joint = d(&directions(&fit(Some(&tree), &nodes, &lattice, &how)));
             // The same in directions: the lattice through the tree at the normal,
             // fitted to the four nodes on the sphere's square.
             let from: Vec<DVec2> = directions(&lattice)
@@ -256,11 +240,11 @@ fn main() {
                 .iter()
                 .map(|&q| square_to_sphere(q))
                 .collect();
-            let joint_directions = d(&joint_directions) / baseline;
+            let joint_directions = d(&joint_directions);
 
             let direct = optimize_directions(&lit, n, &DirectionConfig::default(), &mut |_| {});
             let direct: Vec<DVec3> = direct.iter().map(|&q| square_to_sphere(q)).collect();
-            let direct = d(&direct) / baseline;
+            let direct = d(&direct);
             println!(
                 "normal {index:2} {normal:.3}: lattice {start:.3}  primary {primary:.3}  \
                  blend {blend:.3}  joint {joint:.3}  joint directions {joint_directions:.3}  \

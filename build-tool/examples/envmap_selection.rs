@@ -42,11 +42,10 @@
 //! network). Results: docs/results/envmap.md#selection.
 mod check;
 
-use check::CHECK_SEED;
 use glam::{DVec2, DVec3};
-use nuld_build_tool::lab::eval::prior_judge::{Judge, JudgeSettings};
+use nuld_build_tool::lab::eval::prior_judge::Judge;
 use nuld_build_tool::sphere::metrics::{CapRadius, MeasuredCaps};
-use nuld_build_tool::sphere::{CapMeasureTable, DirectionDensity, EnvmapDensity, EnvmapPrior};
+use nuld_build_tool::sphere::{CapMeasureTable, EnvmapPrior};
 use nuld_core::network::{shifted_lattice_point, OffsetHash};
 use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
@@ -65,24 +64,6 @@ const FAST_CAPS: usize = 1024;
 /// How many chosen candidates a table keeps per node (its instances).
 const KEPT: usize = 8;
 
-/// The judge of the map lit at the normal of octahedral point `u`; `None` where
-/// the normal receives no light.
-fn judge(map: &EnvmapDensity, u: [f64; 2], n: u32, index: u64) -> Option<Judge<[f64; 2]>> {
-    let (lit, irradiance) = map.cosine_weighted(square_to_sphere(DVec2::from(u))).ok()?;
-    if irradiance <= 0.0 {
-        return None;
-    }
-    let settings = JudgeSettings {
-        n,
-        instances: 8,
-        caps: 4096,
-        seed: CHECK_SEED,
-    };
-    // A lit map's own warp is its exact inverse CDF.
-    let exact = |p| lit.sample(p);
-    Some(Judge::new(u, &lit, &exact, &settings, index))
-}
-
 /// Indices of `scores` from best (lowest) to worst.
 fn ranking(scores: &[f64]) -> Vec<usize> {
     let mut order: Vec<usize> = (0..scores.len()).collect();
@@ -93,6 +74,14 @@ fn ranking(scores: &[f64]) -> Vec<usize> {
 /// Mean of `scores` at the first `count` indices of `order`.
 fn mean_of(scores: &[f64], order: &[usize], count: usize) -> f64 {
     order[..count].iter().map(|&k| scores[k]).sum::<f64>() / count as f64
+}
+
+/// A choice's two columns: the held-out scores `at_u` of the best candidate by
+/// `choice` (lower is better), and their mean over its best [`KEPT`].
+fn push_choice(row: &mut Vec<f64>, at_u: &[f64], choice: &[f64]) {
+    let order = ranking(choice);
+    row.push(at_u[order[0]]);
+    row.push(mean_of(at_u, &order, KEPT));
 }
 
 fn main() {
@@ -129,72 +118,62 @@ fn main() {
                 .collect()
         })
         .collect();
-    // Every candidate at the normal of octahedral point `u`, over `judge`'s baseline.
-    let scores = |u: [f64; 2], judge: &Judge<[f64; 2]>| -> Vec<f64> {
+    // Every candidate's directions at the normal of octahedral point `u`.
+    let sets_at = |u: [f64; 2]| -> Vec<Vec<DVec3>> {
         candidates
             .iter()
-            .map(|set| {
-                let dirs: Vec<DVec3> = set.iter().map(|&p| warp(u, p)).collect();
-                judge.d(&dirs) / judge.baseline()
-            })
+            .map(|set| set.iter().map(|&p| warp(u, p)).collect())
+            .collect()
+    };
+    // The check's judge of every set, over its baseline.
+    let scores = |sets: &[Vec<DVec3>], judge: &Judge<[f64; 2]>| -> Vec<f64> {
+        sets.iter()
+            .map(|dirs| judge.d(dirs) / judge.baseline())
             .collect()
     };
     // The squared cap L2 of every candidate at `u` on caps measured by the lit
     // map's mass rule (as the bake's pool measures), for ranking only: no baseline.
-    let fast_scores = |u: [f64; 2], seed: u64| -> Option<Vec<f64>> {
-        let (lit, irradiance) = env
-            .map
-            .cosine_weighted(square_to_sphere(DVec2::from(u)))
-            .ok()?;
-        if irradiance <= 0.0 {
-            return None;
-        }
-        let table = CapMeasureTable::new(&lit.mass_rule(1 << 14));
+    let fast_scores = |u: [f64; 2], sets: &[Vec<DVec3>], seed: u64| -> Option<Vec<f64>> {
+        let table = CapMeasureTable::new(&check::lit(&env.map, u)?.mass_rule(1 << 14));
         let caps = MeasuredCaps::draw(FAST_CAPS, seed, CapRadius::ThetaUniform, |w, t| {
             table.measure(w, t)
         });
         Some(
-            candidates
-                .iter()
-                .map(|set| {
-                    let dirs: Vec<DVec3> = set.iter().map(|&p| warp(u, p)).collect();
-                    caps.l2_squared(&dirs, CapRadius::ThetaUniform).0
-                })
+            sets.iter()
+                .map(|dirs| caps.l2_squared(dirs, CapRadius::ThetaUniform).0)
                 .collect(),
         )
+    };
+    // The check's judge at octahedral point `u`, caps drawn from `index`.
+    let judge = |u: [f64; 2], index: u64| -> Option<Judge<[f64; 2]>> {
+        Some(check::judge(&check::lit(&env.map, u)?, u, n, index))
     };
     let rows: Vec<Vec<f64>> = (0..check::NORMALS)
         .into_par_iter()
         .filter_map(|index| {
             let u = check::held_out(index);
-            let held_out = judge(&env.map, u, n, index as u64)?;
-            let at_u = scores(u, &held_out);
-            let best = ranking(&at_u);
-            let mut row = vec![
-                at_u.iter().sum::<f64>() / at_u.len() as f64,
-                at_u[best[0]],
-                mean_of(&at_u, &best, KEPT),
-            ];
+            let held_out = judge(u, index as u64)?;
+            let sets = sets_at(u);
+            let at_u = scores(&sets, &held_out);
+            let mut row = vec![at_u.iter().sum::<f64>() / at_u.len() as f64];
+            push_choice(&mut row, &at_u, &at_u);
             // The same normal judged on other caps: what the judge's own noise
             // leaves of a choice.
-            let other = judge(&env.map, u, n, 2000 + index as u64)?;
-            let chosen = ranking(&scores(u, &other));
-            row.push(at_u[chosen[0]]);
-            row.push(mean_of(&at_u, &chosen, KEPT));
+            let other = judge(u, 2000 + index as u64)?;
+            push_choice(&mut row, &at_u, &scores(&sets, &other));
             for (j, grid) in GRIDS.iter().enumerate() {
                 let half = 0.5 / (grid - 1) as f64;
                 let node = [u[0] + half, u[1] + half];
+                let clock = std::time::Instant::now();
+                let node_sets = sets_at(node);
+                let warped = clock.elapsed().as_secs_f64();
                 // How far candidate 0's points move from the normal to the node
                 // (radians): the warp's own change across the half cell.
-                let moved: Vec<f64> = candidates[0]
+                let mut sorted: Vec<f64> = sets[0]
                     .iter()
-                    .map(|&p| {
-                        let a = warp(u, p);
-                        let b = warp(node, p);
-                        a.angle_between(b)
-                    })
+                    .zip(&node_sets[0])
+                    .map(|(a, b)| a.angle_between(*b))
                     .collect();
-                let mut sorted = moved.clone();
                 sorted.sort_by(f64::total_cmp);
                 eprintln!(
                     "normal {index:2} grid {grid}: normal moves {:.2} deg; points move median {:.3} deg, 90% {:.3}, max {:.3}",
@@ -204,24 +183,21 @@ fn main() {
                     sorted[sorted.len() - 1].to_degrees()
                 );
                 let clock = std::time::Instant::now();
-                let node_judge = judge(&env.map, node, n, 1000 + (16 * j + index) as u64)?;
+                let node_judge = judge(node, 1000 + (16 * j + index) as u64)?;
                 let judged = clock.elapsed().as_secs_f64();
-                let chosen = ranking(&scores(node, &node_judge));
+                push_choice(&mut row, &at_u, &scores(&node_sets, &node_judge));
                 eprintln!(
                     "normal {index:2} grid {grid}: a node's choice took {:.3} s (judge {judged:.3} s)",
-                    clock.elapsed().as_secs_f64()
+                    warped + clock.elapsed().as_secs_f64()
                 );
-                row.push(at_u[chosen[0]]);
-                row.push(mean_of(&at_u, &chosen, KEPT));
                 if *grid == FAST_GRID {
                     let clock = std::time::Instant::now();
-                    let chosen = ranking(&fast_scores(node, 3000 + index as u64)?);
+                    let fast = fast_scores(node, &node_sets, 3000 + index as u64)?;
                     eprintln!(
                         "normal {index:2} grid {grid}: a node's fast choice took {:.3} s",
-                        clock.elapsed().as_secs_f64()
+                        warped + clock.elapsed().as_secs_f64()
                     );
-                    row.push(at_u[chosen[0]]);
-                    row.push(mean_of(&at_u, &chosen, KEPT));
+                    push_choice(&mut row, &at_u, &fast);
                     // Over the node's own cell: the node and four normals a
                     // quarter cell from it, each point's scores over their mean.
                     let quarter = 0.5 * half;
@@ -231,15 +207,13 @@ fn main() {
                         .enumerate()
                     {
                         let at = [node[0] + dx * quarter, node[1] + dy * quarter];
-                        let sc = fast_scores(at, 4000 + 8 * index as u64 + e as u64)?;
+                        let sc = fast_scores(at, &sets_at(at), 4000 + 8 * index as u64 + e as u64)?;
                         let mean = sc.iter().sum::<f64>() / sc.len() as f64;
                         for (t, v) in total.iter_mut().zip(&sc) {
                             *t += v / mean;
                         }
                     }
-                    let chosen = ranking(&total);
-                    row.push(at_u[chosen[0]]);
-                    row.push(mean_of(&at_u, &chosen, KEPT));
+                    push_choice(&mut row, &at_u, &total);
                 }
             }
             let cells: Vec<String> = row.iter().map(|x| format!("{x:.3}")).collect();
