@@ -177,8 +177,9 @@ impl EnvmapTree {
     /// The tree of `map` (its pdf proportional to the luminance) with `levels`
     /// levels and its top levels' weights on `grid x grid` normals: each leaf's
     /// mass and moment the means of the map's pdf (and of `pdf l`) over a grid of
-    /// points in it, times its solid angle (leaves have equal area), a finer grid
-    /// where the light changes fast ([`REFINE_CONTRAST`]). An error if
+    /// points in it, times its solid angle (leaves have equal area), 16 x 16 points
+    /// a leaf at 9 levels around cells of the map's density that exceed a
+    /// neighbour by more than 4 times its mean (lamps, the sun's edge). An error if
     /// `levels` is below [`TOP_LEVELS`] or above the tree's limit, or `grid` below
     /// 2.
     pub fn new(map: &EnvmapDensity, levels: u32, grid: u32) -> Result<Self, QuadtreeError> {
