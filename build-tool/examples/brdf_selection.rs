@@ -22,7 +22,9 @@
 //!   0.5 and 1;
 //! * with `BLOB` (a `bake --brdf` blob of the same `N`): its table mode on the
 //!   same judge, instances 0 to 7 and 0 to 63.
-use glam::{DVec2, DVec3, Vec2};
+mod selection;
+
+use glam::{DVec3, Vec2};
 use nuld_build_tool::lab::eval::brdf_prior::{held_out, judging, BrdfPriorSettings};
 use nuld_build_tool::lab::eval::prior_judge::Judge;
 use nuld_build_tool::sphere::brdf_prior::BrdfPrior;
@@ -31,7 +33,6 @@ use nuld_build_tool::train::lattice_generator;
 use nuld_core::blob::Domain;
 use nuld_core::brdf::{MAX_ROUGHNESS, MIN_ROUGHNESS};
 use nuld_core::brdf_prior::{theta_o_of_unit, unit_condition};
-use nuld_core::network::{shifted_lattice_point, OffsetHash};
 use rayon::prelude::*;
 
 /// `(roughness, θo)` nodes of the tables whose nodes choose.
@@ -43,16 +44,9 @@ const KEPT: [usize; 3] = [1, 8, 64];
 /// The exact inverse CDF's tabulation (`eval brdf-prior`'s).
 const EXACT_TABULATION: usize = 1024;
 
-/// Indices of `scores` from best (lowest) to worst.
-fn ranking(scores: &[f64]) -> Vec<usize> {
-    let mut order: Vec<usize> = (0..scores.len()).collect();
-    order.sort_by(|&a, &b| scores[a].total_cmp(&scores[b]));
-    order
-}
-
 /// The held-out scores `at_c` of the best 1, 8 and 64 candidates by `choice`.
 fn push_choice(row: &mut Vec<f64>, at_c: &[f64], choice: &[f64]) {
-    let order = ranking(choice);
+    let order = selection::ranking(choice);
     for kept in KEPT {
         let kept = kept.min(order.len());
         row.push(order[..kept].iter().map(|&k| at_c[k]).sum::<f64>() / kept as f64);
@@ -83,14 +77,7 @@ fn main() {
     let prior = BrdfPrior::shared();
     let warp = prior.warp();
     let g = lattice_generator(n);
-    let candidates: Vec<Vec<DVec2>> = (0..k_count)
-        .map(|k| {
-            let z = OffsetHash::Salted.offset::<f64>(k);
-            (0..n)
-                .map(|i| DVec2::from(shifted_lattice_point(i, n, g, z)))
-                .collect()
-        })
-        .collect();
+    let candidates = selection::candidates(n, g, k_count);
     let sets_at = |c: [f64; 3]| -> Vec<Vec<DVec3>> {
         candidates
             .iter()

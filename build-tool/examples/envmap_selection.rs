@@ -41,12 +41,12 @@
 //! sample reads it, shifts the lattice and warps (no blend of points, no
 //! network). Results: docs/results/envmap.md#selection.
 mod check;
+mod selection;
 
 use glam::{DVec2, DVec3};
 use nuld_build_tool::lab::eval::prior_judge::Judge;
 use nuld_build_tool::sphere::metrics::{CapRadius, MeasuredCaps};
 use nuld_build_tool::sphere::{CapMeasureTable, EnvmapPrior};
-use nuld_core::network::{shifted_lattice_point, OffsetHash};
 use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
 
@@ -64,13 +64,6 @@ const FAST_CAPS: usize = 1024;
 /// How many chosen candidates a table keeps per node (its instances).
 const KEPT: usize = 8;
 
-/// Indices of `scores` from best (lowest) to worst.
-fn ranking(scores: &[f64]) -> Vec<usize> {
-    let mut order: Vec<usize> = (0..scores.len()).collect();
-    order.sort_by(|&a, &b| scores[a].total_cmp(&scores[b]));
-    order
-}
-
 /// Mean of `scores` at the first `count` indices of `order`.
 fn mean_of(scores: &[f64], order: &[usize], count: usize) -> f64 {
     order[..count].iter().map(|&k| scores[k]).sum::<f64>() / count as f64
@@ -79,7 +72,7 @@ fn mean_of(scores: &[f64], order: &[usize], count: usize) -> f64 {
 /// A choice's two columns: the held-out scores `at_u` of the best candidate by
 /// `choice` (lower is better), and their mean over its best [`KEPT`].
 fn push_choice(row: &mut Vec<f64>, at_u: &[f64], choice: &[f64]) {
-    let order = ranking(choice);
+    let order = selection::ranking(choice);
     row.push(at_u[order[0]]);
     row.push(mean_of(at_u, &order, KEPT));
 }
@@ -108,16 +101,7 @@ fn main() {
         }
     };
     let g = shape.lattice_generator();
-    let candidates: Vec<Vec<DVec2>> = (0..k_count)
-        .map(|k| {
-            // The hash itself, not `shape.instance_offset`, which wraps at the
-            // shape's instance slots (64): every candidate its own shift.
-            let z = OffsetHash::Salted.offset::<f64>(k);
-            (0..n)
-                .map(|i| DVec2::from(shifted_lattice_point(i, n, g, z)))
-                .collect()
-        })
-        .collect();
+    let candidates = selection::candidates(n, g, k_count);
     // Every candidate's directions at the normal of octahedral point `u`.
     let sets_at = |u: [f64; 2]| -> Vec<Vec<DVec3>> {
         candidates

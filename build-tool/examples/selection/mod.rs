@@ -1,0 +1,27 @@
+//! What the two selection examples (`envmap_selection`, `brdf_selection`)
+//! share: the candidate sets a table of choices would choose among, and their
+//! ranking.
+use glam::DVec2;
+use nuld_core::network::{shifted_lattice_point, OffsetHash};
+
+/// The rank-1 lattice of `n` points with generator `g` shifted by the first
+/// `count` offsets of the salted instance hash (`OffsetHash::Salted`, not
+/// wrapped at a shape's instance slots: every candidate its own shift), in the
+/// primary square.
+pub fn candidates(n: u32, g: u32, count: u32) -> Vec<Vec<DVec2>> {
+    (0..count)
+        .map(|k| {
+            let z = OffsetHash::Salted.offset::<f64>(k);
+            (0..n)
+                .map(|i| DVec2::from(shifted_lattice_point(i, n, g, z)))
+                .collect()
+        })
+        .collect()
+}
+
+/// Indices of `scores` from best (lowest) to worst.
+pub fn ranking(scores: &[f64]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..scores.len()).collect();
+    order.sort_by(|&a, &b| scores[a].total_cmp(&scores[b]));
+    order
+}
