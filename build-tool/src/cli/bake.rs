@@ -64,7 +64,7 @@ pub struct BakeArgs {
     /// sets [default: 64].
     #[arg(long, allow_negative_numbers = true, value_parser = super::count)]
     pub instance_slots: Option<usize>,
-    /// Weight of the union-of-instances term [default: 0.5].
+    /// Weight of the union-of-instances term [default: 0.5 for --brdf, 1.5 for --envmap].
     #[arg(long)]
     pub union_weight: Option<f64>,
     /// Training conditions in the pool (`None`: the target's default,

@@ -172,14 +172,13 @@ impl BakeConfig {
 /// (docs/results/envmap.md).
 pub const ENVMAP_INSTANCE_SLOTS: u32 = 64;
 
-/// Weight of the union term for an environment sampler, the BRDF sampler's. A
-/// larger weight gathers the union of instances but biases the fixed-instance
-/// renders: with the prior's finer leaves, weight 1.5 checked courtyard N = 64 at
-/// 0.728 (worst 0.895, union 0.156) against 0.734 (0.936, 0.186) and studio N =
-/// 256's union at 0.268 against 0.304, but rendered courtyard with MIS at 256 spp
-/// with a bias of -2.1e-3, 16 % of Owen-Sobol's RMSE, where the earlier blobs
-/// of weight 0.5 rendered -1.1e-3, 8 % (docs/results/envmap.md#floor).
-pub const ENVMAP_UNION_WEIGHT: f64 = 0.5;
+/// Weight of the union term for an environment sampler. With the prior's finer
+/// leaves, weight 1.5 against 0.5 (the BRDF sampler's): courtyard N = 64 checked
+/// at 0.728 (worst 0.895, union 0.156) against 0.734 (0.936, 0.186), lowsun's
+/// union 0.286 against 0.299, studio N = 256's 0.268; courtyard rendered with MIS
+/// at an RMSE of 2.188e-2 against 2.299e-2 at 64 spp and a fixed-instance bias of
+/// -2.14e-3 against -2.49e-3 at 256 spp (docs/results/envmap.md#floor).
+pub const ENVMAP_UNION_WEIGHT: f64 = 1.5;
 
 /// Training steps of an environment sampler: on the tree's primary space 3000
 /// steps scored as 12 000 did (courtyard N = 64: 0.755 and 0.759 of the
