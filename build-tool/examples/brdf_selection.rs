@@ -25,12 +25,11 @@
 mod selection;
 
 use glam::{DVec3, Vec2};
-use nuld_build_tool::lab::eval::brdf_prior::{held_out, judging, BrdfPriorSettings};
+use nuld_build_tool::lab::eval::brdf_prior::{self, held_out, judging, BrdfPriorSettings};
 use nuld_build_tool::lab::eval::prior_judge::Judge;
 use nuld_build_tool::sphere::brdf_prior::BrdfPrior;
-use nuld_build_tool::sphere::{BrdfTarget, TabulatedWarp};
+use nuld_build_tool::sphere::BrdfTarget;
 use nuld_build_tool::train::lattice_generator;
-use nuld_core::blob::Domain;
 use nuld_core::brdf::{MAX_ROUGHNESS, MIN_ROUGHNESS};
 use nuld_core::brdf_prior::{theta_o_of_unit, unit_condition};
 use rayon::prelude::*;
@@ -41,9 +40,6 @@ const GRIDS: [[usize; 2]; 3] = [[10, 12], [19, 23], [37, 45]];
 /// How many chosen candidates each column keeps.
 const KEPT: [usize; 3] = [1, 8, 64];
 
-/// The exact inverse CDF's tabulation (`eval brdf-prior`'s).
-const EXACT_TABULATION: usize = 1024;
-
 /// The held-out scores `at_c` of the best 1, 8 and 64 candidates by `choice`.
 fn push_choice(row: &mut Vec<f64>, at_c: &[f64], choice: &[f64]) {
     let order = selection::ranking(choice);
@@ -53,17 +49,9 @@ fn push_choice(row: &mut Vec<f64>, at_c: &[f64], choice: &[f64]) {
     }
 }
 
-/// The judge of condition `c` drawn from `index`.
-fn judge(c: [f64; 3], index: u64) -> Judge<[f64; 3]> {
-    let target = BrdfTarget::metallic(c[0], c[1], c[2], Domain::Hemisphere).unwrap();
-    let exact = TabulatedWarp::new(&target, EXACT_TABULATION, 2).unwrap();
-    Judge::new(
-        c,
-        &target,
-        &|u| exact.warp(u),
-        &judging(&BrdfPriorSettings::default()),
-        index,
-    )
+/// `eval brdf-prior`'s judge of condition `c`, caps drawn from `index`.
+fn judge(c: [f64; 3], index: u64) -> Judge<BrdfTarget> {
+    brdf_prior::judge(c, &judging(&BrdfPriorSettings::default()), index).unwrap()
 }
 
 fn main() {
@@ -84,7 +72,7 @@ fn main() {
             .map(|set| set.iter().map(|&p| prior.sample(&warp, c, p).0).collect())
             .collect()
     };
-    let scores = |sets: &[Vec<DVec3>], j: &Judge<[f64; 3]>| -> Vec<f64> {
+    let scores = |sets: &[Vec<DVec3>], j: &Judge<BrdfTarget>| -> Vec<f64> {
         sets.iter().map(|d| j.d(d) / j.baseline()).collect()
     };
     let parsed = blob.as_ref().map(|b| {

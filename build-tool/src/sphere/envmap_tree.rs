@@ -158,6 +158,15 @@ fn sharp_leaves(map: &EnvmapDensity, levels: u32) -> Vec<bool> {
     sharp
 }
 
+/// [`QuadtreeError::Levels`] unless `levels` is in [`TOP_LEVELS`]`..=`[`MAX_TREE_LEVELS`].
+fn check_levels(levels: u32) -> Result<(), QuadtreeError> {
+    if (TOP_LEVELS..=MAX_TREE_LEVELS).contains(&levels) {
+        Ok(())
+    } else {
+        Err(QuadtreeError::Levels(levels))
+    }
+}
+
 /// A map's tree (see the module docs).
 #[derive(Clone, Debug, PartialEq)]
 pub struct EnvmapTree {
@@ -183,9 +192,7 @@ impl EnvmapTree {
     /// `levels` is below [`TOP_LEVELS`] or above the tree's limit, or `grid` below
     /// 2.
     pub fn new(map: &EnvmapDensity, levels: u32, grid: u32) -> Result<Self, QuadtreeError> {
-        if !(TOP_LEVELS..=MAX_TREE_LEVELS).contains(&levels) {
-            return Err(QuadtreeError::Levels(levels));
-        }
+        check_levels(levels)?;
         Self::measured(|d| map.pdf(d), levels, grid, &sharp_leaves(map, levels))
     }
 
@@ -196,9 +203,7 @@ impl EnvmapTree {
         levels: u32,
         grid: u32,
     ) -> Result<Self, QuadtreeError> {
-        if !(TOP_LEVELS..=MAX_TREE_LEVELS).contains(&levels) {
-            return Err(QuadtreeError::Levels(levels));
-        }
+        check_levels(levels)?;
         Self::measured(light, levels, grid, &[])
     }
 

@@ -103,6 +103,22 @@ pub fn judging(s: &BrdfPriorSettings) -> JudgeSettings {
     }
 }
 
+/// The judge of the condition `c = [roughness, θo in degrees, metallic]` on the
+/// hemisphere, its caps drawn from `index`: the baseline is Owen-Sobol through
+/// the exact inverse CDF of the condition's own target (tabulated on 1024 x 1024
+/// cells).
+pub fn judge(c: [f64; 3], judging: &JudgeSettings, index: u64) -> Result<Judge<BrdfTarget>> {
+    let target = BrdfTarget::metallic(c[0], c[1], c[2], Domain::Hemisphere)?;
+    let exact = TabulatedWarp::new(&target, EXACT_TABULATION, 2)?;
+    Ok(Judge::new(
+        target.clone(),
+        &target,
+        &|u| exact.warp(u),
+        judging,
+        index,
+    ))
+}
+
 /// The figures of the mixture and of every `(space, grid, size)` of `s`, with
 /// `progress` told after each held-out condition's judge and each configuration;
 /// and the judges (for a baked sampler's figures, [`super::brdf_sampler`]).
@@ -113,16 +129,7 @@ pub fn evaluate(
     let judging = judging(s);
     let mut judges: Vec<Judge<BrdfTarget>> = Vec::new();
     for (index, c) in held_out(s).into_iter().enumerate() {
-        let target = BrdfTarget::metallic(c[0], c[1], c[2], Domain::Hemisphere)?;
-        let exact = TabulatedWarp::new(&target, EXACT_TABULATION, 2)?;
-        let judge = Judge::new(
-            target.clone(),
-            &target,
-            &|u| exact.warp(u),
-            &judging,
-            index as u64,
-        );
-        judges.push(judge);
+        judges.push(judge(c, &judging, index as u64)?);
         progress(&format!("condition {index} judged"));
     }
     anyhow::ensure!(!judges.is_empty(), "no held-out condition");
