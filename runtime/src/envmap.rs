@@ -12,12 +12,17 @@
 //! * `(1/N) Σ L(l_i) f(l_i) cos_i / pdf_i`, the renderer's usual one: exact in
 //!   expectation in the **unbiased mode** ([`EnvmapSampler::sample_randomized`],
 //!   a per-pixel random shift of the primary points, under which every sample is
-//!   distributed exactly as its pdf); in the fixed-instance modes the learned
-//!   points follow the pdf only approximately, so it carries a small bias that
-//!   shrinks with the set's discrepancy;
+//!   distributed exactly as its pdf). In the fixed-instance modes the instances
+//!   together follow the pdf closely (rendered with MIS at 256 spp, a bias of 5 %
+//!   of Owen-Sobol's RMSE on courtyard, 2 % on studio), but the prior is uniform
+//!   inside each of its leaves (0.35° across) while `L` is not, and the ratio
+//!   `L cos / pdf` carries that: 4 % (courtyard) to 25 % (studio) more RMSE than
+//!   the weight below;
 //! * `(E / N) Σ f(l_i)` with `weight = E(n)`, the irradiance, as before the prior
-//!   existed: cheaper (no `L` lookup), the same bias in fixed-instance modes.
-
+//!   existed: cheaper (no `L` lookup) and of lower variance, since each set was
+//!   trained towards `L cos / E`; but the instances together follow the prior,
+//!   not `L cos / E`, so it is the more biased in fixed-instance modes (16 % on
+//!   courtyard, 3 % on studio).
 use crate::conditional::{scaled_to_largest, ConditionalSampler, NetworkSampler, Sample};
 use glam::{Vec2, Vec3};
 use nuld_core::blob::BlobError;

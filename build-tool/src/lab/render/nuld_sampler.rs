@@ -19,16 +19,16 @@
 //! * environment sampling: [`EnvmapSampler::sample`] or
 //!   [`EnvmapNetwork::sample`] at the world normal, or their unbiased mode
 //!   ([`EnvmapSampler::sample_randomized`], `nuld-unbiased`, the pixel key's low
-//!   32 bits as its random number). Each mode is weighted by the density its
-//!   samples follow:
+//!   32 bits as its random number), weighted by a density:
 //!   * the unbiased mode's samples are distributed exactly as the runtime's
 //!     pdf (the prior's): the weight is the usual `f(wo, l) cos / pdf(l)`, and
 //!     [`DirectionSampler::pdf`] is the runtime's `pdf`;
 //!   * a fixed instance's set was trained to follow the target
-//!     `q(l) = L(l) max(0, n.l) / E(n)`, not the prior: weighting it by the
-//!     prior's pdf counts the light the prior puts where the target has none
-//!     (across the horizon, the tree's bound) as a surplus of the rest, a bias
-//!     that multiple importance sampling lays bare (docs/results/rendering.md).
+//!     `q(l) = L(l) max(0, n.l) / E(n)`, and is weighted by `q`: the prior's
+//!     pdf would be the less biased weight (the 64 instances together follow
+//!     the prior, not `q`), but the prior is uniform inside its leaves while
+//!     `L` is not, and that ratio costs 4-25 % more RMSE
+//!     (docs/results/rendering.md#fixed-instance-weight).
 //!     Its density is `q`, with `E(n)` the sample's weight and `L` the map (the
 //!     renderer's own lookup): the weight is `f cos / q = E f / L`, and
 //!     [`DirectionSampler::pdf`] is `q` (0 where `L` or the cosine is 0).
