@@ -28,6 +28,9 @@ const NORMALS: usize = 64;
 /// Points per set: a set of 64 shares its normal and scramble.
 const N: u32 = 64;
 
+/// Levels of the shallow tree timed beside the prior's own.
+const SHALLOW_LEVELS: u32 = 5;
+
 /// `(method, ns per sample)` rows, the incumbent first, over `samples` samples
 /// each, one thread: sample `s` has normal `s / N mod 64`, and index `s mod N` of
 /// the set scrambled by `s / N`.
@@ -83,6 +86,17 @@ pub fn measure(map: &EnvmapDensity, samples: u32) -> Result<Vec<(String, f64)>> 
         ns_per_sample(samples / 4, |s| {
             let [x, y] = u(s);
             black_box(core.sample(normals[at(s)].to_array(), [x as f64, y as f64]));
+        }),
+    ));
+    // A shallow tree of the same map, whose records (87 KB) stay in the caches:
+    // the difference per level from the deep one tells cache misses from the
+    // descent's own latency.
+    let shallow = EnvmapTree::new(map, SHALLOW_LEVELS, grid)?;
+    let shallow_core = shallow.tree();
+    rows.push((
+        format!("tree L {SHALLOW_LEVELS} (in cache), top {grid}: sample + pdf (f32)"),
+        ns_per_sample(samples, |s| {
+            black_box(shallow_core.sample(normals32[at(s)], u(s)));
         }),
     ));
     // The default bake's sampler: [32, 32] ReLU, 64 slots, 64 instances on 13 x
