@@ -53,14 +53,49 @@ impl Checkpoint {
         crate::output::write_atomic(path, &bytes)
     }
 
-    /// Reads a checkpoint written by [`Checkpoint::save`].
+    /// Reads a checkpoint written by [`Checkpoint::save`]. A file that does not
+    /// decode is refused in one line that names what to do: it is damaged, or
+    /// an earlier build-tool wrote it (the settings it records have since gained
+    /// fields, the metallic axis's nodes for one), and a run cannot continue it.
     pub fn load(path: &Path) -> Result<Self> {
         let bytes =
             std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
         let body = bytes
             .strip_prefix(MAGIC.as_slice())
             .with_context(|| format!("{} is not a training checkpoint", path.display()))?;
-        postcard::from_bytes(body)
-            .with_context(|| format!("{} is a damaged checkpoint", path.display()))
+        postcard::from_bytes(body).map_err(|_| {
+            anyhow::anyhow!(
+                "{} is damaged or was written by an earlier build-tool; rerun without --resume",
+                path.display()
+            )
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A checkpoint reads back as it was saved; one cut short (as a checkpoint
+    /// of an earlier build-tool's shorter settings decodes) and a file of
+    /// another kind are refused in one line each, the first naming the way out.
+    #[test]
+    fn a_checkpoint_reads_back_and_unreadable_ones_are_refused_in_one_line() {
+        let dir = std::env::temp_dir().join(format!("nuld-checkpoint-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("checkpoint.bin");
+        let c = Checkpoint::fresh(TrainConfig::default(), vec![0.5, -1.25, 3.0], 4);
+        c.save(&path).unwrap();
+        assert_eq!(Checkpoint::load(&path).unwrap(), c);
+
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
+        let e = format!("{:#}", Checkpoint::load(&path).unwrap_err());
+        assert!(e.contains("without --resume") && !e.contains('\n'), "{e}");
+
+        std::fs::write(&path, b"not a checkpoint").unwrap();
+        let e = format!("{:#}", Checkpoint::load(&path).unwrap_err());
+        assert!(e.ends_with("is not a training checkpoint"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
