@@ -50,16 +50,19 @@ fn main() {
             let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(k);
             let m = 200_000;
             let mut acc = [0.0; 4];
+            // `L cos / (E pdf)` at square point `p` of square density `pdf_sq`.
+            let ratio_at = |p: DVec2, pdf_sq: f64| {
+                let d = square_to_sphere(p);
+                if pdf_sq > 0.0 {
+                    l(d) * n.dot(d).max(0.0) * 4.0 * std::f64::consts::PI / (e * pdf_sq)
+                } else {
+                    0.0
+                }
+            };
             for _ in 0..m {
                 let u = [rng.random::<f64>(), rng.random::<f64>()];
                 let (p, pdf_sq, _) = core.sample_square_with_slopes(q.to_array(), u);
-                let d = square_to_sphere(DVec2::from(p));
-                let c = n.dot(d).max(0.0);
-                let ratio = if pdf_sq > 0.0 {
-                    l(d) * c * 4.0 * std::f64::consts::PI / (e * pdf_sq)
-                } else {
-                    0.0
-                };
+                let ratio = ratio_at(DVec2::from(p), pdf_sq);
                 acc[0] += ratio;
                 acc[1] += ratio * ratio;
                 // Bilinear inside the leaf.
@@ -87,14 +90,7 @@ fn main() {
                     (ux, uy, 1.0)
                 };
                 let p2 = DVec2::new((lx + x) / side, (ly + y) / side);
-                let d2 = square_to_sphere(p2);
-                let c2 = n.dot(d2).max(0.0);
-                let pdf2 = pdf_sq * local;
-                let ratio2 = if pdf2 > 0.0 {
-                    l(d2) * c2 * 4.0 * std::f64::consts::PI / (e * pdf2)
-                } else {
-                    0.0
-                };
+                let ratio2 = ratio_at(p2, pdf_sq * local);
                 acc[2] += ratio2;
                 acc[3] += ratio2 * ratio2;
             }
