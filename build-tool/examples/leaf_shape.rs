@@ -1,5 +1,5 @@
 //! What a shape inside the environment prior's leaves would give: `cargo run
-//! --release -p nuld-build-tool --example leaf_shape -- MAP` (about 30 s a map).
+//! --release -p nuld-build-tool --example leaf_shape -- MAP` (about 10 s a map).
 //!
 //! The prior (the tree the bake builds) is uniform inside each leaf, while the
 //! map's light is not. At 64 normals spread over the sphere (`z` from 1 down to
@@ -37,7 +37,17 @@ fn main() {
     let core = tree.tree();
     let side = (1u64 << levels) as f64;
     let l = |d: DVec3| map.pdf(d) * map.integral();
-    let corner = |x: f64, y: f64| l(square_to_sphere(DVec2::new(x / side, y / side)));
+    // `L` at the leaves' corners, `(2^L + 1)^2` values, read once: a sample
+    // reads four.
+    let row = (1usize << levels) + 1;
+    let corners: Vec<f64> = (0..row * row)
+        .into_par_iter()
+        .map(|k| {
+            let (x, y) = ((k % row) as f64, (k / row) as f64);
+            l(square_to_sphere(DVec2::new(x / side, y / side)))
+        })
+        .collect();
+    let corner = |x: f64, y: f64| corners[y as usize * row + x as usize];
     let rows: Vec<[f64; 4]> = (0..64)
         .into_par_iter()
         .map(|k| {
