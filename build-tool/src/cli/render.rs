@@ -1,6 +1,7 @@
 //! `build-tool render`: the rendering evaluation of paper Fig. 8 (library:
 //! [`crate::lab::render`]).
 
+use crate::lab::render::nuld_sampler::FixedWeight;
 use crate::lab::render::sampler::Technique;
 use crate::lab::render::{render, RenderConfig};
 use anyhow::{bail, Result};
@@ -47,9 +48,24 @@ pub struct RenderArgs {
     /// no BRDF blob is baked.
     #[arg(long, value_delimiter = ',', value_parser = technique)]
     pub techniques: Vec<Technique>,
+    /// How our environment sampler's fixed instances weigh a sample `l`:
+    /// target (E f / L: as if the set followed L cos / E), pdf (f cos / pdf, the
+    /// prior's pdf), normalized (f cos / pdf, the set's weights divided by its
+    /// own estimate of the irradiance over the blob's E(n)) [default: target].
+    #[arg(long, value_parser = fixed_weight)]
+    pub fixed_weight: Option<FixedWeight>,
     /// Output directory.
     #[arg(long)]
     pub out: PathBuf,
+}
+
+/// `normalized`, `pdf` or `target`.
+fn fixed_weight(s: &str) -> Result<FixedWeight, String> {
+    FixedWeight::ALL
+        .iter()
+        .find(|(name, _)| *name == s.trim())
+        .map(|(_, w)| *w)
+        .ok_or_else(|| format!("{s:?} is not a weight: normalized, pdf or target"))
 }
 
 /// A sample count in `1..=65536`.
@@ -102,6 +118,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if !a.techniques.is_empty() {
         config.techniques = a.techniques;
     }
+    if let Some(w) = a.fixed_weight {
+        config.fixed_weight = w;
+    }
     let report = render(&config, &a.out)?;
     println!("{}", report.summary);
     println!(
@@ -130,6 +149,12 @@ mod tests {
         assert!(technique("light")
             .unwrap_err()
             .contains("brdf, envmap or mis"));
+        assert_eq!(fixed_weight("pdf"), Ok(FixedWeight::Pdf));
+        assert_eq!(fixed_weight(" normalized"), Ok(FixedWeight::Normalized));
+        assert_eq!(fixed_weight("target"), Ok(FixedWeight::Target));
+        assert!(fixed_weight("q")
+            .unwrap_err()
+            .contains("normalized, pdf or target"));
     }
 
     #[test]
@@ -153,6 +178,7 @@ mod tests {
             seed: 0,
             seeds: None,
             techniques: vec![],
+            fixed_weight: None,
             out: dir.join("never-written"),
         };
         let e = run(a).unwrap_err().to_string();

@@ -5,7 +5,7 @@ use super::environment::Environment;
 use super::envmap_warp::{EnvWarp, EnvmapSampler};
 use super::frame::Frame;
 use super::mis::MisSampler;
-use super::nuld_sampler::{NuldBlobError, NuldMode, NuldSampler};
+use super::nuld_sampler::{FixedWeight, NuldBlobError, NuldMode, NuldSampler};
 use super::primary::{Generator, PrimaryPoints};
 use super::sampler::{DirectionSampler, ShadingPoint, Technique};
 use super::scene::Material;
@@ -78,6 +78,24 @@ pub fn samplers<'a>(
     env: &'a Environment,
     network_weights: &'a mut [Vec<f32>; 2],
 ) -> Result<Vec<Shared<'a>>, NuldBlobError> {
+    let blobs = [blob, envmap_blob];
+    let w = FixedWeight::default();
+    weighted_samplers(techniques, blobs, w, n, seed, lobes, env, network_weights)
+}
+
+/// [`samplers`] of the blobs `[brdf, envmap]` with our environment sampler's
+/// fixed instances weighted by `fixed_weight`.
+#[allow(clippy::too_many_arguments)]
+pub fn weighted_samplers<'a>(
+    techniques: &[Technique],
+    [blob, envmap_blob]: [Option<&'a [u8]>; 2],
+    fixed_weight: FixedWeight,
+    n: u32,
+    seed: u64,
+    lobes: &'a LobeTable,
+    env: &'a Environment,
+    network_weights: &'a mut [Vec<f32>; 2],
+) -> Result<Vec<Shared<'a>>, NuldBlobError> {
     let [brdf_weights, envmap_weights] = network_weights;
     let mut brdf_weights = Some(brdf_weights);
     let generators = [
@@ -108,8 +126,11 @@ pub fn samplers<'a>(
 
     let mut envmaps: Vec<Shared<'a>> = Vec::new();
     if let Some(e) = envmap_blob {
-        envmaps.push(Arc::new(NuldSampler::envmap(e, NuldMode::Table, env)?));
-        let network = NuldSampler::envmap(e, NuldMode::Network, env)?;
+        let w = fixed_weight;
+        envmaps.push(Arc::new(
+            NuldSampler::envmap(e, NuldMode::Table, env)?.with_fixed_weight(w),
+        ));
+        let network = NuldSampler::envmap(e, NuldMode::Network, env)?.with_fixed_weight(w);
         envmaps.push(Arc::new(network.decoded(envmap_weights)));
         envmaps.push(Arc::new(
             NuldSampler::envmap(e, NuldMode::Table, env)?.unbiased(),

@@ -32,6 +32,9 @@
 //!     Its density is `q`, with `E(n)` the sample's weight and `L` the map (the
 //!     renderer's own lookup): the weight is `f cos / q = E f / L`, and
 //!     [`DirectionSampler::pdf`] is `q` (0 where `L` or the cosine is 0).
+//!     `render --fixed-weight` picks the other [`FixedWeight`]s, for
+//!     comparison: the prior's pdf, and that pdf with each set normalized by
+//!     its own estimate of `E(n)`.
 
 use super::environment::Environment;
 use super::sampler::{DirectionSampler, PixelKey, Sample, ShadingPoint, Technique};
@@ -50,6 +53,31 @@ pub enum NuldMode {
     Table,
     /// The f16 network per sample (`nuld-network`).
     Network,
+}
+
+/// How a fixed instance of the environment sampler weighs its samples (module
+/// docs): each sample's `f cos / p`, `p` a density the set stands for.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FixedWeight {
+    /// `p` = the prior's pdf, and the set's weights divided by the set's own
+    /// estimate of `E(n)` relative to the runtime's: `c = (1/n) Σ L cos / (p E)`
+    /// (a self-normalized estimator, whose control variate is `L cos`, of
+    /// known integral `E`).
+    Normalized,
+    /// `p` = the prior's pdf.
+    Pdf,
+    /// `p` = the target `q = L cos / E`: `f cos / q = E f / L`.
+    #[default]
+    Target,
+}
+
+impl FixedWeight {
+    /// The weights by name (`normalized`, `pdf`, `target`).
+    pub const ALL: [(&'static str, FixedWeight); 3] = [
+        ("normalized", FixedWeight::Normalized),
+        ("pdf", FixedWeight::Pdf),
+        ("target", FixedWeight::Target),
+    ];
 }
 
 /// Why a blob cannot serve as the BRDF sampler.
@@ -82,6 +110,7 @@ pub struct NuldSampler<'a> {
     mode: NuldMode,
     kind: Kind<'a>,
     randomized: bool,
+    fixed_weight: FixedWeight,
 }
 
 /// The runtime's refusal of a view as the reason a blob cannot serve.
@@ -104,6 +133,7 @@ impl<'a> NuldSampler<'a> {
             sampler: brdf.conditional(),
             mode,
             randomized: false,
+            fixed_weight: FixedWeight::default(),
             kind: match mode {
                 NuldMode::Table => Kind::Brdf(brdf),
                 NuldMode::Network => Kind::BrdfNetwork(brdf.network()),
@@ -128,6 +158,7 @@ impl<'a> NuldSampler<'a> {
             sampler: sampler.conditional(),
             mode,
             randomized: false,
+            fixed_weight: FixedWeight::default(),
             kind: match mode {
                 NuldMode::Table => Kind::Envmap(sampler, env),
                 NuldMode::Network => Kind::EnvmapNetwork(sampler.network(), env),
@@ -187,6 +218,15 @@ impl<'a> NuldSampler<'a> {
         }
     }
 
+    /// The sampler with a fixed instance's samples weighted by `w` (environment
+    /// sampling; module docs). The unbiased mode and BRDF sampling ignore it.
+    pub fn with_fixed_weight(self, w: FixedWeight) -> Self {
+        Self {
+            fixed_weight: w,
+            ..self
+        }
+    }
+
     /// Points per set `N` of the blob.
     pub fn len(&self) -> u32 {
         self.sampler.len()
@@ -238,20 +278,26 @@ impl DirectionSampler for NuldSampler<'_> {
                 };
                 self.brdf_sample(at, s, (wo, r, m))
             })),
-            Kind::Envmap(t, env) => out.extend((0..n).map(|i| {
-                let s = match self.randomized {
-                    false => t.sample(normal, k, i),
-                    true => t.sample_randomized(normal, k, i, key.scramble()),
-                };
-                self.envmap_sample(at, env, s)
-            })),
-            Kind::EnvmapNetwork(t, env) => out.extend((0..n).map(|i| {
-                let s = match self.randomized {
-                    false => t.sample(normal, k, i),
-                    true => t.sample_randomized(normal, k, i, key.scramble()),
-                };
-                self.envmap_sample(at, env, s)
-            })),
+            Kind::Envmap(t, env) => {
+                out.extend((0..n).map(|i| {
+                    let s = match self.randomized {
+                        false => t.sample(normal, k, i),
+                        true => t.sample_randomized(normal, k, i, key.scramble()),
+                    };
+                    self.envmap_sample(at, env, s)
+                }));
+                self.normalize(at, env, out);
+            }
+            Kind::EnvmapNetwork(t, env) => {
+                out.extend((0..n).map(|i| {
+                    let s = match self.randomized {
+                        false => t.sample(normal, k, i),
+                        true => t.sample_randomized(normal, k, i, key.scramble()),
+                    };
+                    self.envmap_sample(at, env, s)
+                }));
+                self.normalize(at, env, out);
+            }
         }
     }
 
@@ -270,14 +316,16 @@ impl DirectionSampler for NuldSampler<'_> {
             Kind::Envmap(t, env) => (t.pdf(normal, l.as_vec3()), env),
             Kind::EnvmapNetwork(t, env) => (t.pdf(normal, l.as_vec3()), env),
         };
-        Some(match self.randomized {
-            true => prior.0 as f64,
-            false => {
-                // The runtime's E(n), the weight its samples carry here.
-                let e = EnvmapSampler::try_from(self.sampler).map_or(0.0, |t| t.weight(normal));
-                target_density(at, prior.1, e as f64, l)
-            }
-        })
+        Some(
+            match self.randomized || self.fixed_weight != FixedWeight::Target {
+                true => prior.0 as f64,
+                false => {
+                    // The runtime's E(n), the weight its samples carry here.
+                    let e = EnvmapSampler::try_from(self.sampler).map_or(0.0, |t| t.weight(normal));
+                    target_density(at, prior.1, e as f64, l)
+                }
+            },
+        )
     }
 }
 
@@ -309,8 +357,8 @@ impl NuldSampler<'_> {
     }
 
     /// An environment sample (world frame) weighted by the density it follows
-    /// (module docs): the runtime's exact pdf in the unbiased mode, the target
-    /// `q = L cos / E` for a fixed instance.
+    /// (module docs): the runtime's exact pdf in the unbiased mode, and for a
+    /// fixed instance as [`FixedWeight`] says (before [`Self::normalize`]).
     fn envmap_sample(
         &self,
         at: &ShadingPoint,
@@ -318,9 +366,9 @@ impl NuldSampler<'_> {
         s: nuld_runtime::Sample,
     ) -> Sample {
         let l = s.direction.as_dvec3();
-        let pdf = match self.randomized {
-            true => s.pdf as f64,
-            false => target_density(at, env, s.weight as f64, l),
+        let pdf = match (self.randomized, self.fixed_weight) {
+            (false, FixedWeight::Target) => target_density(at, env, s.weight as f64, l),
+            _ => s.pdf as f64,
         };
         let f_cos = at.cosine_weighted(l);
         Sample {
@@ -331,6 +379,34 @@ impl NuldSampler<'_> {
                 0.0
             },
             pdf,
+        }
+    }
+}
+
+impl NuldSampler<'_> {
+    /// A fixed instance's set weighted [`FixedWeight::Normalized`]: each weight
+    /// `f cos / p` divided by `c = (1/n) Σ L cos / (p e)`, the set's own
+    /// estimate of the irradiance `e = E(n)` over the runtime's. Where the
+    /// prior's pdf is `L cos / E` up to a constant, `c` is that constant and
+    /// each sample contributes `E f`, as the target weight; where it is not,
+    /// the set's own errors on `L cos` cancel from the estimate. Nothing
+    /// otherwise (or when no sample sees light: the weights are then 0).
+    fn normalize(&self, at: &ShadingPoint, env: &Environment, set: &mut [Sample]) {
+        let normal = at.frame.normal().as_vec3();
+        let e = EnvmapSampler::try_from(self.sampler).map_or(0.0, |t| t.weight(normal)) as f64;
+        if self.randomized || self.fixed_weight != FixedWeight::Normalized || e <= 0.0 {
+            return;
+        }
+        let n = set.len() as f64;
+        let cos = |l: DVec3| at.frame.normal().dot(l).max(0.0);
+        let c = set
+            .iter()
+            .filter(|s| s.pdf > 0.0)
+            .map(|s| env.radiance(s.direction) * cos(s.direction) / s.pdf)
+            .sum::<f64>()
+            / (n * e);
+        if c > 0.0 && c.is_finite() {
+            set.iter_mut().for_each(|s| s.weight /= c);
         }
     }
 }
@@ -457,8 +533,10 @@ mod tests {
     /// which `pdf` returns for any direction, and that pdf is the product warp's
     /// of the map (`Environment::product_pdf`, the baselines through ours' prior)
     /// to f32 rounding: the same warp. A fixed instance is weighted by the
-    /// target `q = L cos / E` (each sample contributes `E f`), which `pdf`
-    /// returns.
+    /// density its [`FixedWeight`] names: the target `q = L cos / E` (each
+    /// sample contributes `E f`), the runtime's pdf, or that pdf with the set
+    /// normalized (the set's estimate of `∫ L cos`, `f` replaced by 1, is then
+    /// the runtime's `E(n)` exactly), and `pdf` returns that density.
     #[test]
     fn envmap_samples_are_the_runtimes_weighted_by_the_density_they_follow() {
         use crate::lab::render::blobs::tiny_envmap_blob;
@@ -476,36 +554,61 @@ mod tests {
             material: crate::lab::render::scene::Material::dielectric(0.3),
         };
         let key = PixelKey(0x0fed_cba9_8765_4321);
-        let (mut checked, mut compared) = (0, 0);
+        let (mut checked, mut compared, mut normalized) = (0, 0, 0);
+        let modes = [false, true].into_iter().flat_map(|unbiased| {
+            FixedWeight::ALL
+                .into_iter()
+                .map(move |(_, w)| (unbiased, w))
+        });
         for mode in [NuldMode::Table, NuldMode::Network] {
-            for unbiased in [false, true] {
+            for (unbiased, fixed_weight) in modes.clone() {
                 let mut weights = Vec::new();
                 let mut ours = NuldSampler::envmap(blob.as_slice(), mode, &env)
                     .unwrap()
-                    .decoded(&mut weights);
+                    .decoded(&mut weights)
+                    .with_fixed_weight(fixed_weight);
                 if unbiased {
                     ours = ours.unbiased();
                 }
                 assert_eq!(ours.technique(), Technique::Envmap);
                 let mut out = Vec::new();
                 ours.samples(&at, key, 8, &mut out);
+                let (k, nf) = (key.instance(), n.as_vec3());
+                let want = |i: u32| match (mode, unbiased) {
+                    (NuldMode::Table, false) => cs.sample(nf, k, i),
+                    (NuldMode::Network, false) => cs.network().sample(nf, k, i),
+                    (NuldMode::Table, true) => cs.sample_randomized(nf, k, i, key.scramble()),
+                    (NuldMode::Network, true) => {
+                        cs.network().sample_randomized(nf, k, i, key.scramble())
+                    }
+                };
+                // The fixed instance's normalization, from the runtime's samples.
+                let e = cs.weight(nf) as f64;
+                let c = (0..8)
+                    .map(|i| {
+                        let s = want(i);
+                        let l = s.direction.as_dvec3();
+                        env.radiance(l) * n.dot(l).max(0.0) / s.pdf as f64 / e
+                    })
+                    .sum::<f64>()
+                    / 8.0;
+                let mut irradiance = 0.0;
                 for (i, s) in out.iter().enumerate() {
-                    let (k, i) = (key.instance(), i as u32);
-                    let nf = n.as_vec3();
-                    let want = match (mode, unbiased) {
-                        (NuldMode::Table, false) => cs.sample(nf, k, i),
-                        (NuldMode::Network, false) => cs.network().sample(nf, k, i),
-                        (NuldMode::Table, true) => cs.sample_randomized(nf, k, i, key.scramble()),
-                        (NuldMode::Network, true) => {
-                            cs.network().sample_randomized(nf, k, i, key.scramble())
-                        }
-                    };
+                    let want = want(i as u32);
                     assert_eq!(s.direction, want.direction.as_dvec3());
                     let l = s.direction;
                     let f_cos = at.cosine_weighted(l);
-                    if unbiased {
+                    let l_cos = env.radiance(l) * n.dot(l).max(0.0);
+                    let prior = Some(cs.pdf(nf, want.direction) as f64);
+                    let scale = match (unbiased, fixed_weight) {
+                        (false, FixedWeight::Normalized) => c,
+                        _ => 1.0,
+                    };
+                    if unbiased || fixed_weight != FixedWeight::Target {
                         assert_eq!(s.pdf, want.pdf as f64);
-                        assert_eq!(ours.pdf(&at, l), Some(cs.pdf(nf, want.direction) as f64));
+                        assert_eq!(ours.pdf(&at, l), prior);
+                    }
+                    if unbiased {
                         let product = env.product_pdf(n, l);
                         if product > 0.0 {
                             assert!(
@@ -515,10 +618,10 @@ mod tests {
                             );
                             compared += 1;
                         }
-                    } else {
+                    } else if fixed_weight == FixedWeight::Target {
                         // q = L cos / E, E the runtime's weight; f cos / q = E f / L.
                         let e = want.weight as f64;
-                        let q = env.radiance(l) * n.dot(l).max(0.0) / e;
+                        let q = l_cos / e;
                         assert!((s.pdf - q).abs() <= 1e-12 * q, "{} {q}", s.pdf);
                         let back = ours.pdf(&at, l).unwrap();
                         assert!((back - q).abs() <= 1e-5 * q, "{back} {q}");
@@ -529,15 +632,27 @@ mod tests {
                         }
                     }
                     if f_cos > 0.0 {
-                        assert!((s.weight - f_cos / s.pdf).abs() <= 1e-12 * s.weight);
+                        let w = f_cos / s.pdf / scale;
+                        assert!((s.weight - w).abs() <= 1e-12 * s.weight);
+                        irradiance += s.weight * l_cos / f_cos / 8.0;
                         checked += 1;
                     } else {
                         assert_eq!(s.weight, 0.0);
                     }
                 }
+                if !unbiased && fixed_weight == FixedWeight::Normalized {
+                    // Every sample of this normal's set sees the sky (the
+                    // dielectric's f cos > 0 wherever the cosine is).
+                    assert!((irradiance - e).abs() <= 1e-9 * e, "{irradiance} {e}");
+                    assert!(
+                        (c - 1.0).abs() > 1e-6,
+                        "a set that needs no normalization: {c}"
+                    );
+                    normalized += 1;
+                }
             }
         }
-        assert!(checked > 8 && compared > 8, "{checked} {compared}");
+        assert!(checked > 8 && compared > 8 && normalized == 2);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -17,6 +17,7 @@ use super::camera::Camera;
 use super::environment::Environment;
 use super::integrator::{Image, Primary, Setup};
 use super::lineup;
+use super::nuld_sampler::FixedWeight;
 use super::picture::{error_map, exposure, tone_map, Picture};
 use super::reference::Reference;
 use super::sampler::Technique;
@@ -63,6 +64,8 @@ pub struct RenderConfig {
     /// What to render (BRDF sampling, environment sampling, MIS); a BRDF blob is
     /// needed only for BRDF sampling, an environment blob for the others.
     pub techniques: Vec<Technique>,
+    /// How our environment sampler's fixed instances weigh their samples.
+    pub fixed_weight: FixedWeight,
 }
 
 impl RenderConfig {
@@ -83,6 +86,7 @@ impl RenderConfig {
             seed: 0,
             seeds: 4,
             techniques: Technique::ALL.to_vec(),
+            fixed_weight: FixedWeight::default(),
         }
     }
 
@@ -259,10 +263,10 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
             let seed = config.seed.wrapping_add(k as u64);
             // Network mode's weights, decoded once per blob (as a renderer would).
             let mut weights = Default::default();
-            let samplers = lineup::samplers(
+            let samplers = lineup::weighted_samplers(
                 &config.techniques,
-                brdf.map(|(_, b)| b),
-                envmap.map(|(_, b)| b),
+                [brdf.map(|(_, b)| b), envmap.map(|(_, b)| b)],
+                config.fixed_weight,
                 n,
                 seed,
                 &lobes,
