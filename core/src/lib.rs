@@ -41,6 +41,7 @@
 #![no_std]
 #![deny(missing_docs)]
 
+pub mod bilinear;
 pub mod blob;
 pub mod brdf;
 pub mod brdf_prior;
