@@ -47,6 +47,7 @@
 //! per steradian. Everything is generic over [`Real`] (`f32` in the runtime and
 //! shaders, `f64` in the tool), allocates nothing and never panics.
 
+use crate::bilinear;
 use crate::quadtree::{self, ChildWeights, QuadtreeError, MAX_LEVELS};
 use crate::real::{clamp_unit, Real};
 use crate::sphere::{sphere_to_square_real, square_to_sphere_real};
@@ -291,6 +292,9 @@ pub struct EnvmapTree<'a> {
     nodes: &'a [NodeRecord],
     grid: u32,
     top: &'a [f32],
+    /// The leaf shape: `(2^L + 1)^2` corner values, row-major; empty for
+    /// uniform leaves.
+    corners: &'a [f32],
 }
 
 impl<'a> EnvmapTree<'a> {
@@ -341,7 +345,87 @@ impl<'a> EnvmapTree<'a> {
             nodes,
             grid,
             top,
+            corners: &[],
         })
+    }
+
+    /// The tree with a shape inside its leaves: `corners` holds `(2^L + 1)^2`
+    /// values on the leaves' corners (row-major over the octahedral square,
+    /// finite and non-negative), and a point inside a leaf is drawn by the
+    /// bilinear warp of its four corners ([`bilinear`]), the leaf's probability
+    /// unchanged; empty `corners` keep the leaves uniform. An error if the length
+    /// or a value is wrong.
+    pub fn with_corners(self, corners: &'a [f32]) -> Result<Self, QuadtreeError> {
+        let side = (1usize << self.levels) + 1;
+        if !corners.is_empty() && corners.len() != side * side {
+            return Err(QuadtreeError::Length {
+                expected: (side * side) as u64,
+                got: corners.len() as u64,
+            });
+        }
+        if let Some(i) = corners.iter().position(|v| !(*v >= 0.0 && v.is_finite())) {
+            return Err(QuadtreeError::BadCorner(i as u64));
+        }
+        Ok(Self { corners, ..self })
+    }
+
+    /// The four corner values of leaf `(x, y)`, `[w00, w10, w01, w11]`, or
+    /// `None` for uniform leaves.
+    #[inline]
+    fn corners_of<T: Real>(&self, leaf: [u32; 2]) -> Option<[T; 4]> {
+        if self.corners.is_empty() {
+            return None;
+        }
+        let side = (1usize << self.levels) + 1;
+        let (x, y) = (leaf[0] as usize, leaf[1] as usize);
+        let at = |dx: usize, dy: usize| {
+            T::of(
+                self.corners
+                    .get((y + dy) * side + x + dx)
+                    .copied()
+                    .unwrap_or(0.0) as f64,
+            )
+        };
+        Some([at(0, 0), at(1, 0), at(0, 1), at(1, 1)])
+    }
+
+    /// The leaf of square point `p` and `p`'s coordinates inside it.
+    #[inline]
+    fn leaf_of<T: Real>(&self, p: [T; 2]) -> ([u32; 2], [T; 2]) {
+        let side = T::of((1u64 << self.levels) as f64);
+        let leaf = p.map(|c| quadtree::leaf(self.levels, c));
+        let local = [0, 1].map(|k| clamp_unit(clamp_unit(p[k]) * side - T::of(leaf[k] as f64)));
+        (leaf, local)
+    }
+
+    /// The square point, its pdf per unit area of the square and its slopes
+    /// ([`quadtree::sample_with_slopes`]) for `lit` at `u`, shaped inside the
+    /// leaf when the tree has corners.
+    #[inline]
+    fn warp<T: Real>(&self, lit: &Lit<'a, T>, u: [T; 2]) -> ([T; 2], T, [T; 2]) {
+        let d = quadtree::descend(lit, u);
+        let (local, density, s) = match self.corners_of::<T>(d.leaf) {
+            Some(w) => bilinear::sample_bilinear(d.local, w),
+            None => (d.local, T::ONE, [T::ONE; 2]),
+        };
+        let side = T::of((1u64 << self.levels) as f64);
+        let point = [
+            ((T::of(d.leaf[0] as f64) + local[0]) / side).min(T::ONE),
+            ((T::of(d.leaf[1] as f64) + local[1]) / side).min(T::ONE),
+        ];
+        let slopes = [s[0] / (side * d.column), s[1] / (side * d.row)];
+        (point, d.share * side * side * density, slopes)
+    }
+
+    /// The density per unit area of the square at `p` for `lit`.
+    #[inline]
+    fn square_pdf<T: Real>(&self, lit: &Lit<'a, T>, p: [T; 2]) -> T {
+        let pdf = quadtree::pdf(lit, p);
+        let (leaf, local) = self.leaf_of(p);
+        match self.corners_of::<T>(leaf) {
+            Some(w) => pdf * bilinear::bilinear_pdf(local, w),
+            None => pdf,
+        }
     }
 
     /// The per-value checks of [`Self::new`]: every top weight finite and
@@ -423,7 +507,7 @@ impl<'a> EnvmapTree<'a> {
     /// and its solid-angle pdf ([`Self::pdf`]). `O(L)`; never panics.
     #[inline]
     pub fn sample<T: Real>(&self, normal: [T; 3], u: [T; 2]) -> ([T; 3], T) {
-        let (p, pdf) = quadtree::sample(&self.lit(normal), u);
+        let (p, pdf, _) = self.warp(&self.lit(normal), u);
         (square_to_sphere_real(p), pdf / (T::of(4.0) * T::PI))
     }
 
@@ -431,7 +515,7 @@ impl<'a> EnvmapTree<'a> {
     /// ([`Self::lit_square`]). `O(L)`; never panics.
     #[inline]
     pub fn sample_square<T: Real>(&self, q: [T; 2], u: [T; 2]) -> ([T; 3], T) {
-        let (p, pdf) = quadtree::sample(&self.lit_square(q), u);
+        let (p, pdf, _) = self.warp(&self.lit_square(q), u);
         (square_to_sphere_real(p), pdf / (T::of(4.0) * T::PI))
     }
 
@@ -440,25 +524,35 @@ impl<'a> EnvmapTree<'a> {
     /// `(dx/du.x, dy/du.y)` of the point ([`quadtree::sample_with_slopes`]).
     #[inline]
     pub fn sample_square_with_slopes<T: Real>(&self, q: [T; 2], u: [T; 2]) -> ([T; 2], T, [T; 2]) {
-        quadtree::sample_with_slopes(&self.lit_square(q), u)
+        self.warp(&self.lit_square(q), u)
     }
 
     /// [`Self::pdf`] for the normal whose octahedral square point is `q`.
     #[inline]
     pub fn pdf_square<T: Real>(&self, q: [T; 2], d: [T; 3]) -> T {
-        quadtree::pdf(&self.lit_square(q), sphere_to_square_real(d)) / (T::of(4.0) * T::PI)
+        self.square_pdf(&self.lit_square(q), sphere_to_square_real(d)) / (T::of(4.0) * T::PI)
     }
 
     /// The solid-angle density of [`Self::sample`]'s directions at the unit
     /// direction `d` for `normal`. `O(L)`; never panics.
     #[inline]
     pub fn pdf<T: Real>(&self, normal: [T; 3], d: [T; 3]) -> T {
-        quadtree::pdf(&self.lit(normal), sphere_to_square_real(d)) / (T::of(4.0) * T::PI)
+        self.square_pdf(&self.lit(normal), sphere_to_square_real(d)) / (T::of(4.0) * T::PI)
     }
 
     /// The primary sample that [`Self::sample`] maps to the unit direction `d`.
     pub fn invert<T: Real>(&self, normal: [T; 3], d: [T; 3]) -> [T; 2] {
-        quadtree::invert(&self.lit(normal), sphere_to_square_real(d))
+        let p = sphere_to_square_real(d);
+        let (leaf, local) = self.leaf_of(p);
+        let p = match self.corners_of::<T>(leaf) {
+            Some(w) => {
+                let side = T::of((1u64 << self.levels) as f64);
+                let uniform = bilinear::invert_bilinear(local, w);
+                [0, 1].map(|k| ((T::of(leaf[k] as f64) + uniform[k]) / side).min(T::ONE))
+            }
+            None => p,
+        };
+        quadtree::invert(&self.lit(normal), p)
     }
 }
 

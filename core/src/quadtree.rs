@@ -49,6 +49,9 @@ pub enum QuadtreeError {
     /// A tabulated weight ([`crate::envmap_tree`]'s top table) is negative, NaN or
     /// infinite (index into the table).
     BadTopWeight(u64),
+    /// A leaf-corner value ([`crate::envmap_tree`]'s leaf shape) is negative,
+    /// NaN or infinite (index into the corners).
+    BadCorner(u64),
 }
 
 impl core::fmt::Display for QuadtreeError {
@@ -63,6 +66,7 @@ impl core::fmt::Display for QuadtreeError {
             Self::BadTopWeight(i) => {
                 write!(f, "top-level weight {i} is negative or not finite")
             }
+            Self::BadCorner(i) => write!(f, "leaf corner {i} is negative or not finite"),
         }
     }
 }
@@ -292,6 +296,38 @@ pub fn sample<T: Real>(tree: &impl ChildWeights<T>, u: [T; 2]) -> ([T; 2], T) {
 /// derivatives of the piece.) What a trainer chains its gradients through.
 #[inline]
 pub fn sample_with_slopes<T: Real>(tree: &impl ChildWeights<T>, u: [T; 2]) -> ([T; 2], T, [T; 2]) {
+    let d = descend(tree, u);
+    let side = T::of((1u64 << tree.levels().min(MAX_LEVELS)) as f64);
+    let point = [
+        ((T::of(d.leaf[0] as f64) + d.local[0]) / side).min(T::ONE),
+        ((T::of(d.leaf[1] as f64) + d.local[1]) / side).min(T::ONE),
+    ];
+    let slopes = [T::ONE / (side * d.column), T::ONE / (side * d.row)];
+    (point, d.share * side * side, slopes)
+}
+
+/// Where [`sample`]'s descent ends for `u`: the leaf, the rescaled primary
+/// sample inside it, and the products of the chosen shares.
+#[derive(Clone, Copy, Debug)]
+pub struct Descent<T> {
+    /// The leaf's column and row, each below `2^levels`.
+    pub leaf: [u32; 2],
+    /// `u` rescaled into the leaf, in `[0, 1]^2`: where in the leaf the point
+    /// falls when the leaf is uniform.
+    pub local: [T; 2],
+    /// The product of the chosen children's shares (the leaf's probability).
+    pub share: T,
+    /// The product of the chosen columns' shares along the path.
+    pub column: T,
+    /// The product of the chosen rows' shares along the path.
+    pub row: T,
+}
+
+/// The descent of [`sample`] from `u` (clamped into the square, NaN as 0), for a
+/// caller that shapes the point inside its leaf ([`crate::envmap_tree`]).
+/// `O(levels)`; never panics.
+#[inline]
+pub fn descend<T: Real>(tree: &impl ChildWeights<T>, u: [T; 2]) -> Descent<T> {
     let levels = tree.levels().min(MAX_LEVELS);
     let (mut ux, mut uy) = (clamp_unit(u[0]), clamp_unit(u[1]));
     let (mut x, mut y) = (0u32, 0u32);
@@ -316,13 +352,13 @@ pub fn sample_with_slopes<T: Real>(tree: &impl ChildWeights<T>, u: [T; 2]) -> ([
         x = 2 * x + step.i as u32;
         y = 2 * y + step.j as u32;
     }
-    let side = T::of((1u64 << levels) as f64);
-    let point = [
-        ((T::of(x as f64) + ux) / side).min(T::ONE),
-        ((T::of(y as f64) + uy) / side).min(T::ONE),
-    ];
-    let slopes = [T::ONE / (side * column), T::ONE / (side * row)];
-    (point, p * side * side, slopes)
+    Descent {
+        leaf: [x, y],
+        local: [ux, uy],
+        share: p,
+        column,
+        row,
+    }
 }
 
 /// The density at `p` (clamped into the square) of [`sample`]'s points: the
@@ -389,7 +425,7 @@ pub fn invert<T: Real>(tree: &impl ChildWeights<T>, p: [T; 2]) -> [T; 2] {
 /// The leaf column (or row) of coordinate `c` among `2^levels`, clamped into the
 /// square.
 #[inline]
-fn leaf<T: Real>(levels: u32, c: T) -> u32 {
+pub fn leaf<T: Real>(levels: u32, c: T) -> u32 {
     let side = 1u32 << levels;
     ((clamp_unit(c) * T::of(side as f64)).floor().to_f64() as u32).min(side - 1)
 }
