@@ -145,6 +145,22 @@ pub fn sections<'s>(
     ]
 }
 
+/// The leaf-shape section of `corners` ([`EnvmapTree::with_corners`]), for a
+/// writer to add after [`sections`] when the tree has a shape.
+pub fn corner_section(corners: &[f32]) -> crate::blob::SectionSpec<'_> {
+    crate::blob::SectionSpec {
+        tag: crate::blob::SectionTag::EnvmapTreeCorners,
+        elem_size: 4,
+        bytes: bytemuck::cast_slice(corners),
+    }
+}
+
+/// Corner values of a tree with `levels` levels: `(2^L + 1)^2`.
+pub fn corner_len(levels: u32) -> usize {
+    let side = (1usize << levels.min(MAX_TREE_LEVELS)) + 1;
+    side * side
+}
+
 /// Records of a tree with `levels` levels (levels `1..=L`): `(4^(L+1) - 4) / 3`.
 pub fn node_count(levels: u32) -> usize {
     quadtree::pyramid_len(levels) - 1
@@ -354,19 +370,21 @@ impl<'a> EnvmapTree<'a> {
     /// finite and non-negative), and a point inside a leaf is drawn by the
     /// bilinear warp of its four corners ([`bilinear`]), the leaf's probability
     /// unchanged; empty `corners` keep the leaves uniform. An error if the length
-    /// or a value is wrong.
+    /// is wrong (`O(1)`; [`Self::check_values`] reads the values). A tree with
+    /// bad corner values still never panics; it describes another warp.
     pub fn with_corners(self, corners: &'a [f32]) -> Result<Self, QuadtreeError> {
-        let side = (1usize << self.levels) + 1;
-        if !corners.is_empty() && corners.len() != side * side {
+        if !corners.is_empty() && corners.len() != corner_len(self.levels) {
             return Err(QuadtreeError::Length {
-                expected: (side * side) as u64,
+                expected: corner_len(self.levels) as u64,
                 got: corners.len() as u64,
             });
         }
-        if let Some(i) = corners.iter().position(|v| !(*v >= 0.0 && v.is_finite())) {
-            return Err(QuadtreeError::BadCorner(i as u64));
-        }
         Ok(Self { corners, ..self })
+    }
+
+    /// The leaf shape's corner values (empty for uniform leaves).
+    pub fn corners(&self) -> &'a [f32] {
+        self.corners
     }
 
     /// The four corner values of leaf `(x, y)`, `[w00, w10, w01, w11]`, or
@@ -428,12 +446,19 @@ impl<'a> EnvmapTree<'a> {
         }
     }
 
-    /// The per-value checks of [`Self::new`]: every top weight finite and
-    /// non-negative, every record finite with a non-negative spread, some light
+    /// The per-value checks of [`Self::new`]: every top weight and leaf corner
+    /// finite and non-negative, every record finite with a non-negative spread, some light
     /// on level 1. `O(records)`.
     pub fn check_values(&self) -> Result<(), QuadtreeError> {
         if let Some(i) = self.top.iter().position(|v| !(*v >= 0.0 && v.is_finite())) {
             return Err(QuadtreeError::BadTopWeight(i as u64));
+        }
+        if let Some(i) = self
+            .corners
+            .iter()
+            .position(|v| !(*v >= 0.0 && v.is_finite()))
+        {
+            return Err(QuadtreeError::BadCorner(i as u64));
         }
         if let Some(i) = self.nodes.iter().position(|r| {
             !(r.moment.iter().all(|v| v.is_finite()) && r.spread >= 0.0 && r.spread.is_finite())

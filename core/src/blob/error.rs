@@ -506,6 +506,8 @@ pub enum ConditionalError {
     TreeNodeElementSize(u32),
     /// The [`SectionTag::EnvmapTreeTop`] elements are not 4 bytes (f32).
     TreeTopElementSize(u32),
+    /// The [`SectionTag::EnvmapTreeCorners`] elements are not 4 bytes (f32).
+    TreeCornerElementSize(u32),
     /// The tree's levels, counts or values are refused
     /// ([`crate::envmap_tree::EnvmapTree::new`]).
     Tree(crate::quadtree::QuadtreeError),
@@ -668,6 +670,9 @@ impl core::fmt::Display for ConditionalError {
             }
             Self::TreeTopElementSize(e) => {
                 write!(f, "blob environment tree top weights are {e} bytes each, not 4")
+            }
+            Self::TreeCornerElementSize(e) => {
+                write!(f, "blob environment tree leaf corners are {e} bytes each, not 4")
             }
             Self::Tree(e) => write!(f, "blob environment tree: {e}"),
             Self::BrdfPriorUnstretched => write!(

@@ -174,6 +174,11 @@ pub enum SectionTag {
     /// [instance][index]`. Optional; only with
     /// [`crate::conditional::PointWarp::BrdfTable`].
     MetallicNodes = 18,
+    /// The environment prior's leaf shape, `f32` (`elem_size` 4): `(2^L + 1)^2`
+    /// values on the leaves' corners, row-major over the octahedral square
+    /// ([`crate::envmap_tree::EnvmapTree::with_corners`]). Optional: without it
+    /// the leaves are uniform.
+    EnvmapTreeCorners = 19,
 }
 
 /// Contents of the [`SectionTag::PointSetInfo`] section.

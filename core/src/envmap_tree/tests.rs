@@ -578,8 +578,9 @@ fn a_leaf_shape_keeps_the_pdf_exact() {
     assert!(flat.with_corners(short).is_err());
     let mut bad = corners.clone();
     bad[17] = f32::NAN;
-    assert_eq!(
-        flat.with_corners(&bad).err(),
-        Some(QuadtreeError::BadCorner(17))
-    );
+    let shaped = flat.with_corners(&bad).unwrap();
+    assert_eq!(shaped.check_values(), Err(QuadtreeError::BadCorner(17)));
+    // Bad values never make it panic.
+    let (d, pdf) = shaped.sample(n, [0.3, 0.7]);
+    assert!(d.iter().all(|c| c.is_finite()) && pdf.is_finite());
 }

@@ -9,7 +9,7 @@ use nuld_core::conditional::{
     check_metallic_nodes, ConditionalInfo, ConditionalTarget, MetallicNodesError, PointWarp,
 };
 use nuld_core::envmap_tree::{
-    node_count, top_len, EnvmapTree, NodeRecord, TreeInfo, MAX_TREE_LEVELS, TOP_LEVELS,
+    corner_len, node_count, top_len, EnvmapTree, NodeRecord, TreeInfo, MAX_TREE_LEVELS, TOP_LEVELS,
 };
 use nuld_core::marginal2d::Marginal2DError;
 use nuld_core::network::{Activation, OffsetHash};
@@ -299,7 +299,7 @@ fn tree_length(expected: u64, got: u64) -> ConditionalError {
     ConditionalError::Tree(QuadtreeError::Length { expected, got })
 }
 
-/// The environment prior's three sections, their counts checked against the
+/// The environment prior's sections (three, and the optional leaf shape), their counts checked against the
 /// info (`O(1)`; [`EnvmapTree::check_values`] reads every value once, in
 /// [`ConditionalSampler::validate`]).
 fn tree_view<'a>(layout: &Layout<'a>) -> Result<EnvmapTree<'a>, BlobError> {
@@ -332,7 +332,20 @@ fn tree_view<'a>(layout: &Layout<'a>) -> Result<EnvmapTree<'a>, BlobError> {
         || Ok(top_len(info.grid) as u64),
         tree_length,
     )?;
+    // The leaf shape is optional: without it the leaves are uniform.
+    let corners: &[f32] = if layout.section(SectionTag::EnvmapTreeCorners).is_ok() {
+        typed_section(
+            layout,
+            SectionTag::EnvmapTreeCorners,
+            ConditionalError::TreeCornerElementSize,
+            || Ok(corner_len(info.levels) as u64),
+            tree_length,
+        )?
+    } else {
+        &[]
+    };
     EnvmapTree::view(info.levels, nodes, info.grid, top)
+        .and_then(|t| t.with_corners(corners))
         .map_err(|e| ConditionalError::Tree(e).into())
 }
 
