@@ -62,6 +62,7 @@ const NULD_TAG_WEIGHT_TABLE: u32 = 6u;
 const NULD_TAG_ENVMAP_TREE_INFO: u32 = 7u;
 const NULD_TAG_ENVMAP_TREE_NODES: u32 = 8u;
 const NULD_TAG_ENVMAP_TREE_TOP: u32 = 9u;
+const NULD_TAG_ENVMAP_TREE_CORNERS: u32 = 19u;
 const NULD_TAG_BRDF_PRIOR_INFO: u32 = 15u;
 const NULD_TAG_BRDF_PRIOR_DATA: u32 = 11u;
 const NULD_TAG_BRDF_PRIOR_MARGINAL: u32 = 12u;
@@ -982,6 +983,8 @@ struct NuldTree {
     top: u32,
     levels: u32,
     grid: u32,
+    // The leaf shape's corner values (tag 19); 0 without them (uniform leaves).
+    corners: u32,
 }
 
 // Rust: `ConditionalSampler::tree`: the blob's environment prior.
@@ -992,7 +995,80 @@ fn nuld_tree() -> NuldTree {
         nuld_section(NULD_TAG_ENVMAP_TREE_TOP),
         min(nuld_u32(info + NULD_TREE_INFO_LEVELS), NULD_TREE_MAX_LEVELS),
         max(nuld_u32(info + NULD_TREE_INFO_GRID), 2u),
+        nuld_section(NULD_TAG_ENVMAP_TREE_CORNERS),
     );
+}
+
+// Rust: `positive` (core/src/bilinear.rs): `v` if positive and finite, else 0.
+fn nuld_positive(v: f32) -> f32 {
+    if v > 0.0 && nuld_is_finite(v) {
+        return v;
+    }
+    return 0.0;
+}
+
+// Rust: `EnvmapTree::corners_of`: leaf `(x, y)`'s corners `w00, w10, w01, w11`,
+// each read as `positive`.
+fn nuld_leaf_corners(t: NuldTree, x: u32, y: u32) -> vec4<f32> {
+    let row = (1u << t.levels) + 1u;
+    let c = t.corners + 4u * (y * row + x);
+    return vec4<f32>(
+        nuld_positive(nuld_f32(c)),
+        nuld_positive(nuld_f32(c + 4u)),
+        nuld_positive(nuld_f32(c + 4u * row)),
+        nuld_positive(nuld_f32(c + 4u * row + 4u)),
+    );
+}
+
+// Rust: `bilinear::sample_linear`.
+fn nuld_sample_linear(u0: f32, a: f32, b: f32) -> f32 {
+    let u = nuld_clamp01(u0);
+    let d = a + sqrt(max(a * a + (b * b - a * a) * u, 0.0));
+    if d > 0.0 {
+        return nuld_clamp01(u * (a + b) / d);
+    }
+    return u;
+}
+
+// Rust: `bilinear::linear_pdf`.
+fn nuld_linear_pdf(x: f32, a: f32, b: f32) -> f32 {
+    if a + b > 0.0 {
+        return 2.0 * (a + (b - a) * nuld_clamp01(x)) / (a + b);
+    }
+    return 1.0;
+}
+
+// Rust: `bilinear::sample_bilinear` (its point and density): the leaf shape of
+// step 9 at `local` for corners `w`, as `(x, y, density)`; the identity with
+// density 1 where the corners' sum is not positive and finite.
+fn nuld_shape(local: vec2<f32>, w: vec4<f32>) -> vec3<f32> {
+    let u = vec2<f32>(nuld_clamp01(local.x), nuld_clamp01(local.y));
+    let sum = (w.x + w.y) + (w.z + w.w);
+    if !(sum > 0.0 && nuld_is_finite(sum)) {
+        return vec3<f32>(u, 1.0);
+    }
+    let a = w.x + w.z;
+    let b = w.y + w.w;
+    let x = nuld_sample_linear(u.x, a, b);
+    let c = w.x + (w.y - w.x) * x;
+    let d = w.z + (w.w - w.z) * x;
+    let y = nuld_sample_linear(u.y, c, d);
+    return vec3<f32>(x, y, nuld_linear_pdf(x, a, b) * nuld_linear_pdf(y, c, d));
+}
+
+// Rust: `bilinear::bilinear_pdf`: the leaf shape's density at `local`.
+fn nuld_shape_pdf(local: vec2<f32>, w: vec4<f32>) -> f32 {
+    let x = nuld_clamp01(local.x);
+    let y = nuld_clamp01(local.y);
+    let sum = (w.x + w.y) + (w.z + w.w);
+    if !(sum > 0.0 && nuld_is_finite(sum)) {
+        return 1.0;
+    }
+    let a = w.x + w.z;
+    let b = w.y + w.w;
+    let c = w.x + (w.y - w.x) * x;
+    let d = w.z + (w.w - w.z) * x;
+    return nuld_linear_pdf(x, a, b) * nuld_linear_pdf(y, c, d);
 }
 
 // Rust: `morton`: `x` on the even bits, `y` on the odd bits.
@@ -1134,6 +1210,17 @@ fn nuld_tree_sample_square(t: NuldTree, q: vec2<f32>, u: vec2<f32>) -> NuldTreeS
         y = 2u * y + cy.side;
     }
     let side = f32(1u << t.levels);
+    if t.corners != 0u {
+        let shaped = nuld_shape(vec2<f32>(ux, uy), nuld_leaf_corners(t, x, y));
+        let point = vec2<f32>(
+            min((f32(x) + shaped.x) / side, 1.0),
+            min((f32(y) + shaped.y) / side, 1.0),
+        );
+        return NuldTreeSample(
+            nuld_square_to_sphere(point),
+            p * side * side * shaped.z / (4.0 * NULD_PI),
+        );
+    }
     let point = vec2<f32>(min((f32(x) + ux) / side, 1.0), min((f32(y) + uy) / side, 1.0));
     return NuldTreeSample(nuld_square_to_sphere(point), p * side * side / (4.0 * NULD_PI));
 }
@@ -1157,6 +1244,13 @@ fn nuld_tree_pdf_square(t: NuldTree, q: vec2<f32>, d: vec3<f32>) -> f32 {
         prob = prob * (w[k] / ((w.x + w.y) + (w.z + w.w)));
     }
     let s = f32(side);
+    if t.corners != 0u {
+        let local = vec2<f32>(
+            nuld_clamp01(nuld_clamp01(sq.x) * s - f32(lx)),
+            nuld_clamp01(nuld_clamp01(sq.y) * s - f32(ly)),
+        );
+        return prob * s * s * nuld_shape_pdf(local, nuld_leaf_corners(t, lx, ly)) / (4.0 * NULD_PI);
+    }
     return prob * s * s / (4.0 * NULD_PI);
 }
 

@@ -155,6 +155,10 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
             SectionTag::EnvmapTreeNodes as u64,
         ),
         ("NULD_TAG_ENVMAP_TREE_TOP", SectionTag::EnvmapTreeTop as u64),
+        (
+            "NULD_TAG_ENVMAP_TREE_CORNERS",
+            SectionTag::EnvmapTreeCorners as u64,
+        ),
         ("NULD_TAG_BRDF_PRIOR_INFO", SectionTag::BrdfPriorInfo as u64),
         ("NULD_TAG_BRDF_PRIOR_DATA", SectionTag::BrdfPriorData as u64),
         (

@@ -83,6 +83,44 @@ fn refined_supersampling(levels: u32) -> usize {
 /// everywhere; on courtyard 0.04 either way.
 const REFINE_CONTRAST: f64 = 4.0;
 
+/// The leaf shape's floor: a corner's value is at least this share of the mean
+/// density of the brightest leaf it touches, so the shape's density stays
+/// within a bounded factor of the leaf's mean wherever the leaf has light (the
+/// light's `L` at a corner can be 0 beside a lamp whose light reaches into the
+/// leaf), and positive wherever the map's light is.
+const SHAPE_FLOOR: f64 = 0.25;
+
+/// The leaf shape's corner values ([`nuld_core::envmap_tree::EnvmapTree::with_corners`]):
+/// `light` at the octahedral square's points `(cx, cy) / 2^L`, each raised to
+/// [`SHAPE_FLOOR`] times the mean density of the brightest of the up to four
+/// leaves around it (`leaves` row-major `[m0, m1]`, each of solid angle `4 pi /
+/// 4^L`).
+fn leaf_corners(
+    light: &(impl Fn(DVec3) -> f64 + Sync),
+    levels: u32,
+    leaves: &[[f64; 4]],
+) -> Vec<f32> {
+    let side = 1usize << levels;
+    let area = 4.0 * PI / (side * side) as f64;
+    (0..(side + 1) * (side + 1))
+        .into_par_iter()
+        .map(|k| {
+            let (cx, cy) = (k % (side + 1), k / (side + 1));
+            let mut brightest: f64 = 0.0;
+            for (lx, ly) in [(cx, cy), (cx.wrapping_sub(1), cy), (cx, cy.wrapping_sub(1))]
+                .into_iter()
+                .chain([(cx.wrapping_sub(1), cy.wrapping_sub(1))])
+            {
+                if lx < side && ly < side {
+                    brightest = brightest.max(leaves[ly * side + lx][0] / area);
+                }
+            }
+            let p = DVec2::new(cx as f64 / side as f64, cy as f64 / side as f64);
+            light(square_to_sphere(p)).max(SHAPE_FLOOR * brightest) as f32
+        })
+        .collect()
+}
+
 /// A leaf's mass and moment `[m0, m1.x, m1.y, m1.z]` from `k x k` points of
 /// `light` in it (midpoints of a `k x k` grid of the leaf).
 fn measure_leaf(
@@ -180,6 +218,8 @@ pub struct EnvmapTree {
     /// The top levels' exact weights on `grid x grid` normals
     /// ([`nuld_core::envmap_tree::top_row`]).
     pub top: Vec<f32>,
+    /// The leaf shape's `(2^L + 1)^2` corner values ([`leaf_corners`]).
+    pub corners: Vec<f32>,
 }
 
 impl EnvmapTree {
@@ -242,19 +282,25 @@ impl EnvmapTree {
             let j = [r as u32 % grid, r as u32 / grid];
             top_row(levels, &nodes, top_normal(grid, j), row);
         });
+        let corners = leaf_corners(&light, levels, &leaves);
         // Refuses a map without light, as the runtime would.
-        CoreTree::new(levels, &nodes, grid, &top)?;
+        CoreTree::new(levels, &nodes, grid, &top)?
+            .with_corners(&corners)?
+            .check_values()?;
         Ok(Self {
             levels,
             nodes,
             grid,
             top,
+            corners,
         })
     }
 
     /// The tree as core reads it (`O(1)`: the values were checked when built).
     pub fn tree(&self) -> CoreTree<'_> {
-        CoreTree::view(self.levels, &self.nodes, self.grid, &self.top).expect("checked when built")
+        CoreTree::view(self.levels, &self.nodes, self.grid, &self.top)
+            .and_then(|t| t.with_corners(&self.corners))
+            .expect("checked when built")
     }
 
     /// The tree's info record for a blob.
@@ -266,9 +312,12 @@ impl EnvmapTree {
         }
     }
 
-    /// The blob sections of the tree ([`nuld_core::envmap_tree::sections`]).
-    pub fn sections<'s>(&'s self, info: &'s TreeInfo) -> [SectionSpec<'s>; 3] {
-        nuld_core::envmap_tree::sections(info, &self.nodes, &self.top)
+    /// The blob sections of the tree ([`nuld_core::envmap_tree::sections`]) and
+    /// its leaf shape ([`nuld_core::envmap_tree::corner_section`]).
+    pub fn sections<'s>(&'s self, info: &'s TreeInfo) -> Vec<SectionSpec<'s>> {
+        let mut sections = nuld_core::envmap_tree::sections(info, &self.nodes, &self.top).to_vec();
+        sections.push(nuld_core::envmap_tree::corner_section(&self.corners));
+        sections
     }
 
     /// The direction at primary sample `u` for the unit normal `n` and its
