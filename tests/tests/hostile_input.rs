@@ -902,7 +902,8 @@ fn metal_semantics_hold(layout: &Layout<'_>, warp: u32, params: usize, table: us
 /// raw bytes: a 16-byte info (its `elem_size`, as the conditional info's, unread)
 /// with levels 3 to 12, a grid of 2 to 1024 normals and
 /// zero reserved words; `(4^(L+1) - 4) / 3` records of four finite `f32` with a
-/// spread >= 0 and some level-1 record with mass; `84 G^2` finite top weights >= 0.
+/// spread >= 0 and some level-1 record with mass; `84 G^2` finite top weights >= 0;
+/// and, if there is a leaf shape (tag 19), `(2^L + 1)^2` finite values >= 0.
 fn tree_semantics_hold(layout: &Layout<'_>) -> bool {
     let section = |tag| layout.section(tag).ok();
     let (Some((_, info)), Some((ne, nodes)), Some((oe, top))) = (
@@ -938,12 +939,21 @@ fn tree_semantics_hold(layout: &Layout<'_>) -> bool {
         let mass = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]).sqrt();
         mass > 0.0 && mass.is_finite()
     });
-    sound
-        && lit
-        && top.chunks_exact(4).all(|b| {
+    let finite_non_negative = |bytes: &[u8]| {
+        bytes.chunks_exact(4).all(|b| {
             let w = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
             w.is_finite() && w >= 0.0
         })
+    };
+    // The optional leaf shape (tag 19): `(2^L + 1)^2` finite values >= 0.
+    let corners = match section(SectionTag::EnvmapTreeCorners) {
+        None => true,
+        Some((ce, c)) => {
+            let side = (1u128 << levels) + 1;
+            ce.elem_size == 4 && c.len() as u128 == 4 * side * side && finite_non_negative(c)
+        }
+    };
+    sound && lit && finite_non_negative(top) && corners
 }
 
 /// 100k mutations of a conditional BRDF blob: byte changes and truncations (the
