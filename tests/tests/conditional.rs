@@ -422,7 +422,8 @@ fn weights_equal_the_reference_bilinear_interpolation() {
 /// Table mode's environment samples through the tree whose pdf they carry: the
 /// prior's f32 descent on the interpolated point (the test above), and here that
 /// the pdf the runtime returns is the `f64` tree's at the direction to `f32`
-/// rounding, but for directions on a leaf's edge.
+/// rounding, but for directions on a leaf's edge, and `pdf` of the sample's
+/// direction is the sample's pdf to that rounding.
 #[test]
 fn environment_pdfs_are_the_trees_f64_pdfs() {
     let parts = fixtures().pop().unwrap();
@@ -443,7 +444,10 @@ fn environment_pdfs_are_the_trees_f64_pdfs() {
                 continue;
             }
             worst = worst.max(rel);
-            assert_eq!(cs.pdf(c, s.direction), s.pdf);
+            // The pdf of the sample's own direction: the same leaf, and inside
+            // a shaped leaf the direction's square point to its rounding.
+            let back = cs.pdf(c, s.direction);
+            assert!((back - s.pdf).abs() <= 1e-4 * s.pdf, "{back} {}", s.pdf);
         }
     });
     eprintln!("environment pdf vs f64 tree: relative {worst:.2e}, {edges} of 20000 on an edge");

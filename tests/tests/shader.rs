@@ -314,7 +314,37 @@ fn warp_gain(
         .iter()
         .map(|d| DVec3::from_array(*d).length())
         .fold(0.0, f64::max);
-    Gain::all(1.0 + j as f32)
+    if warp != PointWarp::EnvmapTree || tree.corners().is_empty() {
+        return Gain::all(1.0 + j as f32);
+    }
+    // Inside a shaped leaf the pdf depends on where the point falls: a rounding
+    // of the square point (the descent's rescaled `u`, the driver's division and
+    // `atan`) moves it by `|d ln pdf / dp|` relatively. That slope, by central
+    // differences of step `2^-20` along both axes at the sample's square point.
+    let q = c.map(f64::from);
+    let (d, _) = tree.sample_square(q, p.as_dvec2().to_array());
+    let sq = nuld_core::sphere::sphere_to_square(DVec3::from_array(d));
+    let ln_pdf = |s: DVec2| {
+        let d = nuld_core::sphere::square_to_sphere(s.clamp(DVec2::ZERO, DVec2::ONE));
+        tree.pdf_square(q, d.to_array()).ln()
+    };
+    let h = 1.0 / 1_048_576.0;
+    let jp = [DVec2::X, DVec2::Y]
+        .map(|e| ((ln_pdf(sq + e * h) - ln_pdf(sq - e * h)) / (2.0 * h)).abs())
+        .into_iter()
+        .fold(0.0, f64::max);
+    let g = 1.0 + j as f32;
+    Gain {
+        direction: g,
+        weight: g,
+        pdf: g
+            * (1.0
+                + if jp.is_finite() {
+                    jp as f32
+                } else {
+                    f32::INFINITY
+                }),
+    }
 }
 
 /// The gains of the tabulated BRDF prior's warp (warp 3) at the clamped
