@@ -63,15 +63,15 @@ struct Fit {
 /// alone (`p` a point of the sphere's square, the same direction at every
 /// normal).
 fn warp(tree: Option<&EnvmapTree<'_>>, u: [f64; 2], p: DVec2) -> (DVec3, DVec3, DVec3) {
-    let (q, slopes) = match tree {
+    let (q, [dx_dux, dy_dux, dy_duy]) = match tree {
         Some(tree) => {
             let (q, _, slopes) = tree.sample_square_with_slopes(u, p.to_array());
             (DVec2::from(q), slopes)
         }
-        None => (p, [1.0; 2]),
+        None => (p, [1.0, 0.0, 1.0]),
     };
     let (jx, jy) = map_jacobian(Domain::Sphere, q);
-    (square_to_sphere(q), jx * slopes[0], jy * slopes[1])
+    (square_to_sphere(q), jx * dx_dux + jy * dy_dux, jy * dy_duy)
 }
 
 /// What a fit reads at one normal: its octahedral point, lit map, caps and their

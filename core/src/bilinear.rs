@@ -89,14 +89,17 @@ pub fn invert_linear<T: Real>(x: T, a: T, b: T) -> T {
 }
 
 /// The point of the square at `u` under the bilinear density of the corners `w`
-/// (module docs), with its density per unit area ([`bilinear_pdf`]) and the
-/// derivatives `(dx/du.x, dy/du.y)` (each step's inverse density; `dy/du.x`,
-/// nonzero where the conditional depends on `x`, is left out).
+/// (module docs), with its density per unit area ([`bilinear_pdf`]) and its
+/// derivatives `[dx/du.x, dy/du.x, dy/du.y]` (`dx/du.y` is 0: `x` reads `u.x`
+/// only). `dx/du.x` and `dy/du.y` are each step's inverse density; `dy/du.x` is
+/// the conditional's shift as `x` moves, `-(dF/dx) / p(y)` with
+/// `F(y) = (c y (2 - y) + d y²) / (c + d)` the conditional's CDF, so
+/// `dF/dx = 2 y (1 - y) (d c' - c d') / (c + d)²`.
 #[inline]
-pub fn sample_bilinear<T: Real>(u: [T; 2], w: [T; 4]) -> ([T; 2], T, [T; 2]) {
+pub fn sample_bilinear<T: Real>(u: [T; 2], w: [T; 4]) -> ([T; 2], T, [T; 3]) {
     let u = u.map(clamp_unit);
     let Some(w) = corners(w) else {
-        return (u, T::ONE, [T::ONE; 2]);
+        return (u, T::ONE, [T::ONE, T::ZERO, T::ONE]);
     };
     let (a, b) = (w[0] + w[2], w[1] + w[3]);
     let x = sample_linear(u[0], a, b);
@@ -104,7 +107,16 @@ pub fn sample_bilinear<T: Real>(u: [T; 2], w: [T; 4]) -> ([T; 2], T, [T; 2]) {
     let y = sample_linear(u[1], c, d);
     let (px, py) = (linear_pdf(x, a, b), linear_pdf(y, c, d));
     let slope = |p: T| if p > T::ZERO { T::ONE / p } else { T::ZERO };
-    ([x, y], px * py, [slope(px), slope(py)])
+    let (dx, dy) = (slope(px), slope(py));
+    let cd = c + d;
+    let cross = if cd > T::ZERO {
+        let df_dx =
+            T::of(2.0) * y * (T::ONE - y) * (d * (w[1] - w[0]) - c * (w[3] - w[2])) / (cd * cd);
+        -df_dx * dy * dx
+    } else {
+        T::ZERO
+    };
+    ([x, y], px * py, [dx, cross, dy])
 }
 
 /// The density per unit area of [`sample_bilinear`]'s points at `p` (clamped

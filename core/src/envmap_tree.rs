@@ -416,22 +416,29 @@ impl<'a> EnvmapTree<'a> {
         (leaf, local)
     }
 
-    /// The square point, its pdf per unit area of the square and its slopes
-    /// ([`quadtree::sample_with_slopes`]) for `lit` at `u`, shaped inside the
-    /// leaf when the tree has corners.
+    /// The square point, its pdf per unit area of the square and its
+    /// derivatives `[dx/du.x, dy/du.x, dy/du.y]` for `lit` at `u`, shaped inside
+    /// the leaf when the tree has corners ([`quadtree::sample_with_slopes`],
+    /// [`bilinear::sample_bilinear`]).
     #[inline]
-    fn warp<T: Real>(&self, lit: &Lit<'a, T>, u: [T; 2]) -> ([T; 2], T, [T; 2]) {
+    fn warp<T: Real>(&self, lit: &Lit<'a, T>, u: [T; 2]) -> ([T; 2], T, [T; 3]) {
         let d = quadtree::descend(lit, u);
         let (local, density, s) = match self.corners_of::<T>(d.leaf) {
             Some(w) => bilinear::sample_bilinear(d.local, w),
-            None => (d.local, T::ONE, [T::ONE; 2]),
+            None => (d.local, T::ONE, [T::ONE, T::ZERO, T::ONE]),
         };
         let side = T::of((1u64 << self.levels) as f64);
         let point = [
             ((T::of(d.leaf[0] as f64) + local[0]) / side).min(T::ONE),
             ((T::of(d.leaf[1] as f64) + local[1]) / side).min(T::ONE),
         ];
-        let slopes = [s[0] / (side * d.column), s[1] / (side * d.row)];
+        // Within the descent's piece the leaf's local primary point is affine
+        // per axis (`1 / column`, `1 / row`), and the leaf is `1 / side` wide.
+        let slopes = [
+            s[0] / (side * d.column),
+            s[1] / (side * d.column),
+            s[2] / (side * d.row),
+        ];
         (point, d.share * side * side * density, slopes)
     }
 
@@ -546,9 +553,12 @@ impl<'a> EnvmapTree<'a> {
 
     /// [`Self::sample_square`]'s point of the octahedral square (before the
     /// sphere map), its pdf per unit area of the square, and the derivatives
-    /// `(dx/du.x, dy/du.y)` of the point ([`quadtree::sample_with_slopes`]).
+    /// `[dx/du.x, dy/du.x, dy/du.y]` of the point (`dx/du.y` is 0), exact within
+    /// the piece of the tree `u` falls in ([`quadtree::sample_with_slopes`];
+    /// `dy/du.x` is nonzero only inside a shaped leaf,
+    /// [`bilinear::sample_bilinear`]).
     #[inline]
-    pub fn sample_square_with_slopes<T: Real>(&self, q: [T; 2], u: [T; 2]) -> ([T; 2], T, [T; 2]) {
+    pub fn sample_square_with_slopes<T: Real>(&self, q: [T; 2], u: [T; 2]) -> ([T; 2], T, [T; 3]) {
         self.warp(&self.lit_square(q), u)
     }
 

@@ -138,7 +138,8 @@ impl PoolCondition {
     /// derivatives along `p.x` and `p.y`: for the mixture warp by central
     /// differences of step `1e-6`, zeroed where they straddle the lobe boundary (a
     /// jump that no gradient can follow); for the environment tree the descent's
-    /// slopes through the sphere map, exact within the piece of the tree the
+    /// Jacobian (its slopes, and inside a shaped leaf the conditional's shift
+    /// with `x`) through the sphere map, exact within the piece of the tree the
     /// point falls in; for the equal-area maps exact.
     pub fn direction(&self, p: DVec2) -> (DVec3, DVec3, DVec3) {
         if let (
@@ -155,13 +156,15 @@ impl PoolCondition {
             ConditionDensity::Brdf { .. } => None,
         };
         if let (PointWarp::EnvmapTree, Some(tree)) = (self.warp, &tree) {
-            // The tree's warp is affine per axis within a piece: the sphere map's
-            // Jacobian times the descent's slopes (zero across nothing, unlike
+            // Within a piece the tree's warp has a closed-form Jacobian (affine
+            // per axis, and a shaped leaf's conditional moving with x): the
+            // sphere map's Jacobian times it (zero across nothing, unlike
             // differences, and one descent instead of five).
-            let (q, _, slopes) = tree.sample_square_with_slopes(self.cond, p.to_array());
+            let (q, _, [dx_dux, dy_dux, dy_duy]) =
+                tree.sample_square_with_slopes(self.cond, p.to_array());
             let q = DVec2::from(q);
             let (jx, jy) = map_jacobian(Domain::Sphere, q);
-            return (square_to_sphere(q), jx * slopes[0], jy * slopes[1]);
+            return (square_to_sphere(q), jx * dx_dux + jy * dy_dux, jy * dy_duy);
         }
         let tree = tree.as_ref();
         let warp = |u: DVec2| {

@@ -409,47 +409,60 @@ fn bad_trees_are_refused_and_hostile_queries_do_not_panic() {
     }
 }
 
-/// The descent's slopes are the warp's derivatives within a piece (central
-/// differences of step 1e-7 whose two ends share the leaf), and their product is
-/// the inverse of the square's pdf.
+/// The warp's derivatives are its Jacobian within a piece (central differences
+/// of step 1e-7 whose two ends share the leaf), uniform leaves and shaped, and
+/// its determinant is the inverse of the square's pdf.
 #[test]
 fn slopes_are_the_warps_derivatives_and_invert_the_pdf() {
     let levels = 6;
     let nodes = tree_nodes(levels);
     let top = top_table(levels, &nodes);
-    let tree = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let flat = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let corners = corner_values(levels);
+    let shaped = flat.with_corners(&corners).unwrap();
     let q = crate::sphere::sphere_to_square(DVec3::new(0.2, 0.5, 0.7).normalize()).to_array();
-    let mut r = Rng(12);
-    let (h, mut compared) = (1e-7, 0);
-    for _ in 0..5000 {
-        let u = [r.next() * 0.98 + 0.01, r.next() * 0.98 + 0.01];
-        let (p, pdf, slopes) = tree.sample_square_with_slopes(q, u);
-        assert!(
-            (pdf * slopes[0] * slopes[1] - 1.0).abs() < 1e-9,
-            "{pdf} {slopes:?}"
-        );
-        let leaf = |x: [f64; 2]| x.map(|c| (c * 64.0).floor());
-        for a in 0..2 {
-            let mut lo = u;
-            let mut hi = u;
-            lo[a] -= h;
-            hi[a] += h;
-            let (pl, _, _) = tree.sample_square_with_slopes(q, lo);
-            let (ph, _, _) = tree.sample_square_with_slopes(q, hi);
-            if leaf(pl) != leaf(p) || leaf(ph) != leaf(p) {
-                continue;
-            }
-            let d = (ph[a] - pl[a]) / (2.0 * h);
+    for (name, tree) in [("uniform", flat), ("shaped", shaped)] {
+        let mut r = Rng(12);
+        let (h, mut compared, mut crossed) = (1e-7, 0, 0);
+        for _ in 0..5000 {
+            let u = [r.next() * 0.98 + 0.01, r.next() * 0.98 + 0.01];
+            let (p, pdf, [dx_dux, dy_dux, dy_duy]) = tree.sample_square_with_slopes(q, u);
             assert!(
-                (d - slopes[a]).abs() <= 1e-5 * slopes[a],
-                "{d} vs {}",
-                slopes[a]
+                (pdf * dx_dux * dy_duy - 1.0).abs() < 1e-9,
+                "{name}: {pdf} {dx_dux} {dy_duy}"
             );
-            assert!((ph[1 - a] - pl[1 - a]).abs() < 1e-12);
-            compared += 1;
+            let leaf = |x: [f64; 2]| x.map(|c| (c * 64.0).floor());
+            // Column a of the Jacobian: (dx/du_a, dy/du_a).
+            for (a, expected) in [(0, [dx_dux, dy_dux]), (1, [0.0, dy_duy])] {
+                let mut lo = u;
+                let mut hi = u;
+                lo[a] -= h;
+                hi[a] += h;
+                let (pl, _, _) = tree.sample_square_with_slopes(q, lo);
+                let (ph, _, _) = tree.sample_square_with_slopes(q, hi);
+                if leaf(pl) != leaf(p) || leaf(ph) != leaf(p) {
+                    continue;
+                }
+                let scale = dx_dux.max(dy_duy);
+                for k in 0..2 {
+                    let d = (ph[k] - pl[k]) / (2.0 * h);
+                    assert!(
+                        (d - expected[k]).abs() <= 1e-5 * scale,
+                        "{name} u{a} p{k}: {d} vs {}",
+                        expected[k]
+                    );
+                }
+                crossed += usize::from(a == 0 && dy_dux.abs() > 1e-3 * scale);
+                compared += 1;
+            }
+        }
+        assert!(compared > 9000, "{name}: {compared}");
+        // A shaped leaf's conditional moves with x; a uniform one's does not.
+        match name {
+            "uniform" => assert_eq!(crossed, 0),
+            _ => assert!(crossed > 500, "{crossed}"),
         }
     }
-    assert!(compared > 9000, "{compared}");
 }
 
 /// The light at the leaves' corners, `(2^L + 1)^2` values: the leaf shape.
