@@ -48,10 +48,11 @@ pub struct RenderArgs {
     /// no BRDF blob is baked.
     #[arg(long, value_delimiter = ',', value_parser = technique)]
     pub techniques: Vec<Technique>,
-    /// How our environment sampler's fixed instances weigh a sample `l`:
-    /// target (E f / L: as if the set followed L cos / E), pdf (f cos / pdf, the
-    /// prior's pdf), normalized (f cos / pdf, the set's weights divided by its
-    /// own estimate of the irradiance over the blob's E(n)) [default: target].
+    /// How our environment sampler's fixed instances weigh a sample `l`: pdf
+    /// (f cos / pdf, the prior's pdf, as the unbiased mode), target (E f / L: as
+    /// if the set followed L cos / E), normalized (f cos / pdf, the set's weights
+    /// divided by its own estimate of the irradiance over the blob's E(n))
+    /// [default: pdf].
     #[arg(long, value_parser = fixed_weight)]
     pub fixed_weight: Option<FixedWeight>,
     /// Output directory.

@@ -233,9 +233,8 @@ mod tests {
     /// `value / A - 1` within 4 standard errors (from the pixels' own spread,
     /// plus 0.2% for ours' fixed instances, whose weight is the blob's
     /// interpolated albedo table; ours' unbiased mode gets none). Ours for the
-    /// environment is left out: its estimate is `E f` per sample
-    /// (`nuld_sampler`'s tests), unbiased only as far as the trained set follows
-    /// the target, which a test-sized bake does not.
+    /// environment is left out: its blob is of another map, and its weights
+    /// and pdfs are the runtime's, checked in `nuld_sampler`'s tests.
     #[test]
     fn furnace_every_sampler_integrates_to_the_albedo() {
         let env = Environment::constant(1.0).unwrap();
