@@ -33,7 +33,7 @@
 //!     weight and `L` the map; its pdf `q`, 0 where `L` or the cosine is 0), of
 //!     lower variance on studio and biased where the union's prior is not `q`
 //!     (12 % on courtyard), and the pdf with each set normalized by its own
-//!     estimate of `E(n)` (docs/results/rendering.md#fixed-instance-weight).
+//!     estimate of `E(n)` (docs/results/rendering.md#leaf-shape).
 
 use super::environment::Environment;
 use super::sampler::{DirectionSampler, PixelKey, Sample, ShadingPoint, Technique};
