@@ -24,19 +24,9 @@
 //! identity with density 1. Everything is
 //! generic over [`Real`], allocates nothing and never panics.
 
-use crate::real::{clamp_unit, Real};
+use crate::real::{clamp_unit, positive, Real};
 
-/// `v` if positive and finite, else 0.
-#[inline]
-fn positive<T: Real>(v: T) -> T {
-    if v > T::ZERO && v.is_finite() {
-        v
-    } else {
-        T::ZERO
-    }
-}
-
-/// The corners as the warp reads them ([`positive`]), or `None` where none is
+/// The corners as the warp reads them ([`positive`]: negative and non-finite as 0), or `None` where none is
 /// positive (or their sum is not finite): the identity.
 #[inline]
 fn corners<T: Real>(w: [T; 4]) -> Option<[T; 4]> {

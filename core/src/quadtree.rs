@@ -25,7 +25,7 @@
 //!
 //! Work per sample `O(L)` (four weights per level), no allocation, no panic.
 
-use crate::real::{clamp_unit, Real};
+use crate::real::{clamp_unit, positive, Real};
 
 /// Most levels below the root (`4^24` leaves is far beyond any table).
 pub const MAX_LEVELS: u32 = 24;
@@ -264,16 +264,6 @@ fn usable<T: Real>(w: [T; 4]) -> [T; 4] {
         w
     } else {
         [T::ONE; 4]
-    }
-}
-
-/// `v` if positive and finite, else 0.
-#[inline]
-fn positive<T: Real>(v: T) -> T {
-    if v > T::ZERO && v.is_finite() {
-        v
-    } else {
-        T::ZERO
     }
 }
 

@@ -218,6 +218,17 @@ pub fn clamp_unit<T: Real>(x: T) -> T {
     }
 }
 
+/// `v` if positive and finite, else 0: a weight or density value made safe to
+/// sum and divide by (the warps of [`crate::quadtree`] and [`crate::bilinear`]).
+#[inline]
+pub fn positive<T: Real>(v: T) -> T {
+    if v > T::ZERO && v.is_finite() {
+        v
+    } else {
+        T::ZERO
+    }
+}
+
 /// The floor of `x` from its truncation toward zero `t` (exact): `x` itself
 /// when it is whole (keeping -0.0), else `t`, or `t - 1` below zero.
 #[inline]
