@@ -218,7 +218,9 @@ pub struct EnvmapTree {
     /// The top levels' exact weights on `grid x grid` normals
     /// ([`nuld_core::envmap_tree::top_row`]).
     pub top: Vec<f32>,
-    /// The leaf shape's `(2^L + 1)^2` corner values ([`leaf_corners`]).
+    /// The leaf shape's `(2^L + 1)^2` corner values: the light at the square's
+    /// lattice points, each raised to a quarter of the mean density of the
+    /// brightest leaf it touches.
     pub corners: Vec<f32>,
 }
 
