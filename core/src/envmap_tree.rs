@@ -407,15 +407,6 @@ impl<'a> EnvmapTree<'a> {
         Some([at(0, 0), at(1, 0), at(0, 1), at(1, 1)])
     }
 
-    /// The leaf of square point `p` and `p`'s coordinates inside it.
-    #[inline]
-    fn leaf_of<T: Real>(&self, p: [T; 2]) -> ([u32; 2], [T; 2]) {
-        let side = T::of((1u64 << self.levels) as f64);
-        let leaf = p.map(|c| quadtree::leaf(self.levels, c));
-        let local = [0, 1].map(|k| clamp_unit(clamp_unit(p[k]) * side - T::of(leaf[k] as f64)));
-        (leaf, local)
-    }
-
     /// The square point, its pdf per unit area of the square and its
     /// derivatives `[dx/du.x, dy/du.x, dy/du.y]` for `lit` at `u`, shaped inside
     /// the leaf when the tree has corners ([`quadtree::sample_with_slopes`],
@@ -428,10 +419,7 @@ impl<'a> EnvmapTree<'a> {
             None => (d.local, T::ONE, [T::ONE, T::ZERO, T::ONE]),
         };
         let side = T::of((1u64 << self.levels) as f64);
-        let point = [
-            ((T::of(d.leaf[0] as f64) + local[0]) / side).min(T::ONE),
-            ((T::of(d.leaf[1] as f64) + local[1]) / side).min(T::ONE),
-        ];
+        let point = quadtree::leaf_point(self.levels, d.leaf, local);
         // Within the descent's piece the leaf's local primary point is affine
         // per axis (`1 / column`, `1 / row`), and the leaf is `1 / side` wide.
         let slopes = [
@@ -446,7 +434,7 @@ impl<'a> EnvmapTree<'a> {
     #[inline]
     fn square_pdf<T: Real>(&self, lit: &Lit<'a, T>, p: [T; 2]) -> T {
         let pdf = quadtree::pdf(lit, p);
-        let (leaf, local) = self.leaf_of(p);
+        let (leaf, local) = quadtree::locate(self.levels, p);
         match self.corners_of::<T>(leaf) {
             Some(w) => pdf * bilinear::bilinear_pdf(local, w),
             None => pdf,
@@ -578,13 +566,10 @@ impl<'a> EnvmapTree<'a> {
     /// The primary sample that [`Self::sample`] maps to the unit direction `d`.
     pub fn invert<T: Real>(&self, normal: [T; 3], d: [T; 3]) -> [T; 2] {
         let p = sphere_to_square_real(d);
-        let (leaf, local) = self.leaf_of(p);
+        let (leaf, local) = quadtree::locate(self.levels, p);
+        // The point the uniform leaf would have put where the shape put `p`.
         let p = match self.corners_of::<T>(leaf) {
-            Some(w) => {
-                let side = T::of((1u64 << self.levels) as f64);
-                let uniform = bilinear::invert_bilinear(local, w);
-                [0, 1].map(|k| ((T::of(leaf[k] as f64) + uniform[k]) / side).min(T::ONE))
-            }
+            Some(w) => quadtree::leaf_point(self.levels, leaf, bilinear::invert_bilinear(local, w)),
             None => p,
         };
         quadtree::invert(&self.lit(normal), p)

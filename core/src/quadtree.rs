@@ -286,14 +286,15 @@ pub fn sample<T: Real>(tree: &impl ChildWeights<T>, u: [T; 2]) -> ([T; 2], T) {
 /// derivatives of the piece.) What a trainer chains its gradients through.
 #[inline]
 pub fn sample_with_slopes<T: Real>(tree: &impl ChildWeights<T>, u: [T; 2]) -> ([T; 2], T, [T; 2]) {
+    let levels = tree.levels().min(MAX_LEVELS);
     let d = descend(tree, u);
-    let side = T::of((1u64 << tree.levels().min(MAX_LEVELS)) as f64);
-    let point = [
-        ((T::of(d.leaf[0] as f64) + d.local[0]) / side).min(T::ONE),
-        ((T::of(d.leaf[1] as f64) + d.local[1]) / side).min(T::ONE),
-    ];
+    let side = T::of((1u64 << levels) as f64);
     let slopes = [T::ONE / (side * d.column), T::ONE / (side * d.row)];
-    (point, d.share * side * side, slopes)
+    (
+        leaf_point(levels, d.leaf, d.local),
+        d.share * side * side,
+        slopes,
+    )
 }
 
 /// Where [`sample`]'s descent ends for `u`: the leaf, the rescaled primary
@@ -374,10 +375,7 @@ pub fn pdf<T: Real>(tree: &impl ChildWeights<T>, p: [T; 2]) -> T {
 /// `O(levels)`; never panics.
 pub fn invert<T: Real>(tree: &impl ChildWeights<T>, p: [T; 2]) -> [T; 2] {
     let levels = tree.levels().min(MAX_LEVELS);
-    let (lx, ly) = (leaf(levels, p[0]), leaf(levels, p[1]));
-    let side = T::of((1u64 << levels) as f64);
-    let mut ux = clamp_unit(clamp_unit(p[0]) * side - T::of(lx as f64));
-    let mut uy = clamp_unit(clamp_unit(p[1]) * side - T::of(ly as f64));
+    let ([lx, ly], [mut ux, mut uy]) = locate(levels, p);
     let mut steps = [Step {
         px: T::ZERO,
         i: 0,
@@ -415,9 +413,28 @@ pub fn invert<T: Real>(tree: &impl ChildWeights<T>, p: [T; 2]) -> [T; 2] {
 /// The leaf column (or row) of coordinate `c` among `2^levels`, clamped into the
 /// square.
 #[inline]
-pub fn leaf<T: Real>(levels: u32, c: T) -> u32 {
+fn leaf<T: Real>(levels: u32, c: T) -> u32 {
     let side = 1u32 << levels;
     ((clamp_unit(c) * T::of(side as f64)).floor().to_f64() as u32).min(side - 1)
+}
+
+/// The leaf of square point `p` (clamped into the square) among `2^levels x
+/// 2^levels`, and `p`'s place inside it in `[0, 1]^2`: the inverse of
+/// [`leaf_point`].
+#[inline]
+pub fn locate<T: Real>(levels: u32, p: [T; 2]) -> ([u32; 2], [T; 2]) {
+    let side = T::of((1u64 << levels) as f64);
+    let leaf = p.map(|c| leaf(levels, c));
+    let local = [0, 1].map(|k| clamp_unit(clamp_unit(p[k]) * side - T::of(leaf[k] as f64)));
+    (leaf, local)
+}
+
+/// The square point at place `local` (in `[0, 1]^2`) inside leaf `leaf` among
+/// `2^levels x 2^levels` (clamped to 1 against rounding).
+#[inline]
+pub fn leaf_point<T: Real>(levels: u32, leaf: [u32; 2], local: [T; 2]) -> [T; 2] {
+    let side = T::of((1u64 << levels) as f64);
+    [0, 1].map(|k| ((T::of(leaf[k] as f64) + local[k]) / side).min(T::ONE))
 }
 
 /// Picks a child by `u` (column by `u.x`, then the row within it by `u.y`) and

@@ -219,20 +219,22 @@ fn the_pdf_integrates_to_one_over_the_sphere() {
     }
 }
 
-/// 10^6 samples on 64 x 64 bins of the square (each a union of leaves, where the
-/// pdf is constant): chi-square against the pdf; the returned pdf is the pdf at
-/// the sample; `invert` undoes `sample`.
-#[test]
-fn samples_follow_the_pdf_and_invert_undoes_sample() {
-    let levels = 6;
-    let nodes = tree_nodes(levels);
-    let top = top_table(levels, &nodes);
-    let tree = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
-    let n = [0.6, -0.3, 0.1];
-    let bins = 64usize;
+/// 10^6 samples of `tree` at `n` (seed `seed`) on `bins x bins` bins of the
+/// square: every 50th sample away from its leaf's edge (64 leaves per axis) has
+/// `pdf(n, d)` within `tol` relatively of its own pdf and `invert` undoes it to
+/// 1e-6; the counts pass a chi-square against `10^6 x 4 pi / bins² x
+/// bin_pdf(i, j)`, `bin_pdf` the pdf's mean over bin `(i, j)`.
+fn check_samples(
+    tree: &EnvmapTree<'_>,
+    n: [f64; 3],
+    seed: u64,
+    tol: f64,
+    bins: usize,
+    bin_pdf: impl Fn(usize, usize) -> f64,
+) {
     let samples = 1_000_000;
     let mut counts = vec![0u32; bins * bins];
-    let mut r = Rng(5);
+    let mut r = Rng(seed);
     let mut worst: f64 = 0.0;
     for s in 0..samples {
         let u = [r.next(), r.next()];
@@ -244,7 +246,8 @@ fn samples_follow_the_pdf_and_invert_undoes_sample() {
         if s % 50 == 0 {
             let inside = |c: f64| ((c * 64.0).fract() - 0.5).abs() < 0.499;
             if inside(p.x) && inside(p.y) {
-                assert!((tree.pdf(n, d) - pdf).abs() <= 1e-9 * pdf);
+                let back = tree.pdf(n, d);
+                assert!((back - pdf).abs() <= tol * pdf, "{back} {pdf}");
                 let back = tree.invert(n, d);
                 worst = worst
                     .max((back[0] - u[0]).abs())
@@ -256,12 +259,8 @@ fn samples_follow_the_pdf_and_invert_undoes_sample() {
     let (mut chi2, mut dof) = (0.0, 0);
     for j in 0..bins {
         for i in 0..bins {
-            let c = square_to_sphere(DVec2::new(
-                (i as f64 + 0.5) / bins as f64,
-                (j as f64 + 0.5) / bins as f64,
-            ));
-            let expected = samples as f64 * tree.pdf(n, c.to_array()) * 4.0 * core::f64::consts::PI
-                / (bins * bins) as f64;
+            let expected =
+                samples as f64 * bin_pdf(i, j) * 4.0 * core::f64::consts::PI / (bins * bins) as f64;
             let got = counts[j * bins + i] as f64;
             if expected > 0.0 {
                 chi2 += (got - expected).powi(2) / expected;
@@ -273,6 +272,26 @@ fn samples_follow_the_pdf_and_invert_undoes_sample() {
     }
     let sd = (2.0 * dof as f64).sqrt();
     assert!(chi2 < dof as f64 + 5.0 * sd, "chi-square {chi2} over {dof}");
+}
+
+/// 10^6 samples on 64 x 64 bins of the square (each a union of leaves, where the
+/// pdf is constant): chi-square against the pdf; the returned pdf is the pdf at
+/// the sample; `invert` undoes `sample`.
+#[test]
+fn samples_follow_the_pdf_and_invert_undoes_sample() {
+    let levels = 6;
+    let nodes = tree_nodes(levels);
+    let top = top_table(levels, &nodes);
+    let tree = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let n = [0.6, -0.3, 0.1];
+    let bins = 64;
+    check_samples(&tree, n, 5, 1e-9, bins, |i, j| {
+        let c = square_to_sphere(DVec2::new(
+            (i as f64 + 0.5) / bins as f64,
+            (j as f64 + 0.5) / bins as f64,
+        ));
+        tree.pdf(n, c.to_array())
+    });
 }
 
 /// `(1/M) Σ L cos / pdf` over the tree's samples is the irradiance by an
@@ -505,60 +524,20 @@ fn a_leaf_shape_keeps_the_pdf_exact() {
         .sum();
     assert!((sum - 1.0).abs() < 1e-9, "{sum}");
 
-    let bins = 128usize;
-    let samples = 1_000_000;
-    let mut counts = vec![0u32; bins * bins];
-    let mut r = Rng(6);
-    let mut worst: f64 = 0.0;
-    for s in 0..samples {
-        let u = [r.next(), r.next()];
-        let (d, pdf) = tree.sample(n, u);
-        let p = crate::sphere::sphere_to_square(DVec3::from_array(d));
-        let i = ((p.x * bins as f64) as usize).min(bins - 1);
-        let j = ((p.y * bins as f64) as usize).min(bins - 1);
-        counts[j * bins + i] += 1;
-        if s % 50 == 0 {
-            let inside = |c: f64| ((c * 64.0).fract() - 0.5).abs() < 0.499;
-            if inside(p.x) && inside(p.y) {
-                assert!(
-                    (tree.pdf(n, d) - pdf).abs() <= 1e-8 * pdf,
-                    "{} {pdf}",
-                    tree.pdf(n, d)
-                );
-                let back = tree.invert(n, d);
-                worst = worst
-                    .max((back[0] - u[0]).abs())
-                    .max((back[1] - u[1]).abs());
-            }
+    let bins = 128;
+    check_samples(&tree, n, 6, 1e-8, bins, |i, j| {
+        // A bin is a quarter of a leaf: the mean of 2 x 2 midpoints is exact
+        // for the bilinear shape in the square.
+        let mut pdf = 0.0;
+        for (a, b) in [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)] {
+            let c = square_to_sphere(DVec2::new(
+                (i as f64 + a) / bins as f64,
+                (j as f64 + b) / bins as f64,
+            ));
+            pdf += tree.pdf(n, c.to_array()) / 4.0;
         }
-    }
-    assert!(worst < 1e-6, "{worst}");
-    let (mut chi2, mut dof) = (0.0, 0);
-    for j in 0..bins {
-        for i in 0..bins {
-            // A bin is a quarter of a leaf: the mean of 2 x 2 midpoints is exact
-            // for the bilinear shape in the square.
-            let mut pdf = 0.0;
-            for (a, b) in [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)] {
-                let c = square_to_sphere(DVec2::new(
-                    (i as f64 + a) / bins as f64,
-                    (j as f64 + b) / bins as f64,
-                ));
-                pdf += tree.pdf(n, c.to_array()) / 4.0;
-            }
-            let expected =
-                samples as f64 * pdf * 4.0 * core::f64::consts::PI / (bins * bins) as f64;
-            let got = counts[j * bins + i] as f64;
-            if expected > 0.0 {
-                chi2 += (got - expected).powi(2) / expected;
-                dof += 1;
-            } else {
-                assert_eq!(got, 0.0);
-            }
-        }
-    }
-    let sd = (2.0 * dof as f64).sqrt();
-    assert!(chi2 < dof as f64 + 5.0 * sd, "chi-square {chi2} over {dof}");
+        pdf
+    });
 
     // The same estimate of the irradiance, with less spread.
     let nv = DVec3::from_array(n).normalize();
