@@ -42,7 +42,9 @@ use nuld_build_tool::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use nuld_build_tool::discrepancy::GradientPath;
 use nuld_build_tool::optimize::directions::{optimize_directions, DirectionConfig};
 use nuld_build_tool::sphere::geometry::{fold, map_jacobian};
-use nuld_build_tool::sphere::{CapMeasureTable, DirectionDensity, EnvmapDensity};
+use nuld_build_tool::sphere::{
+    CapMeasureTable, DirectionDensity, EnvmapDensity, EnvmapTree as ToolTree,
+};
 use nuld_core::blob::Domain;
 use nuld_core::envmap_tree::EnvmapTree;
 use nuld_core::network::shifted_lattice_point;
@@ -63,15 +65,13 @@ struct Fit {
 /// alone (`p` a point of the sphere's square, the same direction at every
 /// normal).
 fn warp(tree: Option<&EnvmapTree<'_>>, u: [f64; 2], p: DVec2) -> (DVec3, DVec3, DVec3) {
-    let (q, [dx_dux, dy_dux, dy_duy]) = match tree {
-        Some(tree) => {
-            let (q, _, slopes) = tree.sample_square_with_slopes(u, p.to_array());
-            (DVec2::from(q), slopes)
+    match tree {
+        Some(tree) => ToolTree::sample_with_jacobian(tree, u, p),
+        None => {
+            let (jx, jy) = map_jacobian(Domain::Sphere, p);
+            (square_to_sphere(p), jx, jy)
         }
-        None => (p, [1.0, 0.0, 1.0]),
-    };
-    let (jx, jy) = map_jacobian(Domain::Sphere, q);
-    (square_to_sphere(q), jx * dx_dux + jy * dy_dux, jy * dy_duy)
+    }
 }
 
 /// What a fit reads at one normal: its octahedral point, lit map, caps and their

@@ -12,10 +12,11 @@
 //! is positive wherever the cosine is, so `L cos / pdf` is unbiased.
 
 use super::envmap::EnvmapDensity;
+use super::geometry::map_jacobian;
 use super::target::DirectionDensity;
 use bytemuck::Zeroable;
 use glam::{DVec2, DVec3};
-use nuld_core::blob::SectionSpec;
+use nuld_core::blob::{Domain, SectionSpec};
 use nuld_core::envmap_tree::{
     build, node_count, top_len, top_normal, top_row, EnvmapTree as CoreTree, NodeRecord, TreeInfo,
     MAX_TREE_LEVELS, TOP_LEVELS,
@@ -106,15 +107,14 @@ fn leaf_corners(
         .into_par_iter()
         .map(|k| {
             let (cx, cy) = (k % (side + 1), k / (side + 1));
-            let mut brightest: f64 = 0.0;
-            for (lx, ly) in [(cx, cy), (cx.wrapping_sub(1), cy), (cx, cy.wrapping_sub(1))]
+            // The up to four leaves around the corner (`wrapping_sub` past the
+            // square's edge gives an index the bound leaves out).
+            let (x0, y0) = (cx.wrapping_sub(1), cy.wrapping_sub(1));
+            let brightest = [(x0, y0), (cx, y0), (x0, cy), (cx, cy)]
                 .into_iter()
-                .chain([(cx.wrapping_sub(1), cy.wrapping_sub(1))])
-            {
-                if lx < side && ly < side {
-                    brightest = brightest.max(leaves[ly * side + lx][0] / area);
-                }
-            }
+                .filter(|&(lx, ly)| lx < side && ly < side)
+                .map(|(lx, ly)| leaves[ly * side + lx][0] / area)
+                .fold(0.0, f64::max);
             let p = DVec2::new(cx as f64 / side as f64, cy as f64 / side as f64);
             light(square_to_sphere(p)).max(SHAPE_FLOOR * brightest) as f32
         })
@@ -285,8 +285,9 @@ impl EnvmapTree {
             top_row(levels, &nodes, top_normal(grid, j), row);
         });
         let corners = leaf_corners(&light, levels, &leaves);
-        // Refuses a map without light, as the runtime would.
-        CoreTree::new(levels, &nodes, grid, &top)?
+        // Refuses a map without light, as the runtime would (every value,
+        // corners included, read once).
+        CoreTree::view(levels, &nodes, grid, &top)?
             .with_corners(&corners)?
             .check_values()?;
         Ok(Self {
@@ -327,6 +328,22 @@ impl EnvmapTree {
     pub fn sample(tree: &CoreTree<'_>, n: DVec3, u: DVec2) -> (DVec3, f64) {
         let (d, pdf) = tree.sample(n.to_array(), u.to_array());
         (DVec3::from_array(d), pdf)
+    }
+
+    /// The direction at primary sample `p` for the normal of octahedral square
+    /// point `q`, and its derivatives along `p.x` and `p.y`: the sphere map's
+    /// Jacobian times the tree's, exact within the piece of the tree `p` falls in
+    /// ([`nuld_core::envmap_tree::EnvmapTree::sample_square_with_slopes`]). What
+    /// a trainer chains its gradients through.
+    pub fn sample_with_jacobian(
+        tree: &CoreTree<'_>,
+        q: [f64; 2],
+        p: DVec2,
+    ) -> (DVec3, DVec3, DVec3) {
+        let (s, _, [dx_dux, dy_dux, dy_duy]) = tree.sample_square_with_slopes(q, p.to_array());
+        let s = DVec2::from(s);
+        let (jx, jy) = map_jacobian(Domain::Sphere, s);
+        (square_to_sphere(s), jx * dx_dux + jy * dy_dux, jy * dy_duy)
     }
 
     /// The solid-angle pdf of [`Self::sample`] at the unit direction `d` for `n`.

@@ -26,7 +26,7 @@ use crate::discrepancy::GradientPath;
 use crate::seeding::derive_seed;
 use crate::sphere::brdf_prior::BrdfPrior;
 use crate::sphere::geometry::map_jacobian;
-use crate::sphere::{BrdfTarget, CapMeasureTable, DirectionDensity, TabulatedWarp};
+use crate::sphere::{BrdfTarget, CapMeasureTable, DirectionDensity, EnvmapTree, TabulatedWarp};
 use anyhow::Result;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
@@ -156,15 +156,9 @@ impl PoolCondition {
             ConditionDensity::Brdf { .. } => None,
         };
         if let (PointWarp::EnvmapTree, Some(tree)) = (self.warp, &tree) {
-            // Within a piece the tree's warp has a closed-form Jacobian (affine
-            // per axis, and a shaped leaf's conditional moving with x): the
-            // sphere map's Jacobian times it (zero across nothing, unlike
-            // differences, and one descent instead of five).
-            let (q, _, [dx_dux, dy_dux, dy_duy]) =
-                tree.sample_square_with_slopes(self.cond, p.to_array());
-            let q = DVec2::from(q);
-            let (jx, jy) = map_jacobian(Domain::Sphere, q);
-            return (square_to_sphere(q), jx * dx_dux + jy * dy_dux, jy * dy_duy);
+            // Within a piece the tree's warp has a closed-form Jacobian (zero
+            // across nothing, unlike differences, and one descent instead of five).
+            return EnvmapTree::sample_with_jacobian(tree, self.cond, p);
         }
         let tree = tree.as_ref();
         let warp = |u: DVec2| {

@@ -278,24 +278,18 @@ impl DirectionSampler for NuldSampler<'_> {
                 self.brdf_sample(at, s, (wo, r, m))
             })),
             Kind::Envmap(t, env) => {
-                out.extend((0..n).map(|i| {
-                    let s = match self.randomized {
-                        false => t.sample(normal, k, i),
-                        true => t.sample_randomized(normal, k, i, key.scramble()),
-                    };
-                    self.envmap_sample(at, env, s)
-                }));
-                self.normalize(at, env, out);
+                let set = (0..n).map(|i| match self.randomized {
+                    false => t.sample(normal, k, i),
+                    true => t.sample_randomized(normal, k, i, key.scramble()),
+                });
+                self.envmap_set(at, env, set, out);
             }
             Kind::EnvmapNetwork(t, env) => {
-                out.extend((0..n).map(|i| {
-                    let s = match self.randomized {
-                        false => t.sample(normal, k, i),
-                        true => t.sample_randomized(normal, k, i, key.scramble()),
-                    };
-                    self.envmap_sample(at, env, s)
-                }));
-                self.normalize(at, env, out);
+                let set = (0..n).map(|i| match self.randomized {
+                    false => t.sample(normal, k, i),
+                    true => t.sample_randomized(normal, k, i, key.scramble()),
+                });
+                self.envmap_set(at, env, set, out);
             }
         }
     }
@@ -355,6 +349,19 @@ impl NuldSampler<'_> {
         }
     }
 
+    /// The runtime's environment samples `set` as [`Self::envmap_sample`]s
+    /// into `out`, the fixed instance's set then [`Self::normalize`]d.
+    fn envmap_set(
+        &self,
+        at: &ShadingPoint,
+        env: &Environment,
+        set: impl Iterator<Item = nuld_runtime::Sample>,
+        out: &mut Vec<Sample>,
+    ) {
+        out.extend(set.map(|s| self.envmap_sample(at, env, s)));
+        self.normalize(at, env, out);
+    }
+
     /// An environment sample (world frame) weighted by the density it follows
     /// (module docs): the runtime's exact pdf in the unbiased mode, and for a
     /// fixed instance as [`FixedWeight`] says (before [`Self::normalize`]).
@@ -380,9 +387,7 @@ impl NuldSampler<'_> {
             pdf,
         }
     }
-}
 
-impl NuldSampler<'_> {
     /// A fixed instance's set weighted [`FixedWeight::Normalized`]: each weight
     /// `f cos / p` divided by `c = (1/n) Σ L cos / (p e)`, the set's own
     /// estimate of the irradiance `e = E(n)` over the runtime's. Where the
@@ -391,17 +396,19 @@ impl NuldSampler<'_> {
     /// the set's own errors on `L cos` cancel from the estimate. Nothing
     /// otherwise (or when no sample sees light: the weights are then 0).
     fn normalize(&self, at: &ShadingPoint, env: &Environment, set: &mut [Sample]) {
+        if self.randomized || self.fixed_weight != FixedWeight::Normalized {
+            return;
+        }
         let normal = at.frame.normal().as_vec3();
         let e = EnvmapSampler::try_from(self.sampler).map_or(0.0, |t| t.weight(normal)) as f64;
-        if self.randomized || self.fixed_weight != FixedWeight::Normalized || e <= 0.0 {
+        if e <= 0.0 {
             return;
         }
         let n = set.len() as f64;
-        let cos = |l: DVec3| at.frame.normal().dot(l).max(0.0);
         let c = set
             .iter()
             .filter(|s| s.pdf > 0.0)
-            .map(|s| env.radiance(s.direction) * cos(s.direction) / s.pdf)
+            .map(|s| lit(at, env, s.direction) / s.pdf)
             .sum::<f64>()
             / (n * e);
         if c > 0.0 && c.is_finite() {
@@ -414,9 +421,18 @@ impl NuldSampler<'_> {
 /// `q(l) = L(l) max(0, n.l) / E(n)` per steradian, with `E(n) = e`; 0 where the
 /// normal sees no light.
 fn target_density(at: &ShadingPoint, env: &Environment, e: f64, l: DVec3) -> f64 {
+    if e > 0.0 {
+        lit(at, env, l) / e
+    } else {
+        0.0
+    }
+}
+
+/// The map's light at `l` times the shading point's cosine, `L(l) max(0, n.l)`.
+fn lit(at: &ShadingPoint, env: &Environment, l: DVec3) -> f64 {
     let cos = at.frame.normal().dot(l).max(0.0);
-    if e > 0.0 && cos > 0.0 {
-        env.radiance(l) * cos / e
+    if cos > 0.0 {
+        env.radiance(l) * cos
     } else {
         0.0
     }
