@@ -294,6 +294,31 @@ fn samples_follow_the_pdf_and_invert_undoes_sample() {
     });
 }
 
+/// Samples of [`irradiance_estimate`].
+const ESTIMATE_SAMPLES: usize = 200_000;
+
+/// The mean of `L cos / pdf` over [`ESTIMATE_SAMPLES`] of `tree`'s samples at
+/// `n` (seed `seed`), and its standard error.
+fn irradiance_estimate(tree: &EnvmapTree<'_>, n: [f64; 3], seed: u64) -> (f64, f64) {
+    let nv = DVec3::from_array(n).normalize();
+    let mut r = Rng(seed);
+    let (mut sum, mut sq) = (0.0, 0.0);
+    for _ in 0..ESTIMATE_SAMPLES {
+        let (d, pdf) = tree.sample(n, [r.next(), r.next()]);
+        let d = DVec3::from_array(d);
+        let v = if pdf > 0.0 {
+            light(d) * nv.dot(d).max(0.0) / pdf
+        } else {
+            0.0
+        };
+        sum += v;
+        sq += v * v;
+    }
+    let count = ESTIMATE_SAMPLES as f64;
+    let mean = sum / count;
+    (mean, ((sq / count - mean * mean) / count).sqrt())
+}
+
 /// `(1/M) Σ L cos / pdf` over the tree's samples is the irradiance by an
 /// independent quadrature (a fine midpoint rule on the square, `L` the light
 /// itself, not the tree's leaves), for normals facing the sun, the sky and the
@@ -315,22 +340,7 @@ fn the_estimate_with_the_pdf_is_the_irradiance() {
             ));
             exact += light(d) * nv.dot(d).max(0.0) * 4.0 * core::f64::consts::PI / (m * m) as f64;
         }
-        let mut r = Rng(40 + t as u64);
-        let count = 200_000;
-        let (mut sum, mut sq) = (0.0, 0.0);
-        for _ in 0..count {
-            let (d, pdf) = tree.sample(n, [r.next(), r.next()]);
-            let d = DVec3::from_array(d);
-            let v = if pdf > 0.0 {
-                light(d) * nv.dot(d).max(0.0) / pdf
-            } else {
-                0.0
-            };
-            sum += v;
-            sq += v * v;
-        }
-        let mean = sum / count as f64;
-        let se = ((sq / count as f64 - mean * mean) / count as f64).sqrt();
+        let (mean, se) = irradiance_estimate(&tree, n, 40 + t as u64);
         assert!(
             (mean - exact).abs() < 4.0 * se + 1e-4 * exact,
             "{n:?}: {mean} vs {exact} (se {se})"
@@ -338,7 +348,10 @@ fn the_estimate_with_the_pdf_is_the_irradiance() {
         // The cosine product puts samples where the light meets the cosine: the
         // relative error of one sample stays near that of a perfect importance
         // sampler's for these smooth parts, far below the map's alone.
-        assert!(se * (count as f64).sqrt() < 3.0 * exact, "{n:?}: {se}");
+        assert!(
+            se * (ESTIMATE_SAMPLES as f64).sqrt() < 3.0 * exact,
+            "{n:?}: {se}"
+        );
     }
 }
 
@@ -540,29 +553,8 @@ fn a_leaf_shape_keeps_the_pdf_exact() {
     });
 
     // The same estimate of the irradiance, with less spread.
-    let nv = DVec3::from_array(n).normalize();
-    let spread = |t: &EnvmapTree<'_>| {
-        let mut r = Rng(77);
-        let count = 200_000;
-        let (mut sum, mut sq) = (0.0, 0.0);
-        for _ in 0..count {
-            let (d, pdf) = t.sample(n, [r.next(), r.next()]);
-            let d = DVec3::from_array(d);
-            let v = if pdf > 0.0 {
-                light(d) * nv.dot(d).max(0.0) / pdf
-            } else {
-                0.0
-            };
-            sum += v;
-            sq += v * v;
-        }
-        let mean = sum / count as f64;
-        (
-            mean,
-            ((sq / count as f64 - mean * mean) / count as f64).sqrt(),
-        )
-    };
-    let ((a, sa), (b, sb)) = (spread(&flat), spread(&tree));
+    let (a, sa) = irradiance_estimate(&flat, n, 77);
+    let (b, sb) = irradiance_estimate(&tree, n, 77);
     assert!((a - b).abs() < 4.0 * (sa * sa + sb * sb).sqrt(), "{a} {b}");
     assert!(sb < 0.8 * sa, "shaped {sb} against uniform {sa}");
 
