@@ -2,7 +2,10 @@
 """Writes the synthetic 1024x512 Radiance HDR maps of the README's concentrated-target
 table (no dependencies): sun50.hdr (a constant map whose 2x2-pixel block holds half
 the light), lowsun.hdr (a 3x3-pixel sun 4 degrees above the horizon holding 80 %),
-lamps.hdr (a dark room with four 2x1-pixel lamps of 15 % each).
+lamps.hdr (a dark room with four 2x1-pixel lamps of 15 % each), pixel.hdr (one lit
+pixel, 30 degrees above the horizon, the rest black: half the normals see no light),
+sky.hdr (a sky brightening towards the horizon with a 3x3-pixel sun 30 degrees up
+holding 5/7 of the light, above a black ground).
 Usage: scripts/synthetic-maps.py OUT_DIR"""
 import math, os, sys
 out=sys.argv[1] if len(sys.argv)>1 else 'out/maps'
@@ -43,3 +46,10 @@ def lampf(c,r):
         if r==lr and c in (lc,lc+1): return 0.15/0.4*base/(2*omega(lr))
     return 0.05
 write(os.path.join(out,'lamps.hdr'), lampf)
+# 4. one lit pixel, the rest black
+write(os.path.join(out,'pixel.hdr'), lambda c,r: 100.0 if (r,c)==(170,500) else 0.0)
+# 5. sky above a black ground, a 3x3 sun 30 degrees up holding 2.5 times the sky's light
+srows=[170,171,172]; scols=[500,501,502]
+skym=sum(omega(r)*(1+r/256) for r in range(256))*W
+Ls5=2.5*skym/(sum(omega(r) for r in srows)*3)
+write(os.path.join(out,'sky.hdr'), lambda c,r: Ls5 if (r in srows and c in scols) else ((1+r/256) if r<256 else 0.0))

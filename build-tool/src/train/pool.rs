@@ -41,6 +41,13 @@ use std::sync::Arc;
 /// [`BrdfTarget::new`]'s, so that building the pool costs seconds, not minutes.
 pub const POOL_RULE_POINTS: usize = 1 << 14;
 
+/// Most batches of `count` candidates [`ConditionPool::new`] draws to find
+/// `count` conditions that teach something. Every lit direction of a map lights
+/// the half of the sphere's normals about it, so the first batch holds about
+/// half its count or more and two or three suffice; a map lit nowhere is refused
+/// before ([`crate::sphere::EnvmapDensity`]).
+const MAX_POOL_BATCHES: usize = 8;
+
 /// Cells per side of the tabulated inverse CDF (2 x 2 midpoints per cell) that
 /// warps a BRDF pool condition's baseline. The tournament draws conditions by
 /// their loss over this baseline; over the renderer's VNDF/cosine mixture instead,
@@ -109,6 +116,22 @@ pub struct PoolCondition {
 }
 
 impl PoolCondition {
+    /// Whether training on this condition can improve the sampler: not for a
+    /// normal that no light reaches. The estimate there is 0 whatever the set
+    /// (its weight `E(n)` is 0, and every `L cos` it reads too), while the
+    /// prior still puts every point in the map's light (below that normal's
+    /// horizon), so the set could never follow the stand-in target of the
+    /// cosine lobe: such conditions' losses stayed near 1 a cap, the
+    /// tournament drew them most, and their gradients wrecked the lit normals'
+    /// sets (a map lit by one pixel: 2.86 of the baseline against the untrained
+    /// lattice's 1.15).
+    pub fn teaches(&self) -> bool {
+        match &self.density {
+            ConditionDensity::Envmap { scale, .. } => *scale > 0.0,
+            ConditionDensity::Brdf { .. } => true,
+        }
+    }
+
     /// Target density at direction `x`: `q(x) = f(wo, x) (n.x) / A` for the BRDF,
     /// `pdf_map(x) max(0, n.x) scale` for a map.
     pub fn pdf(&self, x: DVec3) -> f64 {
@@ -279,28 +302,38 @@ impl ConditionPool {
     ) -> Result<Self> {
         let loaded = target.load()?;
         let scramble = derive_seed(seed, 0x706f_6f6c) as u32;
-        let conditions = (0..count)
-            .into_par_iter()
-            .map(|p| {
-                let u = [
-                    sobol_burley::sample(p as u32, 0, scramble) as f64,
-                    sobol_burley::sample(p as u32, 1, scramble) as f64,
-                ];
-                let seed = derive_seed(seed, p as u64);
-                let cond = loaded.condition(u);
-                match &loaded {
-                    LoadedTarget::GltfBrdf(prior) => {
-                        let v = sobol_burley::sample(p as u32, 2, scramble) as f64;
-                        let m = layer.pool_metallic(nodes, v);
-                        let cond = [cond[0], cond[1], m];
-                        condition(prior, cond, caps, window, shape, seed)
-                    }
-                    LoadedTarget::Envmap(env) => {
-                        envmap_condition(env, cond, caps, window, shape, seed)
-                    }
+        let candidate = |p: usize| -> Result<PoolCondition> {
+            let u = [
+                sobol_burley::sample(p as u32, 0, scramble) as f64,
+                sobol_burley::sample(p as u32, 1, scramble) as f64,
+            ];
+            let seed = derive_seed(seed, p as u64);
+            let cond = loaded.condition(u);
+            match &loaded {
+                LoadedTarget::GltfBrdf(prior) => {
+                    let v = sobol_burley::sample(p as u32, 2, scramble) as f64;
+                    let m = layer.pool_metallic(nodes, v);
+                    let cond = [cond[0], cond[1], m];
+                    condition(prior, cond, caps, window, shape, seed)
                 }
-            })
-            .collect::<Result<Vec<_>>>()?;
+                LoadedTarget::Envmap(env) => envmap_condition(env, cond, caps, window, shape, seed),
+            }
+        };
+        // Candidates in the sequence's order, a batch of `count` at a time, keeping
+        // the first `count` that teach something ([`PoolCondition::teaches`]).
+        let mut conditions = Vec::with_capacity(count);
+        for batch in 0..MAX_POOL_BATCHES {
+            let first = batch * count;
+            let found = (first..first + count)
+                .into_par_iter()
+                .map(candidate)
+                .collect::<Result<Vec<_>>>()?;
+            conditions.extend(found.into_iter().filter(PoolCondition::teaches));
+            if conditions.len() >= count {
+                break;
+            }
+        }
+        conditions.truncate(count);
         Ok(Self {
             conditions,
             target: loaded,
@@ -501,6 +534,66 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A map lit by one pixel leaves half the sphere's normals in the dark: the
+    /// pool skips them and still holds its count of distinct normals, each lit
+    /// (its irradiance, by the map's own sum over pixels, positive).
+    #[test]
+    fn an_envmap_pool_holds_only_normals_that_light_reaches() {
+        let dir = std::env::temp_dir().join(format!("nuld-pool-dark-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("one-pixel.png");
+        image::RgbImage::from_fn(32, 16, |x, y| {
+            let v = if (x, y) == (5, 3) { 255 } else { 0 };
+            image::Rgb([v, v, v])
+        })
+        .save(&path)
+        .unwrap();
+        let shape = Shape::new(8, &[4], Activation::Relu, 3).unwrap();
+        let count = 24;
+        let pool = ConditionPool::new(
+            &TrainTarget::envmap(&path).unwrap(),
+            (BrdfLayer::Shared, &[]),
+            count,
+            64,
+            32,
+            &shape,
+            5,
+        )
+        .unwrap();
+        let LoadedTarget::Envmap(env) = &pool.target else {
+            panic!("an envmap target")
+        };
+        let normals: Vec<DVec3> = pool
+            .conditions
+            .iter()
+            .map(|pc| match pc.density {
+                ConditionDensity::Envmap { normal, .. } => normal,
+                _ => panic!("an envmap condition"),
+            })
+            .collect();
+        assert_eq!(normals.len(), count);
+        for (k, n) in normals.iter().enumerate() {
+            assert!(env.map.irradiance(*n) > 0.0, "{n}");
+            assert!(pool.conditions[k].teaches());
+            assert!(
+                normals[..k].iter().all(|m| m.distance(*n) > 1e-9),
+                "{n} twice"
+            );
+        }
+        // The map does leave normals in the dark: the filter had work to do.
+        let dark = (0..64)
+            .map(|j| {
+                square_to_sphere(DVec2::new(
+                    (j % 8) as f64 / 8.0 + 0.06,
+                    (j / 8) as f64 / 8.0 + 0.06,
+                ))
+            })
+            .filter(|&n| env.map.irradiance(n) == 0.0)
+            .count();
+        assert!(dark > 16, "{dark} of 64 normals dark");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
