@@ -182,11 +182,17 @@ pub fn run(a: BakeArgs) -> Result<()> {
     );
     if let Some(q) = &report.quality {
         line += &format!(
-            "; held-out cap L2 / warped Owen-Sobol: mean {:.3}, worst {:.3}; union {:.3}, nn {:.3}",
-            q.mean_ratio, q.worst_ratio, q.mean_union_ratio, q.mean_nn_ratio
+            "; held-out cap L2 / warped Owen-Sobol: mean {:.3}, worst {:.3}, unbiased mode {:.3}; union {:.3}, nn {:.3}",
+            q.mean_ratio, q.worst_ratio, q.mean_randomized_ratio, q.mean_union_ratio, q.mean_nn_ratio
         );
     }
     println!("{line}");
+    if let Some(q) = report.quality.as_ref().filter(|q| !q.training_helps()) {
+        eprintln!(
+            "note: on this target the trained sets check worse than the unbiased mode (the prior's lattice, untrained), {:.3} against {:.3}: prefer the unbiased mode (`sample --randomize`, the runtime's `sample_randomized`)",
+            q.mean_ratio, q.mean_randomized_ratio
+        );
+    }
     Ok(())
 }
 

@@ -128,6 +128,15 @@ pub struct Quality {
     pub mean_nn_ratio: f64,
 }
 
+impl Quality {
+    /// Whether the trained sets check at least as well as the unbiased mode, the
+    /// prior's shifted lattice that no training touched: where they do not, the
+    /// learned part did not help this target (`bake` says so).
+    pub fn training_helps(&self) -> bool {
+        self.mean_ratio <= self.mean_randomized_ratio
+    }
+}
+
 /// The directions of instance `k` of a BRDF sampler at `cond` and metallic 0
 /// (network mode, `params` as given, through the shared prior), `p_s` the
 /// condition's lobe probability (read by the mixture warp only,

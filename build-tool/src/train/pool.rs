@@ -536,6 +536,22 @@ mod tests {
         }
     }
 
+    /// A pool of `count` conditions of the map at `path` (8 points, 64 caps a
+    /// condition, windows of 32, seed 5).
+    fn envmap_pool(path: &std::path::Path, count: usize) -> ConditionPool {
+        let shape = Shape::new(8, &[4], Activation::Relu, 3).unwrap();
+        let target = TrainTarget::envmap(path).unwrap();
+        ConditionPool::new(&target, (BrdfLayer::Shared, &[]), count, 64, 32, &shape, 5).unwrap()
+    }
+
+    /// The map of an environment pool.
+    fn envmap_target(pool: &ConditionPool) -> &EnvmapTarget {
+        match &pool.target {
+            LoadedTarget::Envmap(env) => env,
+            _ => panic!("an envmap target"),
+        }
+    }
+
     /// A map lit by one pixel leaves half the sphere's normals in the dark: the
     /// pool skips them and still holds its count of distinct normals, each lit
     /// (its irradiance, by the map's own sum over pixels, positive).
@@ -550,21 +566,9 @@ mod tests {
         })
         .save(&path)
         .unwrap();
-        let shape = Shape::new(8, &[4], Activation::Relu, 3).unwrap();
         let count = 24;
-        let pool = ConditionPool::new(
-            &TrainTarget::envmap(&path).unwrap(),
-            (BrdfLayer::Shared, &[]),
-            count,
-            64,
-            32,
-            &shape,
-            5,
-        )
-        .unwrap();
-        let LoadedTarget::Envmap(env) = &pool.target else {
-            panic!("an envmap target")
-        };
+        let pool = envmap_pool(&path, count);
+        let env = envmap_target(&pool);
         let normals: Vec<DVec3> = pool
             .conditions
             .iter()
@@ -600,21 +604,8 @@ mod tests {
     fn envmap_conditions_hold_the_lit_map() {
         let dir = std::env::temp_dir().join(format!("nuld-pool-envmap-{}", std::process::id()));
         let map = crate::sphere::envmap::tiny_map(&dir);
-        let shape = Shape::new(8, &[4], Activation::Relu, 3).unwrap();
-        let pool = ConditionPool::new(
-            &TrainTarget::envmap(&map).unwrap(),
-            (BrdfLayer::Shared, &[]),
-            3,
-            64,
-            32,
-            &shape,
-            5,
-        )
-        .unwrap();
-        let LoadedTarget::Envmap(env) = &pool.target else {
-            panic!("an envmap target")
-        };
-        let density = &env.map;
+        let pool = envmap_pool(&map, 3);
+        let density = &envmap_target(&pool).map;
         for pc in &pool.conditions {
             let ConditionDensity::Envmap { normal, .. } = pc.density else {
                 panic!("an envmap condition")
