@@ -3,7 +3,7 @@
 //! target of `bake --envmap`).
 
 use super::EnvmapDensity;
-use crate::density::image::LuminanceImage;
+use crate::density::image::{LuminanceImage, NegativePixels};
 use crate::sphere::DirectionSpecError;
 use glam::DVec3;
 use nuld_core::blob::Domain;
@@ -62,33 +62,41 @@ impl EnvmapDensity {
     pub fn cosine_weighted(&self, n: DVec3) -> Result<(Self, f64), DirectionSpecError> {
         let (w, h) = (self.width, self.height);
         let dphi = TAU / w as f64;
-        let values = (0..h)
-            .flat_map(|r| (0..w).map(move |c| (c, r)))
-            .map(|(c, r)| {
-                let omega = dphi * (self.z_hi[r] - self.z_lo[r]);
+        // Row by row into one allocation: a bake builds this for every pool
+        // normal, on the filtered map's four cells a pixel.
+        let mut values = vec![0.0f64; w * h];
+        for (r, row) in values.chunks_exact_mut(w).enumerate() {
+            let omega = dphi * (self.z_hi[r] - self.z_lo[r]);
+            for (c, v) in row.iter_mut().enumerate() {
                 let lum = if omega > 0.0 {
                     self.mass[r * w + c] * self.integral / omega
                 } else {
                     0.0
                 };
-                lum * n.dot(self.pixel_center(c, r)).max(0.0)
-            })
-            .collect::<Vec<f64>>();
+                *v = lum * n.dot(self.pixel_center(c, r)).max(0.0);
+            }
+        }
         let dark = !values.iter().any(|&v| v > 0.0);
-        let values = if dark {
-            (0..h)
-                .flat_map(|r| (0..w).map(move |c| (c, r)))
-                .map(|(c, r)| n.dot(self.pixel_center(c, r)).max(0.0))
-                .collect()
-        } else {
-            values
-        };
+        if dark {
+            for (r, row) in values.chunks_exact_mut(w).enumerate() {
+                for (c, v) in row.iter_mut().enumerate() {
+                    *v = n.dot(self.pixel_center(c, r)).max(0.0);
+                }
+            }
+        }
         let img = LuminanceImage {
             width: w,
             height: h,
             values,
         };
-        let lit = Self::from_luminance(&img, Domain::Sphere, &self.name)?;
+        // Every value is a product of non-negative factors: where all are finite
+        // there is nothing for `cleaned` to clamp or refuse, and the copy it
+        // would make is skipped.
+        let lit = if img.values.iter().all(|v| v.is_finite()) {
+            Self::from_cleaned(&img, NegativePixels::default(), Domain::Sphere, &self.name)?
+        } else {
+            Self::from_luminance(&img, Domain::Sphere, &self.name)?
+        };
         let irradiance = if dark { 0.0 } else { lit.integral };
         Ok((lit, irradiance))
     }
