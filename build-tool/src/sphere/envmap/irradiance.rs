@@ -32,8 +32,11 @@ impl EnvmapDensity {
             .collect();
         // Normals in groups, each pixel read once per group: every normal's sum is
         // still one chain in pixel order (the same bits as summing it alone), and
-        // the group's chains overlap where one would wait on each addition.
-        const GROUP: usize = 4;
+        // the group's chains overlap where one would wait on each addition. The
+        // lit cells (64 MB for a 1024 x 512 map's four cells a pixel) come from
+        // memory once per group, so a wide group reads them fewer times (16: a
+        // bake's 64 x 64 irradiance table in 2.9 s, 4: 4.0 s).
+        const GROUP: usize = 16;
         normals
             .par_chunks(GROUP)
             .flat_map_iter(|group| {
