@@ -689,6 +689,22 @@ fn envmap_bake_and_sample_reject_bad_input_with_one_line() {
     assert!(e.contains("cannot create directory"), "{e}");
     assert_eq!(e.trim().lines().count(), 1, "{e}");
     assert_eq!(std::fs::read(&junk).unwrap(), b"not an image");
+    // A map that is not 2:1 is read all the same, with a warning first.
+    let square = dir.join("square.png");
+    image::GrayImage::from_pixel(16, 16, image::Luma([200]))
+        .save(&square)
+        .unwrap();
+    let e = failure(
+        &["bake", "--envmap", square.to_str().unwrap()],
+        &junk.join("out"),
+    );
+    let lines: Vec<&str> = e.trim().lines().collect();
+    assert_eq!(lines.len(), 2, "{e}");
+    assert!(
+        lines[0].starts_with("warning:") && lines[0].contains("16 x 16 pixels, not 2:1"),
+        "{e}"
+    );
+    assert!(lines[1].contains("cannot create directory"), "{e}");
     let file = dir.join("brdf.nuld");
     conditional_blob(&file);
     for args in [

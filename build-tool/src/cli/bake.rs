@@ -2,6 +2,7 @@
 //! write its blob, report and pictures (library: [`crate::conditional::bake`]).
 
 use crate::conditional::bake::{bake, BakeConfig, ENVMAP_POOL_CONDITIONS};
+use crate::sphere::envmap::shape_warning;
 use crate::train::{TrainConfig, TrainTarget};
 use anyhow::{ensure, Result};
 use clap::Args;
@@ -172,6 +173,9 @@ pub fn run(a: BakeArgs) -> Result<()> {
         resume: a.resume,
         ..defaults
     };
+    if let Some(w) = a.envmap.as_deref().and_then(shape_warning) {
+        eprintln!("warning: {w}");
+    }
     let report = bake(&config, &a.out)?;
     let mut line = format!(
         "wrote {} ({} bytes, {} parameters) in {:.1} s",

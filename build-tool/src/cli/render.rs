@@ -4,6 +4,7 @@
 use crate::lab::render::nuld_sampler::FixedWeight;
 use crate::lab::render::sampler::Technique;
 use crate::lab::render::{render, RenderConfig};
+use crate::sphere::envmap::shape_warning;
 use anyhow::{bail, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -93,6 +94,9 @@ fn size(s: &str) -> Result<(u32, u32), String> {
 
 /// Runs `build-tool render`.
 pub fn run(a: RenderArgs) -> Result<()> {
+    if let Some(w) = shape_warning(&a.envmap) {
+        eprintln!("warning: {w}");
+    }
     let mut config = if a.quick {
         RenderConfig::quick(a.envmap)
     } else {

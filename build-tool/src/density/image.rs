@@ -119,6 +119,23 @@ pub fn load_luminance(path: impl AsRef<Path>) -> Result<LuminanceImage, DensityE
     }
 }
 
+/// The width and height of the image at `path` from its header alone (EXR, or any
+/// format [`load_luminance`] reads through `image`), or `None` where the file
+/// cannot be read or is not such an image (its load then says why).
+pub fn image_size(path: impl AsRef<Path>) -> Option<(usize, usize)> {
+    let path = path.as_ref();
+    let mut magic = [0u8; 4];
+    let n = std::fs::File::open(path).ok()?.read(&mut magic).ok()?;
+    if n == 4 && magic == EXR_MAGIC {
+        let meta = exr::meta::MetaData::read_from_file(path, false).ok()?;
+        let size = meta.headers.first()?.layer_size;
+        Some((size.width(), size.height()))
+    } else {
+        let (w, h) = ::image::image_dimensions(path).ok()?;
+        Some((w as usize, h as usize))
+    }
+}
+
 fn io_error(shown: &str, e: std::io::Error) -> DensityError {
     if e.kind() == std::io::ErrorKind::NotFound {
         DensityError::MissingFile {
@@ -716,6 +733,38 @@ mod tests {
                 (i as f64 * 0.414_213 + 0.1) % 1.0,
             );
             assert!(d.pdf(d.inverse_cdf(u)) > 0.0);
+        }
+    }
+
+    /// The header-only size of EXR and `image` files is what a full decode finds;
+    /// a file that is no image, or none at all, has no size.
+    #[test]
+    fn image_size_reads_the_header_of_each_format() {
+        let exr_path = temp_path("size.exr");
+        exr::prelude::write_rgba_file(&exr_path, 6, 2, |x, _| {
+            (x as f32, 0.0_f32, 0.0_f32, 1.0_f32)
+        })
+        .unwrap();
+        let png_path = temp_path("size.png");
+        ::image::GrayImage::from_fn(5, 4, |x, y| ::image::Luma([(x + y) as u8]))
+            .save(&png_path)
+            .unwrap();
+        for path in [&exr_path, &png_path] {
+            let img = load_luminance(path).unwrap();
+            assert_eq!(
+                image_size(path),
+                Some((img.width, img.height)),
+                "{}",
+                path.display()
+            );
+        }
+        assert_eq!(image_size(&exr_path), Some((6, 2)));
+        let junk = temp_path("size-junk.hdr");
+        std::fs::write(&junk, b"not an image").unwrap();
+        assert_eq!(image_size(&junk), None);
+        assert_eq!(image_size(temp_path("size-missing.png")), None);
+        for path in [exr_path, png_path, junk] {
+            std::fs::remove_file(path).ok();
         }
     }
 

@@ -142,6 +142,21 @@ fn cleaned(
     Ok((img, negative))
 }
 
+/// What is wrong with the shape of the map at `path` if its pixels are not twice
+/// as wide as tall: an equirectangular map spans 360° of longitude across and 180°
+/// of latitude down, so a map of any other shape (a square mirror ball, a cube
+/// cross, a cropped panorama) is read stretched. `None` for a 2:1 map, or one
+/// whose size cannot be read (loading it then says why).
+pub fn shape_warning(path: &Path) -> Option<String> {
+    let (w, h) = crate::density::image::image_size(path)?;
+    (w != 2 * h).then(|| {
+        format!(
+            "{} is {w} x {h} pixels, not 2:1: it is read as an equirectangular map (longitude across, latitude down) and stretched",
+            path.display()
+        )
+    })
+}
+
 /// `z = cos(pi r / H)` written as `sin(pi (H - 2r) / (2H))`, exact 0 at the equator.
 fn z_edge(r: usize, h: usize) -> f64 {
     (PI * (h as f64 - 2.0 * r as f64) / (2.0 * h as f64)).sin()
