@@ -102,17 +102,13 @@ const EXR_MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
 pub fn load_luminance(path: impl AsRef<Path>) -> Result<LuminanceImage, DensityError> {
     let path = path.as_ref();
     let shown = path.display().to_string();
-    let mut file = std::fs::File::open(path).map_err(|e| io_error(&shown, e))?;
     if path.is_dir() {
         return Err(DensityError::Io {
             path: shown,
             reason: "is a directory".to_string(),
         });
     }
-    let mut magic = [0u8; 4];
-    let n = file.read(&mut magic).map_err(|e| io_error(&shown, e))?;
-    drop(file);
-    if n == 4 && magic == EXR_MAGIC {
+    if is_exr(path).map_err(|e| io_error(&shown, e))? {
         read_exr(path, &shown)
     } else {
         read_with_image_crate(path, &shown)
@@ -124,9 +120,7 @@ pub fn load_luminance(path: impl AsRef<Path>) -> Result<LuminanceImage, DensityE
 /// cannot be read or is not such an image (its load then says why).
 pub fn image_size(path: impl AsRef<Path>) -> Option<(usize, usize)> {
     let path = path.as_ref();
-    let mut magic = [0u8; 4];
-    let n = std::fs::File::open(path).ok()?.read(&mut magic).ok()?;
-    if n == 4 && magic == EXR_MAGIC {
+    if is_exr(path).ok()? {
         let meta = exr::meta::MetaData::read_from_file(path, false).ok()?;
         let size = meta.headers.first()?.layer_size;
         Some((size.width(), size.height()))
@@ -134,6 +128,14 @@ pub fn image_size(path: impl AsRef<Path>) -> Option<(usize, usize)> {
         let (w, h) = ::image::image_dimensions(path).ok()?;
         Some((w as usize, h as usize))
     }
+}
+
+/// Whether the file at `path` begins with the EXR magic number (else it is left
+/// to `image`, which knows the other formats by their contents).
+fn is_exr(path: &Path) -> std::io::Result<bool> {
+    let mut magic = [0u8; 4];
+    let n = std::fs::File::open(path)?.read(&mut magic)?;
+    Ok(n == 4 && magic == EXR_MAGIC)
 }
 
 fn io_error(shown: &str, e: std::io::Error) -> DensityError {

@@ -3,7 +3,7 @@
 //! target of `bake --envmap`).
 
 use super::EnvmapDensity;
-use crate::density::image::{LuminanceImage, NegativePixels};
+use crate::density::image::LuminanceImage;
 use crate::sphere::DirectionSpecError;
 use glam::DVec3;
 use nuld_core::blob::Domain;
@@ -92,14 +92,7 @@ impl EnvmapDensity {
             height: h,
             values,
         };
-        // Every value is a product of non-negative factors: where all are finite
-        // there is nothing for `cleaned` to clamp or refuse, and the copy it
-        // would make is skipped.
-        let lit = if img.values.iter().all(|v| v.is_finite()) {
-            Self::from_cleaned(&img, NegativePixels::default(), Domain::Sphere, &self.name)?
-        } else {
-            Self::from_luminance(&img, Domain::Sphere, &self.name)?
-        };
+        let lit = Self::from_owned_luminance(img, Domain::Sphere, &self.name)?;
         let irradiance = if dark { 0.0 } else { lit.integral };
         Ok((lit, irradiance))
     }

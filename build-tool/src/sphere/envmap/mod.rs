@@ -119,10 +119,9 @@ pub struct EnvmapDensity {
 /// `img` with its negative pixels set to 0, and their count, once it is checked to
 /// hold at least one pixel, as many values as pixels, all finite.
 fn cleaned(
-    img: &LuminanceImage,
+    mut img: LuminanceImage,
     name: &str,
 ) -> Result<(LuminanceImage, NegativePixels), DirectionSpecError> {
-    let mut img = img.clone();
     let negative = img.clamp_negatives();
     let (w, h) = (img.width, img.height);
     if w == 0 || h == 0 || img.values.len() != w * h {
@@ -175,6 +174,16 @@ impl EnvmapDensity {
     /// error.
     pub fn from_luminance(
         img: &LuminanceImage,
+        domain: Domain,
+        name: &str,
+    ) -> Result<Self, DirectionSpecError> {
+        Self::from_owned_luminance(img.clone(), domain, name)
+    }
+
+    /// [`Self::from_luminance`] of an image the caller gives up (no copy is made
+    /// to clean it: a bake builds a lit map for every pool normal).
+    pub(super) fn from_owned_luminance(
+        img: LuminanceImage,
         domain: Domain,
         name: &str,
     ) -> Result<Self, DirectionSpecError> {
@@ -285,7 +294,7 @@ impl EnvmapDensity {
         domain: Domain,
         name: &str,
     ) -> Result<Self, DirectionSpecError> {
-        let (img, negative) = cleaned(img, name)?;
+        let (img, negative) = cleaned(img.clone(), name)?;
         let fine = FilteredLuminance::new(&img).half_pixel_averages();
         Self::from_cleaned(&fine, negative, domain, name)
     }
