@@ -5,7 +5,9 @@ the light), lowsun.hdr (a 3x3-pixel sun 4 degrees above the horizon holding 80 %
 lamps.hdr (a dark room with four 2x1-pixel lamps of 15 % each), pixel.hdr (one lit
 pixel, 30 degrees above the horizon, the rest black: half the normals see no light),
 sky.hdr (a sky brightening towards the horizon with a 3x3-pixel sun 30 degrees up
-holding 5/7 of the light, above a black ground).
+holding 5/7 of the light, above a black ground); and lamps-4k.hdr, a 4096x2048 map
+of lamps.hdr's room whose four lamps are 2x1 pixels of that map (0.09 degrees), for
+the bake of a large map (docs/results/envmap.md#large-maps).
 Usage: scripts/synthetic-maps.py OUT_DIR"""
 import math, os, sys
 out=sys.argv[1] if len(sys.argv)>1 else 'out/maps'
@@ -53,3 +55,17 @@ srows=[170,171,172]; scols=[500,501,502]
 skym=sum(omega(r)*(1+r/256) for r in range(256))*W
 Ls5=2.5*skym/(sum(omega(r) for r in srows)*3)
 write(os.path.join(out,'sky.hdr'), lambda c,r: Ls5 if (r in srows and c in scols) else ((1+r/256) if r<256 else 0.0))
+# 6. lamps at 4096 x 2048: the dark room, four 2x1-pixel lamps of ~15 % each, rows
+# written whole (the other maps' per-pixel function would take minutes here)
+W4,H4=4096,2048
+def omega4(r): return (2*math.pi/W4)*(math.cos(math.pi*r/H4)-math.cos(math.pi*(r+1)/H4))
+lamps4=[(401,241),(1602,601),(2803,802),(3601,361)]
+big=bytearray(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y %d +X %d\n"%(H4,W4))
+for r in range(H4):
+    row=bytearray(rgbe(0.05)*W4)
+    for (lc,lr) in lamps4:
+        if r==lr:
+            v=rgbe(0.15/0.4*base/(2*omega4(lr)))
+            row[4*lc:4*lc+8]=v+v
+    big+=row
+open(os.path.join(out,'lamps-4k.hdr'),'wb').write(big)

@@ -13,7 +13,8 @@
 //!   [`crate::sphere::brdf_albedo::lobe_probability`] computes, from the same
 //!   quadrature); for an environment sampler ([`nuld_core::conditional::ConditionalTarget::EnvmapNormal`])
 //!   the irradiance `E(n)` of the map at every node's normal
-//!   ([`EnvmapDensity::irradiance`]);
+//!   ([`EnvmapDensity::irradiance`]; of its box-filtered copy for a map larger
+//!   than 1024 x 512, [`crate::train::target::EnvmapTarget::coarse_map`]);
 //! * **prior**: an environment sampler on the tree
 //!   ([`PointWarp::EnvmapTree`]) carries the map's tree, which the pool trained
 //!   through;
@@ -24,6 +25,7 @@
 use super::blob::{MetalParts, Prior};
 use super::ConditionalParts;
 use crate::network::Params;
+use crate::progress::Progress;
 use crate::sphere::brdf_albedo::{directional_albedo, directional_albedo_metallic};
 use crate::sphere::EnvmapDensity;
 use crate::train::target::LoadedTarget;
@@ -84,35 +86,46 @@ pub fn distill(
     metallic_nodes: &[f32],
 ) -> ConditionalParts {
     let info = info(&params.shape, target, instances, grid, weight_grid);
+    // Progress in grid nodes: each point-table layer's, then the weight table's.
+    let layers = metallic_nodes.len().max(1) + usize::from(metal.is_some());
+    let nodes = (grid[0] * grid[1]) as u64;
+    let weight_nodes = (weight_grid[0] * weight_grid[1]) as u64;
+    let progress = Progress::stderr("distill", layers as u64 * nodes + weight_nodes, "node");
     let table = match metallic_nodes {
-        [] => point_table(params, 0.0, instances, grid),
+        [] => point_table(params, 0.0, instances, grid, &progress),
         nodes => nodes
             .iter()
-            .flat_map(|&m| point_table(params, m as f64, instances, grid))
+            .flat_map(|&m| point_table(params, m as f64, instances, grid, &progress))
             .collect(),
     };
+    let metal = metal.map(|metal| MetalParts {
+        params: metal.to_f16_bits(),
+        table: point_table(metal, 1.0, instances, grid, &progress),
+    });
     let (weights, prior) = match target {
         LoadedTarget::GltfBrdf(prior) => (
-            brdf_weights(&info),
+            {
+                let w = brdf_weights(&info);
+                progress.inc(weight_nodes);
+                w
+            },
             (info.point_warp() == Some(PointWarp::BrdfTable))
                 .then(|| Prior::Brdf(Arc::clone(prior))),
         ),
         LoadedTarget::Envmap(env) => (
-            envmap_weights(&info, &env.map),
+            envmap_weights(&info, env.coarse_map(), &progress),
             (info.point_warp() == Some(PointWarp::EnvmapTree))
                 .then(|| Prior::Envmap(Arc::new(env.tree.clone()))),
         ),
     };
+    progress.finish();
     ConditionalParts {
         info,
         params: params.to_f16_bits(),
         table,
         weights,
         prior,
-        metal: metal.map(|metal| MetalParts {
-            params: metal.to_f16_bits(),
-            table: point_table(metal, 1.0, instances, grid),
-        }),
+        metal,
         metallic_nodes: metallic_nodes.to_vec(),
     }
 }
@@ -122,13 +135,20 @@ pub fn distill(
 /// point of the f16-rounded network at metallic `m` (read only by a network
 /// with the metallic input) as u16 unorm codes. Parallel over nodes; identical
 /// for any thread count.
-fn point_table(params: &Params, m: f64, instances: u32, grid: [u32; 2]) -> Vec<u32> {
+fn point_table(
+    params: &Params,
+    m: f64,
+    instances: u32,
+    grid: [u32; 2],
+    progress: &Progress,
+) -> Vec<u32> {
     let shipped = params.rounded_to_f16();
     let n = shipped.shape.n();
     let nodes = (grid[0] * grid[1]) as usize;
     (0..nodes)
         .into_par_iter()
         .flat_map_iter(|node| {
+            progress.inc(1);
             // Node j's normalized condition is j / (nodes - 1), what the reader
             // computes there.
             let unit = [
@@ -147,7 +167,7 @@ fn point_table(params: &Params, m: f64, instances: u32, grid: [u32; 2]) -> Vec<u
 }
 
 /// The irradiance `E(n)` at every weight-grid node's normal.
-fn envmap_weights(info: &ConditionalInfo, map: &EnvmapDensity) -> Vec<f32> {
+fn envmap_weights(info: &ConditionalInfo, map: &EnvmapDensity, progress: &Progress) -> Vec<f32> {
     let g = info.weight_grid;
     let normals: Vec<_> = (0..g[0] * g[1])
         .map(|node| {
@@ -155,8 +175,15 @@ fn envmap_weights(info: &ConditionalInfo, map: &EnvmapDensity) -> Vec<f32> {
             square_to_sphere(DVec2::from(u))
         })
         .collect();
-    map.irradiances(&normals)
-        .into_iter()
+    // In rows of nodes, for the progress: each normal's sum is the same alone or
+    // in any group (`EnvmapDensity::irradiances`).
+    normals
+        .chunks(g[0].max(1) as usize)
+        .flat_map(|row| {
+            let e = map.irradiances(row);
+            progress.inc(row.len() as u64);
+            e
+        })
         .map(|e| e as f32)
         .collect()
 }

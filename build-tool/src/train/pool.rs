@@ -23,6 +23,7 @@ use crate::descent::local_factor;
 use crate::discrepancy::caps::epoch_caps;
 use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use crate::discrepancy::GradientPath;
+use crate::progress::Progress;
 use crate::seeding::derive_seed;
 use crate::sphere::brdf_prior::BrdfPrior;
 use crate::sphere::geometry::map_jacobian;
@@ -146,7 +147,7 @@ impl PoolCondition {
                     / albedo
             }
             ConditionDensity::Envmap { normal, env, scale } => {
-                env.map.pdf(x) * normal.dot(x).max(0.0) * scale
+                env.coarse_map().pdf(x) * normal.dot(x).max(0.0) * scale
             }
         }
     }
@@ -324,10 +325,24 @@ impl ConditionPool {
         let mut conditions = Vec::with_capacity(count);
         for batch in 0..MAX_POOL_BATCHES {
             let first = batch * count;
+            // Named as `bake` names the training it feeds ("train metal").
+            let mut phase = match (&loaded, layer) {
+                (LoadedTarget::GltfBrdf(_), BrdfLayer::Metal) => "pool metal".to_string(),
+                _ => "pool".to_string(),
+            };
+            if batch > 0 {
+                phase += &format!(", batch {} (normals that light reaches)", batch + 1);
+            }
+            let progress = Progress::stderr(&phase, count as u64, "condition");
             let found = (first..first + count)
                 .into_par_iter()
-                .map(candidate)
+                .map(|p| {
+                    let c = candidate(p);
+                    progress.inc(1);
+                    c
+                })
                 .collect::<Result<Vec<_>>>()?;
+            progress.finish();
             conditions.extend(found.into_iter().filter(PoolCondition::teaches));
             if conditions.len() >= count {
                 break;
@@ -449,7 +464,7 @@ fn envmap_condition(
     seed: u64,
 ) -> Result<PoolCondition> {
     let n = shape.n() as usize;
-    let map = &env.map;
+    let map = env.coarse_map();
     let normal = square_to_sphere(DVec2::from(u));
     // A normal that no light reaches trains on the cosine lobe (its weight is 0).
     let (lit, irradiance) = map.cosine_weighted(normal)?;

@@ -4,6 +4,7 @@
 
 use crate::seeding::content_hash;
 use crate::sphere::brdf_prior::BrdfPrior;
+use crate::sphere::envmap::COARSE_CELLS;
 use crate::sphere::envmap_tree::{prior_levels, PRIOR_GRID};
 use crate::sphere::{EnvmapDensity, EnvmapTree};
 use anyhow::{Context, Result};
@@ -69,7 +70,7 @@ impl TrainTarget {
                     .with_context(|| format!("environment map {}", path.display()))?;
                 let tree = EnvmapTree::new(&map, prior_levels(&map), PRIOR_GRID)
                     .with_context(|| format!("environment map {}", path.display()))?;
-                Ok(LoadedTarget::Envmap(Arc::new(EnvmapTarget { map, tree })))
+                Ok(LoadedTarget::Envmap(Arc::new(EnvmapTarget::new(map, tree))))
             }
         }
     }
@@ -95,6 +96,34 @@ pub struct EnvmapTarget {
     /// The map's tree ([`prior_levels`] levels, top weights on [`PRIOR_GRID`]
     /// normals): the prior whose primary space the network refines.
     pub tree: EnvmapTree,
+    /// The map box-filtered to at most [`COARSE_CELLS`] cells where it has more
+    /// ([`EnvmapDensity::box_filtered`]), else `None`: see [`Self::coarse_map`].
+    coarse: Option<EnvmapDensity>,
+}
+
+impl EnvmapTarget {
+    /// The map and its tree, with the coarse copy of [`Self::coarse_map`] made
+    /// where the map has more than [`COARSE_CELLS`] cells (`O(cells)`).
+    pub fn new(map: EnvmapDensity, tree: EnvmapTree) -> Self {
+        Self::with_coarse_cells(map, tree, COARSE_CELLS)
+    }
+
+    /// [`Self::new`] with the copy made above `max_cells` cells instead (a
+    /// map's [`EnvmapDensity::coarse_factor`] of `max_cells`).
+    pub fn with_coarse_cells(map: EnvmapDensity, tree: EnvmapTree, max_cells: usize) -> Self {
+        let coarse = map.box_filtered(map.coarse_factor(max_cells));
+        Self { map, tree, coarse }
+    }
+
+    /// The density the bake lights through each pool normal's cosine (the
+    /// training's caps, baselines and target) and sums for the irradiance
+    /// table: the map itself up to [`COARSE_CELLS`] cells (a 1024 x 512 map or
+    /// smaller: the same bits as before the copy existed), a box-filtered copy of
+    /// a larger one, whose blocks keep their cells' mass. The prior's tree and
+    /// the quality check read [`Self::map`], every cell.
+    pub fn coarse_map(&self) -> &EnvmapDensity {
+        self.coarse.as_ref().unwrap_or(&self.map)
+    }
 }
 
 impl LoadedTarget {
@@ -164,6 +193,31 @@ mod tests {
             assert_eq!(map.condition(u), u);
             assert_eq!(map.normalized(u), u);
         }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A map within the limit is lit whole (the coarse map is the map itself, so
+    /// its bakes write what they wrote before the copy); above it, the pool and
+    /// the irradiance table read a box-filtered copy of at most that many cells
+    /// with the map's integral, while the tree is the map's own.
+    #[test]
+    fn a_map_over_the_limit_is_lit_through_a_coarse_copy() {
+        let dir = std::env::temp_dir().join(format!("nuld-target-coarse-{}", std::process::id()));
+        let path = crate::sphere::envmap::tiny_map(&dir);
+        let map = EnvmapDensity::from_file_filtered(&path, Domain::Sphere).unwrap();
+        let tree = EnvmapTree::new(&map, 3, 2).unwrap();
+        let cells = map.width() * map.height();
+        let whole = EnvmapTarget::with_coarse_cells(map.clone(), tree.clone(), cells);
+        assert!(std::ptr::eq(whole.coarse_map(), &whole.map));
+        let small = EnvmapTarget::with_coarse_cells(map, tree, cells / 4);
+        let coarse = small.coarse_map();
+        assert!(!std::ptr::eq(coarse, &small.map));
+        assert_eq!(coarse.width() * 2, small.map.width());
+        assert_eq!(coarse.height() * 2, small.map.height());
+        assert!((coarse.integral() / small.map.integral() - 1.0).abs() < 1e-12);
+        assert_eq!(coarse.negative_pixels(), small.map.negative_pixels());
+        // A real map is over the default limit only from 1024 x 512 pixels up.
+        assert_eq!(COARSE_CELLS, 4 * 1024 * 512);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -37,6 +37,7 @@
 //!   sun of a few pixels is resolved as finely as the rest of the light; profiles
 //!   use a `2^15`-point rule (coarser than `cap_measure`).
 
+mod box_filter;
 mod cap_measure;
 mod irradiance;
 mod mass_rule;
@@ -44,6 +45,8 @@ mod mass_rule;
 pub(crate) mod test_support;
 #[cfg(test)]
 mod tests;
+
+pub use box_filter::COARSE_CELLS;
 
 use super::cap_table::profile_of_rule;
 use super::equirect::pixel_coords;
