@@ -28,6 +28,7 @@
 //!   the warp (`build-tool eval brdf-prior`).
 
 use super::envmap_prior::tabulated;
+use crate::progress::Progress;
 use glam::{DVec2, DVec3};
 use nuld_core::brdf::{gltf_metallic, gltf_metallic_ends, view_direction};
 use nuld_core::brdf_prior::{
@@ -205,6 +206,8 @@ impl BrdfPrior {
             .map(|n| vec![n, n + layer])
             .chain((2 * layer..nodes).map(|n| vec![n]))
             .collect();
+        // Seconds at the start of every BRDF bake: shown like its other phases.
+        let progress = Progress::stderr("prior", nodes as u64, "node");
         let tabulated_jobs: Vec<Vec<Vec<f32>>> = jobs
             .par_iter()
             .map(|job| {
@@ -242,9 +245,11 @@ impl BrdfPrior {
                         }
                     }
                 }
+                progress.inc(job.len() as u64);
                 out
             })
             .collect();
+        progress.finish();
         // Back in node order: layer 0, layer 1, then the metal layer.
         let mut tables = vec![Vec::new(); nodes as usize];
         for (job, out) in jobs.iter().zip(tabulated_jobs) {

@@ -6,8 +6,15 @@ use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// Magic and version at the front of a checkpoint file.
-const MAGIC: &[u8; 8] = b"NULDCKP1";
+/// Magic and version at the front of a checkpoint file. Version 2: the pool a
+/// run trains on is rebuilt from its settings on resume, and since version 1 an
+/// environment pool skips normals that no light reaches and lights a map larger
+/// than 1024 x 512 through a coarse copy, so a version-1 run would continue on
+/// another pool than it began with (the settings it records are the same).
+const MAGIC: &[u8; 8] = b"NULDCKP2";
+
+/// The magics of earlier versions, refused with their own message.
+const EARLIER_MAGICS: [&[u8; 8]; 1] = [b"NULDCKP1"];
 
 /// The state of a training run after `step` steps.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -60,6 +67,15 @@ impl Checkpoint {
     pub fn load(path: &Path) -> Result<Self> {
         let bytes =
             std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+        if EARLIER_MAGICS
+            .iter()
+            .any(|m| bytes.starts_with(m.as_slice()))
+        {
+            anyhow::bail!(
+                "{} was written by an earlier build-tool, whose training pool differs; rerun without --resume",
+                path.display()
+            );
+        }
         let body = bytes
             .strip_prefix(MAGIC.as_slice())
             .with_context(|| format!("{} is not a training checkpoint", path.display()))?;
@@ -77,8 +93,9 @@ mod tests {
     use super::*;
 
     /// A checkpoint reads back as it was saved; one cut short (as a checkpoint
-    /// of an earlier build-tool's shorter settings decodes) and a file of
-    /// another kind are refused in one line each, the first naming the way out.
+    /// of an earlier build-tool's shorter settings decodes), one of version 1
+    /// and a file of another kind are refused in one line each, the first two
+    /// naming the way out.
     #[test]
     fn a_checkpoint_reads_back_and_unreadable_ones_are_refused_in_one_line() {
         let dir = std::env::temp_dir().join(format!("nuld-checkpoint-{}", std::process::id()));
@@ -92,6 +109,17 @@ mod tests {
         std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
         let e = format!("{:#}", Checkpoint::load(&path).unwrap_err());
         assert!(e.contains("without --resume") && !e.contains('\n'), "{e}");
+
+        // A version-1 checkpoint, whole, is refused for its version.
+        let mut old = b"NULDCKP1".to_vec();
+        old.extend(postcard::to_allocvec(&c).unwrap());
+        std::fs::write(&path, &old).unwrap();
+        let e = format!("{:#}", Checkpoint::load(&path).unwrap_err());
+        assert!(
+            e.contains("earlier build-tool") && e.contains("without --resume"),
+            "{e}"
+        );
+        assert!(!e.contains('\n'), "{e}");
 
         std::fs::write(&path, b"not a checkpoint").unwrap();
         let e = format!("{:#}", Checkpoint::load(&path).unwrap_err());
