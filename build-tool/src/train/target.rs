@@ -2,6 +2,7 @@
 //! training settings name it (so a checkpoint records it and a resumed run must
 //! use the same), and [`LoadedTarget`], the data a pool is built from.
 
+use crate::progress::Progress;
 use crate::seeding::content_hash;
 use crate::sphere::brdf_prior::BrdfPrior;
 use crate::sphere::envmap::COARSE_CELLS;
@@ -66,11 +67,24 @@ impl TrainTarget {
         match self {
             Self::GltfBrdf => Ok(LoadedTarget::gltf_brdf()),
             Self::Envmap { path, .. } => {
+                // Seconds on a large map (an 8192 x 4096 one: 21 s) before the
+                // pool's first line: shown as a phase of its own.
+                let started = std::time::Instant::now();
+                let progress = Progress::stderr("map", 3, "step");
+                // Each line names the step under way.
                 let map = EnvmapDensity::from_file_filtered(path, Domain::Sphere)
                     .with_context(|| format!("environment map {}", path.display()))?;
+                progress.set_message("measuring the prior's tree");
+                progress.inc(1);
                 let tree = EnvmapTree::new(&map, prior_levels(&map), PRIOR_GRID)
                     .with_context(|| format!("environment map {}", path.display()))?;
-                Ok(LoadedTarget::Envmap(Arc::new(EnvmapTarget::new(map, tree))))
+                progress.set_message("box-filtering the copy the pool lights");
+                progress.inc(1);
+                let target = EnvmapTarget::new(map, tree);
+                progress.inc(1);
+                let seconds = started.elapsed().as_secs_f64();
+                progress.finish_with(&format!("{}, in {seconds:.1} s", target.summary()));
+                Ok(LoadedTarget::Envmap(Arc::new(target)))
             }
         }
     }
@@ -123,6 +137,26 @@ impl EnvmapTarget {
     /// the quality check read [`Self::map`], every cell.
     pub fn coarse_map(&self) -> &EnvmapDensity {
         self.coarse.as_ref().unwrap_or(&self.map)
+    }
+
+    /// What a bake reads of the map, in one line: `2048 x 1024 cells, a prior
+    /// of 9 levels` (the filtered density's cells, two a pixel each way), and
+    /// `, lit for the pool on a copy of W x H cells` where there is one.
+    pub fn summary(&self) -> String {
+        let coarse = match &self.coarse {
+            Some(c) => format!(
+                ", lit for the pool on a copy of {} x {} cells",
+                c.width(),
+                c.height()
+            ),
+            None => String::new(),
+        };
+        format!(
+            "{} x {} cells, a prior of {} levels{coarse}",
+            self.map.width(),
+            self.map.height(),
+            self.tree.info().levels
+        )
     }
 }
 
@@ -216,6 +250,11 @@ mod tests {
         assert_eq!(coarse.height() * 2, small.map.height());
         assert!((coarse.integral() / small.map.integral() - 1.0).abs() < 1e-12);
         assert_eq!(coarse.negative_pixels(), small.map.negative_pixels());
+        assert_eq!(whole.summary(), "64 x 32 cells, a prior of 3 levels");
+        assert_eq!(
+            small.summary(),
+            "64 x 32 cells, a prior of 3 levels, lit for the pool on a copy of 32 x 16 cells"
+        );
         // A real map is over the default limit only from 1024 x 512 pixels up.
         assert_eq!(COARSE_CELLS, 4 * 1024 * 512);
         std::fs::remove_dir_all(&dir).unwrap();
