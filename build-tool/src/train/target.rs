@@ -2,6 +2,7 @@
 //! training settings name it (so a checkpoint records it and a resumed run must
 //! use the same), and [`LoadedTarget`], the data a pool is built from.
 
+use crate::density::image::image_size;
 use crate::progress::Progress;
 use crate::seeding::content_hash;
 use crate::sphere::brdf_prior::BrdfPrior;
@@ -67,23 +68,33 @@ impl TrainTarget {
         match self {
             Self::GltfBrdf => Ok(LoadedTarget::gltf_brdf()),
             Self::Envmap { path, .. } => {
-                // Seconds on a large map (an 8192 x 4096 one: 21 s) before the
-                // pool's first line: shown as a phase of its own.
+                // Seconds on a large map (8192 x 4096: 17.7 s) before the pool's
+                // first line: a phase of its own there. A map of at most 1024 x
+                // 512 pixels reads in about a second, and a file whose size
+                // cannot be read fails at once: no progress for either, so that
+                // a bad map's error stays one line.
+                let large = image_size(path).is_some_and(|(w, h)| 4 * w * h > COARSE_CELLS);
                 let started = std::time::Instant::now();
-                let progress = Progress::stderr("map", 3, "step");
+                let progress = large.then(|| Progress::stderr("map", 3, "step"));
                 // Each line names the step under way.
+                let step = |next: &str| {
+                    if let Some(p) = &progress {
+                        p.set_message(next);
+                        p.inc(1);
+                    }
+                };
                 let map = EnvmapDensity::from_file_filtered(path, Domain::Sphere)
                     .with_context(|| format!("environment map {}", path.display()))?;
-                progress.set_message("measuring the prior's tree");
-                progress.inc(1);
+                step("measuring the prior's tree");
                 let tree = EnvmapTree::new(&map, prior_levels(&map), PRIOR_GRID)
                     .with_context(|| format!("environment map {}", path.display()))?;
-                progress.set_message("box-filtering the copy the pool lights");
-                progress.inc(1);
+                step("box-filtering the copy the pool lights");
                 let target = EnvmapTarget::new(map, tree);
-                progress.inc(1);
-                let seconds = started.elapsed().as_secs_f64();
-                progress.finish_with(&format!("{}, in {seconds:.1} s", target.summary()));
+                step("");
+                if let Some(p) = &progress {
+                    let seconds = started.elapsed().as_secs_f64();
+                    p.finish_with(&format!("{}, in {seconds:.1} s", target.summary()));
+                }
                 Ok(LoadedTarget::Envmap(Arc::new(target)))
             }
         }
