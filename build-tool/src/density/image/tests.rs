@@ -107,14 +107,21 @@ fn pick_skips_empty_cells() {
     }
 }
 
+/// `path` if the shared data holds it, else `None` after a `skipped:` line.
+fn shared_file(path: &str) -> Option<&str> {
+    if Path::new(path).exists() {
+        return Some(path);
+    }
+    // Straight to stderr: the test harness hides `eprintln!` of passing tests.
+    let _ = writeln!(std::io::stderr(), "skipped: {path} not found (see README)");
+    None
+}
+
 #[test]
 fn camera_png_if_present() {
-    let path = "../../shared/data/images/camera.png";
-    if !Path::new(path).exists() {
-        // Straight to stderr: the test harness hides `eprintln!` of passing tests.
-        let _ = writeln!(std::io::stderr(), "skipped: {path} not found (see README)");
+    let Some(path) = shared_file("../../shared/data/images/camera.png") else {
         return;
-    }
+    };
     let d = parse_spec(&format!("image:{path}")).unwrap();
     assert_eq!(d.spec(), format!("image:{path}"));
     let cells = d.cells(0);
@@ -163,11 +170,9 @@ fn camera_png_if_present() {
 
 #[test]
 fn studio_hdr_if_present() {
-    let path = "../../shared/data/envmaps/studio.hdr";
-    if !Path::new(path).exists() {
-        let _ = writeln!(std::io::stderr(), "skipped: {path} not found (see README)");
+    let Some(path) = shared_file("../../shared/data/envmaps/studio.hdr") else {
         return;
-    }
+    };
     let img = load_luminance(path).unwrap();
     assert_eq!((img.width, img.height), (1024, 512));
     assert!(img.values.iter().all(|v| v.is_finite() && *v >= 0.0));

@@ -46,11 +46,7 @@ impl EnvmapDensity {
             // The block's solid angle: the sum of its cells' (their z edges nest).
             let omega = dphi * (self.z_hi[rc * k] - self.z_lo[(rc + 1) * k - 1]).max(0.0);
             for v in row.iter_mut() {
-                *v = if omega > 0.0 {
-                    *v * self.integral / omega
-                } else {
-                    0.0
-                };
+                *v = self.luminance_of(*v, omega);
             }
         }
         let img = LuminanceImage {
@@ -68,12 +64,12 @@ impl EnvmapDensity {
     /// `max_cells` and divides both sides, or 1 if no `k` up to four times that
     /// size does (a map of an odd size is then lit whole, as before).
     pub fn coarse_factor(&self, max_cells: usize) -> usize {
-        let cells = self.width * self.height;
-        if cells <= max_cells.max(1) {
+        let (cells, max_cells) = (self.width * self.height, max_cells.max(1));
+        if cells <= max_cells {
             return 1;
         }
         let mut least = 2;
-        while cells.div_ceil(least * least) > max_cells.max(1) {
+        while cells.div_ceil(least * least) > max_cells {
             least += 1;
         }
         (least..=4 * least)

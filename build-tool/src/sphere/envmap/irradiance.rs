@@ -71,11 +71,7 @@ impl EnvmapDensity {
         for (r, row) in values.chunks_exact_mut(w).enumerate() {
             let omega = dphi * (self.z_hi[r] - self.z_lo[r]);
             for (c, v) in row.iter_mut().enumerate() {
-                let lum = if omega > 0.0 {
-                    self.mass[r * w + c] * self.integral / omega
-                } else {
-                    0.0
-                };
+                let lum = self.luminance_of(self.mass[r * w + c], omega);
                 *v = lum * n.dot(self.pixel_center(c, r)).max(0.0);
             }
         }

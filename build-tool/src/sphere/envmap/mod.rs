@@ -309,6 +309,17 @@ impl EnvmapDensity {
         self.integral
     }
 
+    /// The luminance of a region of solid angle `omega` (steradians) that holds
+    /// `mass` of this density: `mass integral / omega`, 0 for a region of no
+    /// solid angle (rows cut off by the hemisphere's horizon).
+    fn luminance_of(&self, mass: f64, omega: f64) -> f64 {
+        if omega > 0.0 {
+            mass * self.integral / omega
+        } else {
+            0.0
+        }
+    }
+
     /// The negative pixels that were set to 0 when the map was loaded.
     pub fn negative_pixels(&self) -> NegativePixels {
         self.negative
