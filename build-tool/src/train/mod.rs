@@ -40,7 +40,7 @@ use crate::discrepancy::GradientPath;
 use crate::network::{backward, output_gradient, Params};
 use crate::seeding::rng;
 use glam::{DVec2, DVec3};
-use nuld_core::network::{Activation, Shape};
+use nuld_core::network::{Activation, Shape, Trace};
 use rand::Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -275,6 +275,8 @@ pub struct Trainer {
     /// The network's architecture (`config.shape()`, whose lattice-generator
     /// search is built once here).
     shape: Shape,
+    /// Buffers that every step reuses ([`StepScratch`]).
+    scratch: StepScratch,
 }
 
 /// How many random pool members a tournament compares.
@@ -311,11 +313,13 @@ impl Trainer {
                 Checkpoint::fresh(config.clone(), params.values, pool.len())
             }
         };
+        let scratch = StepScratch::new(&config, shape);
         Ok(Self {
             config,
             pool,
             state,
             shape,
+            scratch,
         })
     }
 
@@ -359,8 +363,8 @@ impl Trainer {
         let mut batch = BatchLoss {
             cfg,
             pool: &self.pool,
-            shape: self.shape,
             running: &mut self.state.running,
+            scratch: &mut self.scratch,
             step: t,
             set_ratio: 0.0,
         };
@@ -389,8 +393,8 @@ impl Trainer {
 struct BatchLoss<'a> {
     cfg: &'a TrainConfig,
     pool: &'a ConditionPool,
-    shape: Shape,
     running: &'a mut Vec<f64>,
+    scratch: &'a mut StepScratch,
     step: usize,
     /// Mean set loss over the conditions' baselines, once computed.
     set_ratio: f64,
@@ -426,32 +430,28 @@ impl EpochLoss<f64> for BatchLoss<'_> {
             let start = r.random_range(0..cfg.pool_caps);
             batch.push((pick, instances, start));
         }
-        let params = Params {
-            shape: self.shape,
-            values: values.to_vec(),
-        };
-        let results: Vec<(f64, f64, Vec<f64>)> = batch
+        let StepScratch { params, slots } = &mut *self.scratch;
+        params.values.copy_from_slice(values);
+        let params = &*params;
+        let results: Vec<(f64, f64)> = batch
             .par_iter()
-            .map(|(pick, instances, start)| {
+            .zip(slots.par_iter_mut())
+            .map(|((pick, instances, start), slot)| {
+                let pc = &self.pool.conditions[*pick];
                 if pretraining {
-                    return pretrain_step(cfg, &params, &self.pool.conditions[*pick], instances);
+                    return pretrain_step(cfg, params, pc, instances, &mut slot.grad);
                 }
-                condition_step(
-                    cfg,
-                    &params,
-                    &self.pool.conditions[*pick],
-                    instances,
-                    *start,
-                    alpha,
-                )
+                condition_step(cfg, params, pc, instances, *start, alpha, slot)
             })
             .collect();
         let (mut loss, mut ratio) = (0.0, 0.0);
         let inv_b = 1.0 / batch.len() as f64;
-        for ((pick, _, _), (set_loss, union_loss, g)) in batch.iter().zip(&results) {
+        for (((pick, _, _), (set_loss, union_loss)), slot) in
+            batch.iter().zip(&results).zip(slots.iter())
+        {
             loss += (set_loss + cfg.union_weight * union_loss) * inv_b;
             ratio += set_loss / self.pool.conditions[*pick].baseline_loss * inv_b;
-            for (a, b) in grad.iter_mut().zip(g) {
+            for (a, b) in grad.iter_mut().zip(&slot.grad) {
                 *a += b;
             }
             if pretraining {
@@ -489,16 +489,17 @@ fn draw_instances(r: &mut impl Rng, count: usize, slots: u32) -> Vec<u32> {
 /// A pretraining step for one condition: the squared distance of the network's
 /// square points to the warp's ([`PoolCondition::warp_targets`]) for the
 /// pretraining instance `instances[j] mod PRETRAIN_INSTANCES`; returns
-/// `(mean squared distance, 0, gradient)`.
+/// `(mean squared distance, 0)` and writes the gradient into `grad`.
 fn pretrain_step(
     cfg: &TrainConfig,
     params: &Params,
     pc: &PoolCondition,
     instances: &[u32],
-) -> (f64, f64, Vec<f64>) {
+    grad: &mut [f64],
+) -> (f64, f64) {
     let n = cfg.n as usize;
     let w = 1.0 / (cfg.conditions_per_step * instances.len() * n) as f64;
-    let mut grad = vec![0.0; params.values.len()];
+    grad.fill(0.0);
     let mut loss = 0.0;
     for &r in instances {
         let k = r % pool::PRETRAIN_INSTANCES;
@@ -509,14 +510,62 @@ fn pretrain_step(
             loss += d.length_squared() / (instances.len() * n) as f64;
             let d_out = output_gradient(&t, 2.0 * w * d);
             let row = params.shape.embedding_row(k, i);
-            backward(&params.shape, &params.values, &t, row, d_out, &mut grad);
+            backward(&params.shape, &params.values, &t, row, d_out, grad);
         }
     }
-    (loss, 0.0, grad)
+    (loss, 0.0)
 }
 
-/// The sets of one condition in a batch: `(mean set loss, union loss, dL/dparams)`,
-/// the gradient already scaled by the batch's weights.
+/// Buffers that every training step reuses, so that a step allocates no
+/// large arrays: a copy of the parameters and, per condition of a batch, its
+/// forward passes and gradients. A step's memory was allocated afresh
+/// before (about 24 MB a step at N = 64, from the network's traces and a
+/// dense gradient per condition) and a quarter of training went to the
+/// kernel's page faults and the allocator. No state: the results are the
+/// same bits.
+struct StepScratch {
+    /// The parameters of the step, copied in (the forward and backward passes
+    /// read a [`Params`]).
+    params: Params,
+    /// One per condition of a batch, in batch order.
+    slots: Vec<ConditionScratch>,
+}
+
+impl StepScratch {
+    fn new(cfg: &TrainConfig, shape: Shape) -> Self {
+        let len = shape.param_len();
+        Self {
+            params: Params {
+                shape,
+                values: vec![0.0; len],
+            },
+            slots: (0..cfg.conditions_per_step)
+                .map(|_| ConditionScratch {
+                    grad: vec![0.0; len],
+                    ..ConditionScratch::default()
+                })
+                .collect(),
+        }
+    }
+}
+
+/// One condition's buffers in a step ([`condition_step`]).
+#[derive(Default)]
+struct ConditionScratch {
+    traces: Vec<Trace<f64>>,
+    jacobians: Vec<(DVec3, DVec3)>,
+    dirs: Vec<DVec3>,
+    local: Vec<f64>,
+    grad3: Vec<DVec3>,
+    g: Vec<DVec3>,
+    caps: Vec<Cap>,
+    mu: Vec<f64>,
+    /// `dL/dparams` of the condition, already scaled by the batch's weights.
+    grad: Vec<f64>,
+}
+
+/// The sets of one condition in a batch: `(mean set loss, union loss)`, and
+/// `dL/dparams` in `scratch.grad`, already scaled by the batch's weights.
 fn condition_step(
     cfg: &TrainConfig,
     params: &Params,
@@ -524,17 +573,31 @@ fn condition_step(
     instances: &[u32],
     start: usize,
     alpha: f64,
-) -> (f64, f64, Vec<f64>) {
+    scratch: &mut ConditionScratch,
+) -> (f64, f64) {
     let n = cfg.n as usize;
     let s = instances.len();
     let b = cfg.conditions_per_step as f64;
     let m = cfg.caps_per_step.min(pc.caps.len());
+    let ConditionScratch {
+        traces,
+        jacobians,
+        dirs,
+        local,
+        grad3,
+        g,
+        caps,
+        mu,
+        grad,
+    } = scratch;
     let idx = |j: usize| (start + j) % pc.caps.len();
-    let caps: Vec<Cap> = (0..m).map(|j| pc.caps[idx(j)]).collect();
-    let mu: Vec<f64> = (0..m).map(|j| pc.measures[idx(j)]).collect();
-    let mut traces = Vec::with_capacity(s * n);
-    let mut jacobians = Vec::with_capacity(s * n);
-    let mut dirs = Vec::with_capacity(s * n);
+    caps.clear();
+    caps.extend((0..m).map(|j| pc.caps[idx(j)]));
+    mu.clear();
+    mu.extend((0..m).map(|j| pc.measures[idx(j)]));
+    traces.clear();
+    jacobians.clear();
+    dirs.clear();
     for &k in instances {
         for i in 0..cfg.n {
             let t = params.trace(pc.unit, pc.metallic, k, i);
@@ -545,17 +608,20 @@ fn condition_step(
             dirs.push(d);
         }
     }
-    let local: Vec<f64> = dirs.iter().map(|&x| pc.local_factor(x)).collect();
+    local.clear();
+    local.extend(dirs.iter().map(|&x| pc.local_factor(x)));
     let spacing = |points: usize| (pc.domain.area() / points as f64).sqrt();
-    let mut grad3 = vec![DVec3::ZERO; s * n];
-    let mut g = vec![DVec3::ZERO; s * n];
+    grad3.clear();
+    grad3.resize(s * n, DVec3::ZERO);
+    g.clear();
+    g.resize(s * n, DVec3::ZERO);
     let mut set_loss = 0.0;
     for j in 0..s {
         let range = j * n..(j + 1) * n;
         set_loss += cap_loss_and_gradient(
             &dirs[range.clone()],
-            &caps,
-            CapArea::Precomputed(&mu),
+            caps,
+            CapArea::Precomputed(mu),
             alpha / spacing(n),
             Some(&local[range.clone()]),
             GradientPath::Fast,
@@ -570,26 +636,31 @@ fn condition_step(
     let mut union_loss = 0.0;
     if cfg.union_weight > 0.0 {
         union_loss = cap_loss_and_gradient(
-            &dirs,
-            &caps,
-            CapArea::Precomputed(&mu),
+            dirs,
+            caps,
+            CapArea::Precomputed(mu),
             alpha / spacing(s * n),
-            Some(&local),
+            Some(local),
             GradientPath::Fast,
-            &mut g,
+            g,
         );
         let w = cfg.union_weight / b;
-        for (a, &x) in grad3.iter_mut().zip(&g) {
+        for (a, &x) in grad3.iter_mut().zip(g.iter()) {
             *a += w * x;
         }
     }
-    let mut grad = vec![0.0; params.values.len()];
-    for (j, ((t, &(jx, jy)), &g3)) in traces.iter().zip(&jacobians).zip(&grad3).enumerate() {
+    grad.fill(0.0);
+    for (j, ((t, &(jx, jy)), &g3)) in traces
+        .iter()
+        .zip(jacobians.iter())
+        .zip(grad3.iter())
+        .enumerate()
+    {
         let d_out = output_gradient(t, DVec2::new(jx.dot(g3), jy.dot(g3)));
         let row = params.shape.embedding_row(instances[j / n], (j % n) as u32);
-        backward(&params.shape, &params.values, t, row, d_out, &mut grad);
+        backward(&params.shape, &params.values, t, row, d_out, grad);
     }
-    (set_loss, union_loss, grad)
+    (set_loss, union_loss)
 }
 
 #[cfg(test)]
