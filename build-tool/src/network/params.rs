@@ -53,6 +53,16 @@ impl Params {
         )
     }
 
+    /// [`Self::trace`] written into `trace` ([`Network::forward_into`]: the
+    /// same bits, no 3 kB trace cleared and moved per point).
+    pub fn trace_into(&self, c: [f64; 2], m: f64, k: u32, i: u32, trace: &mut Trace<f64>) {
+        self.network().forward_into(
+            self.shape.embedding_row(k, i),
+            input_features(&self.shape, c, m, k, i),
+            trace,
+        )
+    }
+
     /// The point of the unit square of index `i`, instance `k`, normalized condition
     /// `c` and metallic `m`: [`Network::square_point`], the same bits as
     /// `self.trace(c, m, k, i).square_point()` without recording a [`Trace`].

@@ -82,6 +82,14 @@ fn forward_equals_explicit_matrix_products() {
         assert!(close(&t.pre[0][..3], &h1, 1e-14));
         assert!(close(&t.pre[1][..2], &h2, 1e-14));
         assert!(close(&t.output, &out, 1e-14));
+        // Into a trace that holds another pass's values: every value a
+        // backward pass reads is overwritten with the same bits.
+        let mut into = net.forward(1, x.map(|v| 2.0 - v));
+        net.forward_into(i, x, &mut into);
+        assert_eq!(into.input.map(f64::to_bits), t.input.map(f64::to_bits));
+        assert_eq!(into.pre[0][..3], t.pre[0][..3]);
+        assert_eq!(into.pre[1][..2], t.pre[1][..2]);
+        assert_eq!(into.output.map(f64::to_bits), t.output.map(f64::to_bits));
     }
 }
 
