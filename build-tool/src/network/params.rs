@@ -47,10 +47,9 @@ impl Params {
     /// metallic `m` (read only by a shape with
     /// [`Shape::metallic_input`]).
     pub fn trace(&self, c: [f64; 2], m: f64, k: u32, i: u32) -> Trace<f64> {
-        self.network().forward(
-            self.shape.embedding_row(k, i),
-            input_features(&self.shape, c, m, k, i),
-        )
+        let mut trace = Trace::default();
+        self.trace_into(c, m, k, i, &mut trace);
+        trace
     }
 
     /// [`Self::trace`] written into `trace` ([`Network::forward_into`]: the

@@ -67,6 +67,7 @@ impl EpochLoss<f64> for BatchLoss<'_> {
             .zip(slots.par_iter_mut())
             .map(|((pick, instances, start), slot)| {
                 let pc = &self.pool.conditions[*pick];
+                slot.grad.fill(0.0);
                 if pretraining {
                     return pretrain_step(cfg, params, pc, instances, &mut slot.grad);
                 }
@@ -118,7 +119,7 @@ pub(super) fn draw_instances(r: &mut impl Rng, count: usize, slots: u32) -> Vec<
 /// A pretraining step for one condition: the squared distance of the network's
 /// square points to the warp's ([`PoolCondition::warp_targets`]) for the
 /// pretraining instance `instances[j] mod PRETRAIN_INSTANCES`; returns
-/// `(mean squared distance, 0)` and writes the gradient into `grad`.
+/// `(mean squared distance, 0)` and adds the gradient into `grad`.
 fn pretrain_step(
     cfg: &TrainConfig,
     params: &Params,
@@ -128,7 +129,6 @@ fn pretrain_step(
 ) -> (f64, f64) {
     let n = cfg.n as usize;
     let w = 1.0 / (cfg.conditions_per_step * instances.len() * n) as f64;
-    grad.fill(0.0);
     let mut loss = 0.0;
     for &r in instances {
         let k = r % pool::PRETRAIN_INSTANCES;
@@ -189,12 +189,14 @@ struct ConditionScratch {
     g: Vec<DVec3>,
     caps: Vec<Cap>,
     mu: Vec<f64>,
-    /// `dL/dparams` of the condition, already scaled by the batch's weights.
+    /// `dL/dparams` of the condition, already scaled by the batch's weights
+    /// (cleared by the step before each condition adds into it).
     grad: Vec<f64>,
 }
 
 /// The sets of one condition in a batch: `(mean set loss, union loss)`, and
-/// `dL/dparams` in `scratch.grad`, already scaled by the batch's weights.
+/// `dL/dparams` added into `scratch.grad`, already scaled by the batch's
+/// weights.
 fn condition_step(
     cfg: &TrainConfig,
     params: &Params,
@@ -280,7 +282,6 @@ fn condition_step(
             *a += w * x;
         }
     }
-    grad.fill(0.0);
     for (j, ((t, &(jx, jy)), &g3)) in traces
         .iter()
         .zip(jacobians.iter())
