@@ -13,44 +13,33 @@ use std::f64::consts::TAU;
 impl EnvmapDensity {
     /// `∫ L(l) max(0, n.l) dl` for the unit normal `n`: the irradiance at a
     /// surface facing `n` (luminance units), `Σ L_p Ω_p max(0, n.c_p)` over the
-    /// pixels with `c_p` the pixel's centre. `O(W H)`; [`Self::irradiances`] for
-    /// many normals.
+    /// pixels with `c_p` the pixel's centre. `O(W H)` the first time (the blocks
+    /// of [`Self::irradiances`]), then a block per `16 x 16` cells and the cells
+    /// along the horizon.
     pub fn irradiance(&self, n: DVec3) -> f64 {
         self.irradiances(&[n])[0]
     }
 
-    /// [`Self::irradiance`] at each of `normals`, the pixel centres computed once
-    /// (pixels without light skipped), the normals in parallel (each sum in pixel
-    /// order, so the values do not depend on the thread count).
-    /// `O(W H + lit pixels x normals)`.
+    /// [`Self::irradiance`] at each of `normals`, in parallel (each normal's sum
+    /// in a fixed order, so the values do not depend on the thread count).
+    ///
+    /// Each sum runs over blocks of 16 x 16 cells (built on first use): a block
+    /// whose lit cell centres all lie above the normal's horizon adds
+    /// `n . Σ mass c_p` (the same sum,
+    /// `max` never clipping, in another order of operations), one below it
+    /// nothing, and only the blocks the horizon crosses add their cells one by
+    /// one. On a 2048 x 1024 cell map that is about a twentieth of the cells
+    /// (a bake's 64 x 64 irradiance table read every cell of the map 4096 times).
+    /// Equal to the pixel-order sum to rounding: the blocks kept whole have every
+    /// cell at least `1e-3` above the horizon (in `n . c_p`), so no term is small
+    /// against the rounding of the others. `O(blocks + horizon cells)` a normal.
     pub fn irradiances(&self, normals: &[DVec3]) -> Vec<f64> {
-        let w = self.width;
-        let lit: Vec<(DVec3, f64)> = (0..self.height)
-            .flat_map(|r| (0..w).map(move |c| (c, r)))
-            .filter(|&(c, r)| self.mass[r * w + c] > 0.0)
-            .map(|(c, r)| (self.pixel_center(c, r), self.mass[r * w + c]))
-            .collect();
-        // Normals in groups, each pixel read once per group: every normal's sum is
-        // still one chain in pixel order (the same bits as summing it alone), and
-        // the group's chains overlap where one would wait on each addition. The
-        // lit cells (64 MB for a 1024 x 512 map's four cells a pixel) come from
-        // memory once per group, so a wide group reads them fewer times (16: a
-        // bake's 64 x 64 irradiance table in 2.9 s, 4: 4.0 s).
-        const GROUP: usize = 16;
+        let blocks = self
+            .irradiance_blocks
+            .get_or_init(|| IrradianceBlocks::new(self));
         normals
-            .par_chunks(GROUP)
-            .flat_map_iter(|group| {
-                let mut share = [-0.0f64; GROUP];
-                for (d, m) in &lit {
-                    for (s, n) in share.iter_mut().zip(group) {
-                        *s += m * n.dot(*d).max(0.0);
-                    }
-                }
-                share
-                    .into_iter()
-                    .take(group.len())
-                    .map(|s| self.integral * s)
-            })
+            .par_iter()
+            .map(|&n| self.integral * blocks.lit_sum(self, n))
             .collect()
     }
 
@@ -91,5 +80,110 @@ impl EnvmapDensity {
         let lit = Self::from_owned_luminance(img, Domain::Sphere, &self.name)?;
         let irradiance = if dark { 0.0 } else { lit.integral };
         Ok((lit, irradiance))
+    }
+}
+
+/// Cells per side of an [`IrradianceBlocks`] block: 16 x 16 cells of a
+/// 2048 x 1024 map are 8192 blocks, of which a horizon crosses a few hundred.
+const IRRADIANCE_BLOCK: usize = 16;
+
+/// How far above a normal's horizon (in `n . l`) every lit cell centre of a block
+/// must lie for the block to add its first moment in one dot product: `n . Σ m c`
+/// then sums terms of at least this size, whose rounding stays within about
+/// `1e-13` of the block's share.
+const HORIZON_MARGIN: f64 = 1e-3;
+
+/// A map's cells in square blocks, each with what [`EnvmapDensity::irradiances`]
+/// needs to take it whole: the first moment of its light and a cone about its
+/// cell centres.
+#[derive(Clone, Debug)]
+pub(super) struct IrradianceBlocks {
+    blocks: Vec<Block>,
+}
+
+/// One block of [`IrradianceBlocks`].
+#[derive(Clone, Debug)]
+struct Block {
+    /// First cell row and column; the block ends at the map's edge or
+    /// [`IRRADIANCE_BLOCK`] cells on.
+    row: usize,
+    col: usize,
+    /// `Σ mass c_p` over the block's lit cells.
+    moment: DVec3,
+    /// The unit axis of the cone (the mean of the lit cell centres).
+    axis: DVec3,
+    /// `sin r` for the cone's half-angle `r` (the largest angle from the axis to
+    /// a lit cell centre); 2 where `r` reaches 90°, so that no normal sees the
+    /// block whole.
+    sin_radius: f64,
+}
+
+impl IrradianceBlocks {
+    /// The blocks of `map` that hold light, in row-major block order.
+    fn new(map: &EnvmapDensity) -> Self {
+        let (w, h, b) = (map.width, map.height, IRRADIANCE_BLOCK);
+        let cells = |row: usize, col: usize| {
+            (row..(row + b).min(h))
+                .flat_map(move |r| (col..(col + b).min(w)).map(move |c| (c, r)))
+                .filter(|&(c, r)| map.mass[r * w + c] > 0.0)
+        };
+        let corners: Vec<(usize, usize)> = (0..h.div_ceil(b))
+            .flat_map(|by| (0..w.div_ceil(b)).map(move |bx| (by * b, bx * b)))
+            .collect();
+        let blocks = corners
+            .par_iter()
+            .filter_map(|&(row, col)| {
+                let mut moment = DVec3::ZERO;
+                let mut sum = DVec3::ZERO;
+                for (c, r) in cells(row, col) {
+                    let d = map.pixel_center(c, r);
+                    moment += map.mass[r * w + c] * d;
+                    sum += d;
+                }
+                let axis = sum.try_normalize()?;
+                let min_cos = cells(row, col)
+                    .map(|(c, r)| axis.dot(map.pixel_center(c, r)))
+                    .fold(1.0f64, f64::min);
+                let sin_radius = match min_cos > 0.0 {
+                    true => (1.0 - min_cos * min_cos).max(0.0).sqrt(),
+                    false => 2.0,
+                };
+                Some(Block {
+                    row,
+                    col,
+                    moment,
+                    axis,
+                    sin_radius,
+                })
+            })
+            .collect();
+        Self { blocks }
+    }
+
+    /// `Σ mass max(0, n . c_p)` over `map`'s lit cells (the masses normalized to
+    /// 1), block by block in order: with `a` the angle from `n` to a block's axis
+    /// and `r` its radius, `cos a > sin r + margin` puts every cell centre more
+    /// than the margin above the horizon (`a + r < 90°` by at least that), and
+    /// `cos a < -(sin r + margin)` every one below it.
+    fn lit_sum(&self, map: &EnvmapDensity, n: DVec3) -> f64 {
+        let (w, h, b) = (map.width, map.height, IRRADIANCE_BLOCK);
+        let mut sum = -0.0;
+        for block in &self.blocks {
+            let cos_a = n.dot(block.axis);
+            let bound = block.sin_radius + HORIZON_MARGIN;
+            if cos_a > bound {
+                sum += n.dot(block.moment);
+            } else if cos_a >= -bound {
+                for r in block.row..(block.row + b).min(h) {
+                    for c in block.col..(block.col + b).min(w) {
+                        let m = map.mass[r * w + c];
+                        if m > 0.0 {
+                            sum += m * n.dot(map.pixel_center(c, r)).max(0.0);
+                        }
+                    }
+                }
+            }
+        }
+        sum
     }
 }

@@ -116,6 +116,9 @@ pub struct EnvmapDensity {
     /// The rule of [`Self::cap_measure_profile`], built on first use: a bake
     /// builds a lit map per normal and never asks most of them for a profile.
     profile_rule: OnceLock<Vec<(DVec3, f64)>>,
+    /// The blocks of [`Self::irradiances`], built on first use: only the maps
+    /// whose irradiance is asked for (a bake's weight table, a render's light).
+    irradiance_blocks: OnceLock<irradiance::IrradianceBlocks>,
     negative: NegativePixels,
 }
 
@@ -273,6 +276,7 @@ impl EnvmapDensity {
             col_trig,
             row_trig,
             profile_rule: OnceLock::new(),
+            irradiance_blocks: OnceLock::new(),
             negative,
         })
     }
