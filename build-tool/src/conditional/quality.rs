@@ -9,7 +9,9 @@
 //!   environment sampler the target is the map lit through the cosine about the
 //!   normal ([`crate::sphere::EnvmapDensity::cosine_weighted`], caps measured by its exact
 //!   quadrature) and the warp that lit map's inverse CDF, which is what a renderer
-//!   sampling the map for this one normal could do at best;
+//!   sampling the map for this one normal could do at best; a map of more than
+//!   2048 x 1024 cells is lit through the training pool's box-filtered copy
+//!   ([`EnvmapTarget::coarse_map`]), as the pool lights it;
 //! * **diversity**: `D_cap,2` of the union of many instances over the mean of a
 //!   single instance's (independent sets: about `1/sqrt(instances)`; identical
 //!   sets: 1), and the mean angle from a point of one instance to the nearest point
@@ -237,7 +239,11 @@ impl HeldOut {
             }
             LoadedTarget::Envmap(env) => {
                 let normal = square_to_sphere(DVec2::from(cond));
-                let (lit, irradiance) = env.map.cosine_weighted(normal)?;
+                // Lit on the pool's copy: the map itself up to 2048 x 1024 cells;
+                // a larger map's blocks of cells keep their mass, finer than any
+                // cap of an N = 64 set sees, and lighting every cell of an
+                // 8192 x 4096 map took the check three and a half minutes.
+                let (lit, irradiance) = env.coarse_map().cosine_weighted(normal)?;
                 (irradiance > 0.0).then(|| Self {
                     unit,
                     cond,
@@ -411,6 +417,56 @@ mod tests {
             assert!(c.ratio > 2.0, "{c:?}");
             assert!((c.union_ratio - 1.0).abs() < 1e-12, "{c:?}");
             assert_eq!(c.nn_ratio, 0.0, "{c:?}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A map over the coarse copy's limit is judged, like the pool lights it,
+    /// through the copy: a held-out normal's target is the copy lit through the
+    /// normal's cosine (its cap measures bit for bit), not the map's every cell,
+    /// whose sharp light measures otherwise; within the limit the map itself.
+    #[test]
+    fn a_large_maps_check_lights_the_coarse_copy() {
+        let dir = std::env::temp_dir().join(format!("nuld-quality-coarse-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("spots.png");
+        image::RgbImage::from_fn(64, 32, |x, y| {
+            let v = if (x * 7 + y * 3) % 11 == 0 { 255 } else { 3 };
+            image::Rgb([v; 3])
+        })
+        .save(&path)
+        .unwrap();
+        let loaded = TrainTarget::envmap(&path).unwrap().load().unwrap();
+        let LoadedTarget::Envmap(env) = &loaded else {
+            panic!("an envmap target");
+        };
+        let cells = env.map.width() * env.map.height();
+        let (map, tree) = (env.map.clone(), env.tree.clone());
+        let cond = [0.375, 0.625];
+        let normal = square_to_sphere(DVec2::from(cond));
+        let caps: Vec<(DVec3, f64)> = (0..32)
+            .map(|k| {
+                let t = 0.1 + 0.09 * k as f64;
+                (
+                    DVec3::new(t.cos(), t.sin(), 0.3 - 0.02 * k as f64).normalize(),
+                    (0.2 * t).cos(),
+                )
+            })
+            .collect();
+        let measures = |d: &dyn DirectionDensity| -> Vec<u64> {
+            caps.iter()
+                .map(|&(c, t)| d.cap_measure(c, t).to_bits())
+                .collect()
+        };
+        for (limit, coarse) in [(cells, false), (cells / 4, true)] {
+            let env = EnvmapTarget::with_coarse_cells(map.clone(), tree.clone(), limit);
+            let judged = env.coarse_map().cosine_weighted(normal).unwrap().0;
+            let whole = env.map.cosine_weighted(normal).unwrap().0;
+            let target = LoadedTarget::Envmap(Arc::new(env));
+            let held = HeldOut::new(&target, cond, 0.0).unwrap().unwrap();
+            let got = measures(held.density.as_ref());
+            assert_eq!(got, measures(&judged), "limit {limit}");
+            assert_eq!(got != measures(&whole), coarse, "limit {limit}");
         }
         std::fs::remove_dir_all(&dir).unwrap();
     }

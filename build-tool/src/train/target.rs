@@ -142,10 +142,11 @@ impl EnvmapTarget {
 
     /// The density the bake lights through each pool normal's cosine (the
     /// training's caps, baselines and target) and sums for the irradiance
-    /// table: the map itself up to [`COARSE_CELLS`] cells (a 1024 x 512 map or
-    /// smaller: the same bits as before the copy existed), a box-filtered copy of
-    /// a larger one, whose blocks keep their cells' mass. The prior's tree and
-    /// the quality check read [`Self::map`], every cell.
+    /// table, and that the quality check lights for its held-out normals: the
+    /// map itself up to [`COARSE_CELLS`] cells (a 1024 x 512 map or smaller: the
+    /// same bits as before the copy existed), a box-filtered copy of a larger
+    /// one, whose blocks keep their cells' mass. The prior's tree reads
+    /// [`Self::map`], every cell.
     pub fn coarse_map(&self) -> &EnvmapDensity {
         self.coarse.as_ref().unwrap_or(&self.map)
     }

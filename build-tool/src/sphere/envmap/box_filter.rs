@@ -7,8 +7,9 @@
 //! times a 1024 x 512 map's: its pool took 182 s and its irradiance table 50 s
 //! where the shared maps take 12 s and 3 s. Those phases read the map through
 //! sums over caps and over the sphere, which a block's mass serves as well as
-//! its cells' do, so they read the copy this module makes, while the prior's tree
-//! and the quality check keep every cell (docs/results/envmap.md#large-maps).
+//! its cells' do, so they read the copy this module makes, as does the bake's
+//! quality check, while the prior's tree keeps every cell
+//! (docs/results/envmap.md#large-maps, #coarse-check).
 
 use super::EnvmapDensity;
 use crate::density::image::LuminanceImage;
