@@ -3,6 +3,7 @@
 
 use crate::baselines::Baseline;
 use crate::discrepancy::GradientPath;
+use crate::lab::bench::rounds::ROUNDS;
 use crate::lab::bench::{baselines, envmap_prior, optimizer, runtime, training};
 use crate::optimize::directions::DirectionConfig;
 use crate::optimize::{AreaOption, OptimizeConfig};
@@ -175,14 +176,15 @@ fn run_training() -> Result<()> {
     Ok(())
 }
 
-/// Samples timed per method (a tenth of it in network mode).
-const RUNTIME_SAMPLES: u32 = 2_000_000;
+/// Samples timed per method over its rounds (a tenth of it in network mode):
+/// half a million a round.
+const RUNTIME_SAMPLES: u32 = 500_000 * ROUNDS;
 
 /// Nanoseconds per sample of the conditional sampler's modes and of the incumbent,
 /// one thread, with each method's ratio to the incumbent (direction only).
 fn run_runtime() -> Result<()> {
     let t = runtime::measure(RUNTIME_SAMPLES)?;
-    println!("runtime ns per sample, one thread, n = 64 (best of 3)");
+    println!("runtime ns per sample, one thread, n = 64 (median of {ROUNDS} interleaved rounds)");
     println!("{:<68} {:>10} {:>12}", "method", "ns/sample", "/ incumbent");
     let base = t.rows.first().map_or(f64::NAN, |r| r.1);
     for (name, ns) in &t.rows {
@@ -200,7 +202,7 @@ fn run_envmap_prior(a: &BenchArgs) -> Result<()> {
     )?;
     let rows = envmap_prior::measure(&map, RUNTIME_SAMPLES)?;
     println!(
-        "environment prior ns per sample, one thread, {}, n = 64 (best of 3)",
+        "environment prior ns per sample, one thread, {}, n = 64 (median of {ROUNDS} interleaved rounds)",
         a.envmap.display()
     );
     println!("{:<52} {:>10} {:>12}", "method", "ns/sample", "/ incumbent");

@@ -7,7 +7,8 @@
 //! through the map's luminance inverse CDF ([`EnvmapDensity`]'s warp, which
 //! ignores the cosine).
 
-use super::runtime::{envmap_parts, ns_per_sample, random_parts, random_shape};
+use super::rounds::Rounds;
+use super::runtime::{envmap_parts, random_parts, random_shape};
 use crate::sphere::envmap_tree::{prior_levels, PRIOR_GRID};
 use crate::sphere::{DirectionDensity, EnvmapDensity, EnvmapTree};
 use anyhow::{anyhow, Result};
@@ -32,8 +33,9 @@ const N: u32 = 64;
 const SHALLOW_LEVELS: u32 = 5;
 
 /// `(method, ns per sample)` rows, the incumbent first, over `samples` samples
-/// each, one thread: sample `s` has normal `s / N mod 64`, and index `s mod N` of
-/// the set scrambled by `s / N`.
+/// each, one thread, the methods taking turns over the rounds of [`Rounds`]
+/// (each figure the median of its rounds): sample `s` has normal `s / N mod 64`,
+/// and index `s mod N` of the set scrambled by `s / N`.
 pub fn measure(map: &EnvmapDensity, samples: u32) -> Result<Vec<(String, f64)>> {
     // The environment sampler's own tree of this map.
     let (levels, grid) = (prior_levels(map), PRIOR_GRID);
@@ -59,46 +61,11 @@ pub fn measure(map: &EnvmapDensity, samples: u32) -> Result<Vec<(String, f64)>> 
             sobol_burley::sample(s % N, 1, seed),
         ]
     };
-    let mut rows = Vec::new();
-    rows.push((
-        "incumbent: owen-sobol + luminance inverse CDF (f64)".to_string(),
-        ns_per_sample(samples, |s| {
-            let [x, y] = u(s);
-            black_box(map.sample(DVec2::new(x as f64, y as f64)));
-        }),
-    ));
-    rows.push((
-        format!("tree L {levels}, top {grid}: sample + pdf (f32)"),
-        ns_per_sample(samples, |s| {
-            black_box(core.sample(normals32[at(s)], u(s)));
-        }),
-    ));
-    rows.push((
-        format!("tree L {levels}, top {grid}: pdf of a direction (f32)"),
-        ns_per_sample(samples, |s| {
-            let [x, y] = u(s);
-            let d = nuld_core::sphere::square_to_sphere_real([x, y]);
-            black_box(core.pdf(normals32[at(s)], d));
-        }),
-    ));
-    rows.push((
-        format!("tree L {levels}, top {grid}: sample + pdf (f64)"),
-        ns_per_sample(samples / 4, |s| {
-            let [x, y] = u(s);
-            black_box(core.sample(normals[at(s)].to_array(), [x as f64, y as f64]));
-        }),
-    ));
     // A shallow tree of the same map, whose records (87 KB) stay in the caches:
     // the difference per level from the deep one tells cache misses from the
     // descent's own latency.
     let shallow = EnvmapTree::new(map, SHALLOW_LEVELS, grid)?;
     let shallow_core = shallow.tree();
-    rows.push((
-        format!("tree L {SHALLOW_LEVELS} (in cache), top {grid}: sample + pdf (f32)"),
-        ns_per_sample(samples, |s| {
-            black_box(shallow_core.sample(normals32[at(s)], u(s)));
-        }),
-    ));
     // The default bake's sampler: [32, 32] ReLU, 64 slots, 64 instances on 13 x
     // 13 normals.
     let defaults = crate::conditional::bake::BakeConfig::default();
@@ -125,42 +92,80 @@ pub fn measure(map: &EnvmapDensity, samples: u32) -> Result<Vec<(String, f64)>> 
         .map_err(|e| anyhow!("{e}"))?
         .envmap()
         .map_err(|e| anyhow!("{e}"))?;
-    let normals32: Vec<Vec3> = normals32.iter().map(|&n| Vec3::from(n)).collect();
-    rows.push((
-        "EnvmapSampler::sample (table mode)".to_string(),
-        ns_per_sample(samples, |s| {
-            black_box(env.sample(normals32[at(s)], s / N, s % N));
-        }),
-    ));
-    rows.push((
-        "EnvmapSampler::sample_randomized (unbiased mode)".to_string(),
-        ns_per_sample(samples, |s| {
-            black_box(env.sample_randomized(normals32[at(s)], s / N, s % N, s));
-        }),
-    ));
-    rows.push((
-        "EnvmapSampler::pdf of a direction".to_string(),
-        ns_per_sample(samples, |s| {
-            let [x, y] = u(s);
-            let d = Vec3::from(nuld_core::sphere::square_to_sphere_real([x, y]));
-            black_box(env.pdf(normals32[at(s)], d));
-        }),
-    ));
-    rows.push((
-        "network: zero-copy, EnvmapNetwork::sample".to_string(),
-        ns_per_sample(samples / 10, |s| {
-            black_box(env.network().sample(normals32[at(s)], s / N, s % N));
-        }),
-    ));
+    let normals_v: Vec<Vec3> = normals32.iter().map(|&n| Vec3::from(n)).collect();
     let mut buf = vec![0.0f32; env.decoded_network_len()];
     let decoded = env
         .decode_network(&mut buf)
         .ok_or_else(|| anyhow!("decode_network refused a buffer of its own length"))?;
-    rows.push((
-        "network: decoded, EnvmapNetwork::sample".to_string(),
-        ns_per_sample(samples / 10, |s| {
-            black_box(decoded.sample(normals32[at(s)], s / N, s % N));
-        }),
-    ));
-    Ok(rows)
+
+    let mut rounds = Rounds::new();
+    rounds.add(
+        "incumbent: owen-sobol + luminance inverse CDF (f64)",
+        samples,
+        |s| {
+            let [x, y] = u(s);
+            black_box(map.sample(DVec2::new(x as f64, y as f64)));
+        },
+    );
+    rounds.add(
+        format!("tree L {levels}, top {grid}: sample + pdf (f32)"),
+        samples,
+        |s| {
+            black_box(core.sample(normals32[at(s)], u(s)));
+        },
+    );
+    rounds.add(
+        format!("tree L {levels}, top {grid}: pdf of a direction (f32)"),
+        samples,
+        |s| {
+            let [x, y] = u(s);
+            let d = nuld_core::sphere::square_to_sphere_real([x, y]);
+            black_box(core.pdf(normals32[at(s)], d));
+        },
+    );
+    rounds.add(
+        format!("tree L {levels}, top {grid}: sample + pdf (f64)"),
+        samples / 4,
+        |s| {
+            let [x, y] = u(s);
+            black_box(core.sample(normals[at(s)].to_array(), [x as f64, y as f64]));
+        },
+    );
+    rounds.add(
+        format!("tree L {SHALLOW_LEVELS} (in cache), top {grid}: sample + pdf (f32)"),
+        samples,
+        |s| {
+            black_box(shallow_core.sample(normals32[at(s)], u(s)));
+        },
+    );
+    rounds.add("EnvmapSampler::sample (table mode)", samples, |s| {
+        black_box(env.sample(normals_v[at(s)], s / N, s % N));
+    });
+    rounds.add(
+        "EnvmapSampler::sample_randomized (unbiased mode)",
+        samples,
+        |s| {
+            black_box(env.sample_randomized(normals_v[at(s)], s / N, s % N, s));
+        },
+    );
+    rounds.add("EnvmapSampler::pdf of a direction", samples, |s| {
+        let [x, y] = u(s);
+        let d = Vec3::from(nuld_core::sphere::square_to_sphere_real([x, y]));
+        black_box(env.pdf(normals_v[at(s)], d));
+    });
+    rounds.add(
+        "network: zero-copy, EnvmapNetwork::sample",
+        samples / 10,
+        |s| {
+            black_box(env.network().sample(normals_v[at(s)], s / N, s % N));
+        },
+    );
+    rounds.add(
+        "network: decoded, EnvmapNetwork::sample",
+        samples / 10,
+        |s| {
+            black_box(decoded.sample(normals_v[at(s)], s / N, s % N));
+        },
+    );
+    Ok(rounds.run())
 }

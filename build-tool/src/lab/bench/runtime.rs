@@ -7,6 +7,7 @@
 //! Speed does not depend on the network's or the table's values, so the samplers
 //! are timed on blobs with random contents ([`random_parts`]).
 
+use super::rounds::Rounds;
 use crate::conditional::blob::{ConditionalParts, MetalParts, Prior};
 use crate::conditional::distill::info;
 use crate::pointset::AlignedBytes;
@@ -23,7 +24,6 @@ use nuld_runtime::Blob;
 use rand::{Rng, SeedableRng};
 use std::hint::black_box;
 use std::sync::Arc;
-use std::time::Instant;
 
 /// The network shape of [`random_parts`]: `n` points, the given hidden widths (1
 /// to 3) and activation, a lattice residual for every warp but the equal-area
@@ -164,7 +164,7 @@ fn sampler(b: &AlignedBytes) -> Result<nuld_runtime::BrdfSampler<'_>> {
 /// Nanoseconds per sample of each method, one thread.
 #[derive(Clone, Debug)]
 pub struct RuntimeTimings {
-    /// `(method, ns per sample)`, the incumbent first.
+    /// `(method, median ns per sample over the rounds)`, the incumbent first.
     pub rows: Vec<(String, f64)>,
 }
 
@@ -177,26 +177,9 @@ const CONDITIONS: usize = 64;
 /// one spares building 64 rules of `2^18` points (seconds) for nothing.
 const INCUMBENT_RULE_POINTS: usize = 1 << 10;
 
-/// Times of each method are the best of this many repeats (the least disturbed by
-/// other work on the machine).
-const REPEATS: usize = 3;
-
-/// Best-of-[`REPEATS`] nanoseconds per call of `f(sample number)` over `count`
-/// calls (every runtime timing of `bench`).
-pub(crate) fn ns_per_sample(count: u32, mut f: impl FnMut(u32)) -> f64 {
-    let mut best = f64::INFINITY;
-    for _ in 0..REPEATS {
-        let t = Instant::now();
-        for s in 0..count {
-            f(black_box(s));
-        }
-        best = best.min(t.elapsed().as_secs_f64() * 1e9 / count as f64);
-    }
-    best
-}
-
 /// Times, one thread, `samples` samples per method (a tenth of it for network
-/// mode): the incumbent (direction only, and with its estimator weight
+/// mode), the methods taking turns over [`super::rounds::ROUNDS`] rounds
+/// ([`Rounds`]; each figure the median of its rounds): the incumbent (direction only, and with its estimator weight
 /// `f cos / p` as a renderer needs it), table mode (`sample` and `sample_brdf`;
 /// on the BRDF mixture prior of earlier blobs, and on the default bake's
 /// tabulated prior with metallic 0, 0.5 and 1 in turn, also its unbiased mode and
@@ -248,8 +231,6 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
     );
     let (relu, silu) = (sampler(&relu)?, sampler(&silu)?);
     let at = |s: u32| (s as usize / n as usize) % CONDITIONS;
-    let mut rows = Vec::new();
-
     let incumbent_u = |s: u32| {
         let seed = nuld_core::network::hash_u32(s / n);
         DVec2::new(
@@ -257,32 +238,6 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
             sobol_burley::sample(s % n, 1, seed) as f64,
         )
     };
-    rows.push((
-        "incumbent: owen-sobol + mixture warp (f64)".into(),
-        ns_per_sample(samples, |s| {
-            black_box(targets[at(s)].sample(incumbent_u(s)));
-        }),
-    ));
-    rows.push((
-        "incumbent + weight f cos / p (f64)".into(),
-        ns_per_sample(samples, |s| {
-            let t = &targets[at(s)];
-            let d: DVec3 = t.sample(incumbent_u(s));
-            black_box((d, t.pdf(d) * t.albedo() / t.sample_pdf(d)));
-        }),
-    ));
-    rows.push((
-        "table: ConditionalSampler::sample".into(),
-        ns_per_sample(samples, |s| {
-            black_box(relu.conditional().sample(conds[at(s)], s / n, s % n));
-        }),
-    ));
-    rows.push((
-        "table: BrdfSampler::sample".into(),
-        ns_per_sample(samples, |s| {
-            black_box(relu.sample(views[at(s)], conds[at(s)].x, 0.0, s / n, s % n));
-        }),
-    ));
     // The default bake's sampler: the tabulated prior (shared, 17.8 MB), the
     // metal points and the default metallic axis (a query between two nodes
     // reads two layers), metallic 0, 0.5 and 1 in turn.
@@ -295,56 +250,87 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
     };
     let prior = sampler(&table_blob)?;
     let metallic = |s: u32| [0.0, 0.5, 1.0][(s / n) as usize % 3];
-    rows.push((
-        "tabulated prior, table: BrdfSampler::sample".into(),
-        ns_per_sample(samples, |s| {
-            let (v, r) = (views[at(s)], conds[at(s)].x);
-            black_box(prior.sample(v, r, metallic(s), s / n, s % n));
-        }),
-    ));
-    rows.push((
-        "tabulated prior, table: BrdfSampler::sample_randomized".into(),
-        ns_per_sample(samples, |s| {
-            let (v, r) = (views[at(s)], conds[at(s)].x);
-            black_box(prior.sample_randomized(v, r, metallic(s), s / n, s % n, s));
-        }),
-    ));
     let mut prior_buf = vec![0.0f32; prior.decoded_network_len()];
     let prior_net = prior
         .decode_network(&mut prior_buf)
         .ok_or_else(|| anyhow!("decode_network refused a buffer of its own length"))?;
-    rows.push((
-        "tabulated prior, network [32,32] relu: decoded, BrdfNetwork::sample".into(),
-        ns_per_sample(samples / 10, |s| {
-            let (v, r) = (views[at(s)], conds[at(s)].x);
-            black_box(prior_net.sample(v, r, metallic(s), s / n, s % n));
-        }),
-    ));
-    for (name, cs) in [
+    let networks = [
         ("network [32,32] relu", &relu),
         ("network [64,64] silu", &silu),
-    ] {
-        rows.push((
+    ];
+    let mut bufs: Vec<Vec<f32>> = networks
+        .iter()
+        .map(|(_, cs)| vec![0.0f32; cs.decoded_network_len()])
+        .collect();
+    let decoded = networks
+        .iter()
+        .zip(bufs.iter_mut())
+        .map(|((_, cs), buf)| {
+            cs.conditional()
+                .decode_network(buf)
+                .ok_or_else(|| anyhow!("decode_network refused a buffer of its own length"))
+        })
+        .collect::<Result<Vec<_>>>()?;
+
+    let mut rounds = Rounds::new();
+    rounds.add("incumbent: owen-sobol + mixture warp (f64)", samples, |s| {
+        black_box(targets[at(s)].sample(incumbent_u(s)));
+    });
+    rounds.add("incumbent + weight f cos / p (f64)", samples, |s| {
+        let t = &targets[at(s)];
+        let d: DVec3 = t.sample(incumbent_u(s));
+        black_box((d, t.pdf(d) * t.albedo() / t.sample_pdf(d)));
+    });
+    rounds.add("table: ConditionalSampler::sample", samples, |s| {
+        black_box(relu.conditional().sample(conds[at(s)], s / n, s % n));
+    });
+    rounds.add("table: BrdfSampler::sample", samples, |s| {
+        black_box(relu.sample(views[at(s)], conds[at(s)].x, 0.0, s / n, s % n));
+    });
+    rounds.add(
+        "tabulated prior, table: BrdfSampler::sample",
+        samples,
+        |s| {
+            let (v, r) = (views[at(s)], conds[at(s)].x);
+            black_box(prior.sample(v, r, metallic(s), s / n, s % n));
+        },
+    );
+    rounds.add(
+        "tabulated prior, table: BrdfSampler::sample_randomized",
+        samples,
+        |s| {
+            let (v, r) = (views[at(s)], conds[at(s)].x);
+            black_box(prior.sample_randomized(v, r, metallic(s), s / n, s % n, s));
+        },
+    );
+    rounds.add(
+        "tabulated prior, network [32,32] relu: decoded, BrdfNetwork::sample",
+        samples / 10,
+        |s| {
+            let (v, r) = (views[at(s)], conds[at(s)].x);
+            black_box(prior_net.sample(v, r, metallic(s), s / n, s % n));
+        },
+    );
+    let (conds, at) = (&conds, &at);
+    for ((name, cs), decoded) in networks.iter().zip(&decoded) {
+        rounds.add(
             format!("{name}: zero-copy, NetworkSampler::sample"),
-            ns_per_sample(samples / 10, |s| {
+            samples / 10,
+            move |s| {
                 black_box(
                     cs.conditional()
                         .network()
                         .sample(conds[at(s)], s / n, s % n),
                 );
-            }),
-        ));
-        let mut buf = vec![0.0f32; cs.decoded_network_len()];
-        let decoded = cs
-            .conditional()
-            .decode_network(&mut buf)
-            .ok_or_else(|| anyhow!("decode_network refused a buffer of its own length"))?;
-        rows.push((
+            },
+        );
+        rounds.add(
             format!("{name}: decoded, NetworkSampler::sample"),
-            ns_per_sample(samples / 10, |s| {
+            samples / 10,
+            move |s| {
                 black_box(decoded.sample(conds[at(s)], s / n, s % n));
-            }),
-        ));
+            },
+        );
     }
-    Ok(RuntimeTimings { rows })
+    Ok(RuntimeTimings { rows: rounds.run() })
 }
