@@ -135,12 +135,19 @@ impl IrradianceBlocks {
             .filter_map(|&(row, col)| {
                 let mut moment = DVec3::ZERO;
                 let mut sum = DVec3::ZERO;
+                let mut lit = 0usize;
                 for (c, r) in cells(row, col) {
                     let d = map.pixel_center(c, r);
                     moment += map.mass[r * w + c] * d;
                     sum += d;
+                    lit += 1;
                 }
-                let axis = sum.try_normalize()?;
+                if lit == 0 {
+                    return None;
+                }
+                // A block of a tiny map can span half the sphere, its centres'
+                // sum near 0: any axis then, and a radius past 90° below.
+                let axis = sum.try_normalize().unwrap_or(DVec3::Z);
                 let min_cos = cells(row, col)
                     .map(|(c, r)| axis.dot(map.pixel_center(c, r)))
                     .fold(1.0f64, f64::min);
