@@ -239,9 +239,10 @@ impl HeldOut {
             }
             LoadedTarget::Envmap(env) => {
                 let normal = square_to_sphere(DVec2::from(cond));
-                // Lit on the pool's copy: the map itself up to 2048 x 1024 cells;
-                // a larger map's blocks of cells keep their mass, finer than any
-                // cap of an N = 64 set sees, and lighting every cell of an
+                // Lit on the pool's copy: the map itself up to 2048 x 1024 cells,
+                // above that blocks of cells that keep their mass (0.18° at
+                // 4096 x 2048; the figures move by under 0.01,
+                // docs/results/envmap.md#coarse-check). Lighting every cell of an
                 // 8192 x 4096 map took the check three and a half minutes.
                 let (lit, irradiance) = env.coarse_map().cosine_weighted(normal)?;
                 (irradiance > 0.0).then(|| Self {

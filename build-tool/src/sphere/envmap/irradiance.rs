@@ -25,14 +25,14 @@ impl EnvmapDensity {
     ///
     /// Each sum runs over blocks of 16 x 16 cells (built on first use): a block
     /// whose lit cell centres all lie above the normal's horizon adds
-    /// `n . Σ mass c_p` (the same sum,
-    /// `max` never clipping, in another order of operations), one below it
-    /// nothing, and only the blocks the horizon crosses add their cells one by
-    /// one. On a 2048 x 1024 cell map that is about a twentieth of the cells
-    /// (a bake's 64 x 64 irradiance table read every cell of the map 4096 times).
-    /// Equal to the pixel-order sum to rounding: the blocks kept whole have every
-    /// cell at least `1e-3` above the horizon (in `n . c_p`), so no term is small
-    /// against the rounding of the others. `O(blocks + horizon cells)` a normal.
+    /// `n . Σ mass c_p` (the same sum, `max` never clipping, in another order of
+    /// operations), one below it nothing, and only the blocks the horizon
+    /// crosses add their cells one by one. On a 2048 x 1024 cell map that is
+    /// about a twentieth of the cells (a bake's 64 x 64 irradiance table read
+    /// every cell of the map 4096 times). Equal to the pixel-order sum to
+    /// rounding: the blocks kept whole have every cell about `1e-3` or more
+    /// above the horizon (in `n . c_p`), so no term is small against the
+    /// rounding of the others. `O(blocks + horizon cells)` a normal.
     pub fn irradiances(&self, normals: &[DVec3]) -> Vec<f64> {
         let blocks = self
             .irradiance_blocks
