@@ -122,11 +122,7 @@ impl IrradianceBlocks {
     /// The blocks of `map` that hold light, in row-major block order.
     fn new(map: &EnvmapDensity) -> Self {
         let (w, h, b) = (map.width, map.height, IRRADIANCE_BLOCK);
-        let cells = |row: usize, col: usize| {
-            (row..(row + b).min(h))
-                .flat_map(move |r| (col..(col + b).min(w)).map(move |c| (c, r)))
-                .filter(|&(c, r)| map.mass[r * w + c] > 0.0)
-        };
+        let cells = |row, col| lit_cells(map, row, col);
         let corners: Vec<(usize, usize)> = (0..h.div_ceil(b))
             .flat_map(|by| (0..w.div_ceil(b)).map(move |bx| (by * b, bx * b)))
             .collect();
@@ -173,7 +169,6 @@ impl IrradianceBlocks {
     /// than the margin above the horizon (`a + r < 90°` by at least that), and
     /// `cos a < -(sin r + margin)` every one below it.
     fn lit_sum(&self, map: &EnvmapDensity, n: DVec3) -> f64 {
-        let (w, h, b) = (map.width, map.height, IRRADIANCE_BLOCK);
         let mut sum = -0.0;
         for block in &self.blocks {
             let cos_a = n.dot(block.axis);
@@ -181,16 +176,26 @@ impl IrradianceBlocks {
             if cos_a > bound {
                 sum += n.dot(block.moment);
             } else if cos_a >= -bound {
-                for r in block.row..(block.row + b).min(h) {
-                    for c in block.col..(block.col + b).min(w) {
-                        let m = map.mass[r * w + c];
-                        if m > 0.0 {
-                            sum += m * n.dot(map.pixel_center(c, r)).max(0.0);
-                        }
-                    }
+                for (c, r) in lit_cells(map, block.row, block.col) {
+                    let m = map.mass[r * map.width + c];
+                    sum += m * n.dot(map.pixel_center(c, r)).max(0.0);
                 }
             }
         }
         sum
     }
+}
+
+/// The lit cells `(column, row)` of the block whose first cell is `(col, row)`,
+/// row by row: what a block's moment, its cone and a horizon's cell-by-cell sum
+/// all run over, in this order.
+fn lit_cells(
+    map: &EnvmapDensity,
+    row: usize,
+    col: usize,
+) -> impl Iterator<Item = (usize, usize)> + '_ {
+    let (w, b) = (map.width, IRRADIANCE_BLOCK);
+    (row..(row + b).min(map.height))
+        .flat_map(move |r| (col..(col + b).min(w)).map(move |c| (c, r)))
+        .filter(move |&(c, r)| map.mass[r * w + c] > 0.0)
 }
