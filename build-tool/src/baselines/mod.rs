@@ -15,11 +15,14 @@
 //! * [`gaussian_blue_noise`]: Ahmed, Ren, Wonka 2022 Gaussian blue noise.
 //! * [`spherical_fibonacci`]: spherical Fibonacci directions.
 //! * [`warp`]: the warps baselines use for non-uniform targets.
+//! * [`EnvmapLight`]: a shipping renderer's environment-light warp (Mitsuba 3's
+//!   `envmap`), the incumbent of the environment sampler's cost.
 //! * [`warped_owen_sobol`]: the standard 2D baseline, Owen-Sobol through the
 //!   target's inverse CDF (the optimizer's start);
 //!   [`warped_owen_sobol_directions`] its twin for direction targets.
 //! * [`Baseline`]: an enum over the uniform 2D methods, for evaluation loops.
 
+mod envmap_light;
 mod gbn;
 mod grid;
 mod halton;
@@ -33,6 +36,7 @@ mod spherical_fibonacci;
 pub mod warp;
 mod warped;
 
+pub use envmap_light::{EnvmapLight, EnvmapLightSampler};
 pub use gbn::{gaussian_blue_noise, gaussian_blue_noise_energy, GBN_DEFAULT_ITERATIONS};
 pub use halton::scrambled_halton;
 pub use kind::Baseline;

@@ -61,8 +61,8 @@ pub enum BenchPart {
     Runtime,
     /// Only the environment sampler's prior, the exact product warp of a map's
     /// light and a normal's cosine, against Owen-Sobol through the map's
-    /// luminance inverse CDF (nanoseconds per sample, one thread; not part of
-    /// `all`).
+    /// luminance warp in f32 with its pdf, as Mitsuba 3's environment light
+    /// samples it (nanoseconds per sample, one thread; not part of `all`).
     EnvmapPrior,
     /// Only the conditional sampler's training: milliseconds per step at N = 64,
     /// 256 and 2048, all threads, and the default bake's training time that
@@ -196,19 +196,22 @@ fn run_runtime() -> Result<()> {
 /// Nanoseconds per sample of the environment sampler's prior against the
 /// incumbent, one thread.
 fn run_envmap_prior(a: &BenchArgs) -> Result<()> {
-    let map = crate::sphere::EnvmapDensity::from_file_filtered(
-        &a.envmap,
+    let img = crate::density::image::load_luminance(&a.envmap)?;
+    let map = crate::sphere::EnvmapDensity::from_luminance_filtered(
+        &img,
         nuld_core::blob::Domain::Sphere,
+        &a.envmap.display().to_string(),
     )?;
-    let rows = envmap_prior::measure(&map, RUNTIME_SAMPLES)?;
+    let light = crate::baselines::EnvmapLight::new(&img)?;
+    let rows = envmap_prior::measure(&map, &light, RUNTIME_SAMPLES)?;
     println!(
         "environment prior ns per sample, one thread, {}, n = 64 (median of {ROUNDS} interleaved rounds)",
         a.envmap.display()
     );
-    println!("{:<52} {:>10} {:>12}", "method", "ns/sample", "/ incumbent");
+    println!("{:<72} {:>10} {:>12}", "method", "ns/sample", "/ incumbent");
     let base = rows.first().map_or(f64::NAN, |r| r.1);
     for (name, ns) in &rows {
-        println!("{name:<52} {ns:>10.1} {:>11.2}x", ns / base);
+        println!("{name:<72} {ns:>10.1} {:>11.2}x", ns / base);
     }
     Ok(())
 }

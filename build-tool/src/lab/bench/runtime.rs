@@ -16,9 +16,10 @@ use crate::train::target::LoadedTarget;
 use anyhow::{anyhow, ensure, Result};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Metadata;
-use nuld_core::brdf::{CONDITION_MAX, CONDITION_MIN};
+use nuld_core::brdf::{alpha, view_direction, CONDITION_MAX, CONDITION_MIN};
 use nuld_core::conditional::PointWarp;
 use nuld_core::network::{Activation, Shape, MAX_HIDDEN_LAYERS};
+use nuld_core::warp::brdf_mixture_real;
 use nuld_runtime::glam::{Vec2, Vec3};
 use nuld_runtime::Blob;
 use rand::{Rng, SeedableRng};
@@ -179,8 +180,9 @@ const INCUMBENT_RULE_POINTS: usize = 1 << 10;
 
 /// Times, one thread, `samples` samples per method (a tenth of it for network
 /// mode), the methods taking turns over [`super::rounds::ROUNDS`] rounds
-/// ([`Rounds`]; each figure the median of its rounds): the incumbent (direction only, and with its estimator weight
-/// `f cos / p` as a renderer needs it), table mode (`sample` and `sample_brdf`;
+/// ([`Rounds`]; each figure the median of its rounds): the incumbent (direction
+/// only in `f32`, as a renderer runs it, and in `f64`, and with its estimator
+/// weight `f cos / p` as a renderer needs it), table mode (`sample` and `sample_brdf`;
 /// on the BRDF mixture prior of earlier blobs, and on the default bake's
 /// tabulated prior with metallic 0, 0.5 and 1 in turn, also its unbiased mode and
 /// decoded network mode),
@@ -214,6 +216,16 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
         .iter()
         .map(|c| BrdfTarget::coarse(c.x as f64, c.y as f64, 0.0, INCUMBENT_RULE_POINTS))
         .collect::<Result<Vec<_>, _>>()?;
+    // The same warp in `f32`, as a renderer runs it: `(wo, alpha, p_s)` per
+    // condition, set up before timing as the `f64` targets are.
+    let targets32: Vec<([f32; 3], f32, f32)> = conds
+        .iter()
+        .zip(&targets)
+        .map(|(c, t)| {
+            let wo = view_direction(c.y as f64).as_vec3().to_array();
+            (wo, alpha(c.x as f64) as f32, t.lobe_probability() as f32)
+        })
+        .collect();
     let meta = Metadata {
         generator: "bench",
         target: "random",
@@ -273,6 +285,11 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
         .collect::<Result<Vec<_>>>()?;
 
     let mut rounds = Rounds::new();
+    rounds.add("incumbent: owen-sobol + mixture warp (f32)", samples, |s| {
+        let (wo, a, ps) = targets32[at(s)];
+        let u = incumbent_u(s).as_vec2().to_array();
+        black_box(brdf_mixture_real(wo, a, ps, u));
+    });
     rounds.add("incumbent: owen-sobol + mixture warp (f64)", samples, |s| {
         black_box(targets[at(s)].sample(incumbent_u(s)));
     });
