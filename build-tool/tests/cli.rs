@@ -661,6 +661,8 @@ fn envmap_bake_and_sample_reject_bad_input_with_one_line() {
     assert!(e.contains("negative"), "{e}");
     let e = failure(&["bake", "--brdf", "--union-weight", "nan"], &out);
     assert!(e.contains("--union-weight must be finite"), "{e}");
+    let e = failure(&["bake", "--brdf", "--alpha-end", "0"], &out);
+    assert!(e.contains("--alpha-end must be finite and > 0"), "{e}");
     let e = failure(&["bake", "--brdf", "--pool-conditions", "0"], &out);
     assert!(
         e.contains("--pool-conditions must be in 1..=65536, got 0"),

@@ -76,6 +76,10 @@ pub struct BakeArgs {
     /// Initial Adam step.
     #[arg(long, default_value_t = TrainConfig::default().learning_rate)]
     pub lr: f64,
+    /// Sharpness of the cap loss's sigmoid at the end of training, in inverse
+    /// point spacings (it ramps up from 8; smaller: a softer, wider gradient).
+    #[arg(long, value_name = "A1", help = alpha_end_help())]
+    pub alpha_end: Option<f64>,
     /// Held-out conditions per axis of the quality check in the report (0: none).
     #[arg(long, default_value_t = BakeConfig::default().quality_grid, allow_negative_numbers = true, value_parser = super::count)]
     pub quality_grid: usize,
@@ -92,6 +96,18 @@ fn pool_help() -> String {
          (more: a longer pool phase, a finer cover of the condition range) [default: {}; {} with --envmap]",
         TrainConfig::default().pool_conditions,
         ENVMAP_POOL_CONDITIONS
+    )
+}
+
+/// `--alpha-end`'s help with its two defaults, the BRDF sampler's and the
+/// environment sampler's.
+fn alpha_end_help() -> String {
+    format!(
+        "Sharpness of the cap loss's sigmoid at the end of training, in inverse point spacings \
+         (it ramps up from {}; smaller: a softer, wider gradient) [default: {} for --brdf, {} for --envmap]",
+        TrainConfig::default().alpha_start,
+        TrainConfig::default().alpha_end,
+        BakeConfig::envmap_sizes().train.alpha_end
     )
 }
 
@@ -145,6 +161,11 @@ pub fn run(a: BakeArgs) -> Result<()> {
         a.lr.is_finite() && a.lr > 0.0,
         "--lr must be finite and > 0"
     );
+    let alpha_end = a.alpha_end.unwrap_or(defaults.train.alpha_end);
+    ensure!(
+        alpha_end.is_finite() && alpha_end > 0.0,
+        "--alpha-end must be finite and > 0"
+    );
     let pool_conditions = a.pool_conditions.unwrap_or(defaults.train.pool_conditions);
     ensure!(
         (1..=1 << 16).contains(&pool_conditions),
@@ -162,6 +183,7 @@ pub fn run(a: BakeArgs) -> Result<()> {
         steps,
         union_weight,
         learning_rate: a.lr,
+        alpha_end,
         seed: a.seed,
         ..defaults.train.clone()
     };
