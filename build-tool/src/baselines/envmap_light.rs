@@ -6,8 +6,9 @@
 //! repeated at the end, so the interpolant wraps in `φ`), sampled by the exact
 //! bilinear marginal-conditional warp ([`nuld_core::marginal2d`], one node) in
 //! `f32`, the point `(x, y)` of the square read as `φ = 2π x`, `θ = π y`
-//! (`+z` up, row 0 at the zenith, as [`crate::sphere::EnvmapDensity`] reads a
-//! map). Its solid-angle pdf is the square's over the area element:
+//! (`+z` up, row 0 at the zenith: the inverse of
+//! [`pixel_coords`]` (ω, 1, 1)`, the layout every map here is read in). Its
+//! solid-angle pdf is the square's over the area element:
 //!
 //! ```text
 //! p(ω) = p(x, y) / (2 π² sin θ)
@@ -19,8 +20,10 @@
 //! pdf.
 
 use crate::density::image::LuminanceImage;
+use crate::sphere::equirect::pixel_coords;
 use anyhow::{anyhow, ensure, Result};
 use core::f32::consts::PI;
+use glam::DVec3;
 use nuld_core::marginal2d::{tabulate, Blend, Marginal2D, Marginal2DShape};
 
 /// A map's luminance warp, tabulated once ([`EnvmapLight::new`]); sample it
@@ -102,13 +105,17 @@ impl EnvmapLightSampler<'_> {
     /// The solid-angle density of [`Self::sample`]'s directions at the unit
     /// vector `d`. `O(1)`.
     pub fn pdf(&self, d: [f32; 3]) -> f32 {
-        let theta = d[2].clamp(-1.0, 1.0).acos();
-        let phi = d[1].atan2(d[0]).rem_euclid(2.0 * PI);
-        let p = self
-            .warp
-            .pdf([phi / (2.0 * PI), theta / PI], &Blend::single(0));
-        solid_angle_pdf(p, theta.sin())
+        let [x, y] = square_point(d);
+        let p = self.warp.pdf([x, y], &Blend::single(0));
+        solid_angle_pdf(p, (PI * y).sin())
     }
+}
+
+/// The point of the square whose direction is the unit vector `d`: `(φ / 2π,
+/// θ / π)`, [`pixel_coords`] of a one-pixel map.
+fn square_point(d: [f32; 3]) -> [f32; 2] {
+    let p = pixel_coords(DVec3::from_array(d.map(f64::from)), 1, 1);
+    [p.x as f32, p.y as f32]
 }
 
 /// The square's density `p` over the area element `2 π² sin θ`; 0 where `sin θ`
@@ -188,12 +195,10 @@ mod tests {
         let in_patch = (0..n)
             .filter(|_| {
                 let (d, _) = s.sample([r.random::<f32>(), r.random::<f32>()]);
-                let phi = d[1].atan2(d[0]).rem_euclid(2.0 * PI) / (2.0 * PI);
-                let theta = d[2].clamp(-1.0, 1.0).acos() / PI;
+                let [x, y] = square_point(d);
                 // Columns 20..24 and rows 12..16 of 64 x 32, with the
                 // interpolant's half-pixel spread.
-                (19.0 / 64.0..25.0 / 64.0).contains(&phi)
-                    && (11.0 / 31.0..16.0 / 31.0).contains(&theta)
+                (19.0 / 64.0..25.0 / 64.0).contains(&x) && (11.0 / 31.0..16.0 / 31.0).contains(&y)
             })
             .count();
         assert!(in_patch > n / 2, "{in_patch} of {n} in the patch");

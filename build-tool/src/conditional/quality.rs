@@ -373,6 +373,7 @@ pub fn evaluate(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sphere::envmap::test_support::grey_map;
     use crate::train::TrainTarget;
     use nuld_core::network::{Activation, Shape};
 
@@ -387,11 +388,12 @@ mod tests {
     #[test]
     fn an_envmap_check_judges_lit_normals_against_the_lit_maps_inverse_cdf() {
         let dir = std::env::temp_dir().join(format!("nuld-quality-envmap-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("upper.png");
-        image::RgbImage::from_fn(32, 16, |_, y| image::Rgb([if y < 7 { 200 } else { 0 }; 3]))
-            .save(&path)
-            .unwrap();
+        let path = grey_map(
+            &dir,
+            "upper.png",
+            [32, 16],
+            |_, y| if y < 7 { 200 } else { 0 },
+        );
         let target = TrainTarget::envmap(&path).unwrap().load().unwrap();
         let mut config = QualityConfig::held_out(&target, 4, 3);
         assert_eq!(config.conditions.len(), 16);
@@ -429,14 +431,13 @@ mod tests {
     #[test]
     fn a_large_maps_check_lights_the_coarse_copy() {
         let dir = std::env::temp_dir().join(format!("nuld-quality-coarse-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("spots.png");
-        image::RgbImage::from_fn(64, 32, |x, y| {
-            let v = if (x * 7 + y * 3) % 11 == 0 { 255 } else { 3 };
-            image::Rgb([v; 3])
-        })
-        .save(&path)
-        .unwrap();
+        let path = grey_map(&dir, "spots.png", [64, 32], |x, y| {
+            if (x * 7 + y * 3) % 11 == 0 {
+                255
+            } else {
+                3
+            }
+        });
         let loaded = TrainTarget::envmap(&path).unwrap().load().unwrap();
         let LoadedTarget::Envmap(env) = &loaded else {
             panic!("an envmap target");

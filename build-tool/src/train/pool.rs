@@ -515,6 +515,7 @@ fn envmap_condition(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sphere::envmap::test_support::grey_map;
     use nuld_core::network::Activation;
 
     /// An environment pool condition measures its caps on the lit map: its
@@ -573,14 +574,13 @@ mod tests {
     #[test]
     fn an_envmap_pool_holds_only_normals_that_light_reaches() {
         let dir = std::env::temp_dir().join(format!("nuld-pool-dark-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("one-pixel.png");
-        image::RgbImage::from_fn(32, 16, |x, y| {
-            let v = if (x, y) == (5, 3) { 255 } else { 0 };
-            image::Rgb([v, v, v])
-        })
-        .save(&path)
-        .unwrap();
+        let path = grey_map(&dir, "one-pixel.png", [32, 16], |x, y| {
+            if (x, y) == (5, 3) {
+                255
+            } else {
+                0
+            }
+        });
         let count = 24;
         let pool = envmap_pool(&path, count);
         let env = envmap_target(&pool);

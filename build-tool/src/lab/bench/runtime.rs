@@ -16,7 +16,7 @@ use crate::train::target::LoadedTarget;
 use anyhow::{anyhow, ensure, Result};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Metadata;
-use nuld_core::brdf::{alpha, view_direction, CONDITION_MAX, CONDITION_MIN};
+use nuld_core::brdf::{alpha, CONDITION_MAX, CONDITION_MIN};
 use nuld_core::conditional::PointWarp;
 use nuld_core::network::{Activation, Shape, MAX_HIDDEN_LAYERS};
 use nuld_core::warp::brdf_mixture_real;
@@ -218,12 +218,11 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
         .collect::<Result<Vec<_>, _>>()?;
     // The same warp in `f32`, as a renderer runs it: `(wo, alpha, p_s)` per
     // condition, set up before timing as the `f64` targets are.
-    let targets32: Vec<([f32; 3], f32, f32)> = conds
+    let targets32: Vec<([f32; 3], f32, f32)> = targets
         .iter()
-        .zip(&targets)
-        .map(|(c, t)| {
-            let wo = view_direction(c.y as f64).as_vec3().to_array();
-            (wo, alpha(c.x as f64) as f32, t.lobe_probability() as f32)
+        .map(|t| {
+            let wo = t.view().as_vec3().to_array();
+            (wo, alpha(t.roughness()) as f32, t.lobe_probability() as f32)
         })
         .collect();
     let meta = Metadata {

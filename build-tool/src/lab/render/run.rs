@@ -415,6 +415,7 @@ fn composite<'a>(
 mod tests {
     use super::*;
     use crate::lab::render::summary::CSV_HEADER;
+    use crate::sphere::envmap::test_support::grey_map;
 
     /// `../shared/data/envmaps/courtyard.hdr` when present, else a generated sky
     /// written as PNG into `dir`.
@@ -425,19 +426,15 @@ mod tests {
             return shared;
         }
         eprintln!("skipped: {} (using a generated sky)", shared.display());
-        let img = image::RgbImage::from_fn(64, 32, |x, y| {
-            let v = if y == 5 && x == 9 {
+        grey_map(dir, "sky.png", [64, 32], |x, y| {
+            if y == 5 && x == 9 {
                 255
             } else if y < 16 {
                 120 + 4 * y as u8
             } else {
                 30
-            };
-            image::Rgb([v, v, v])
-        });
-        let path = dir.join("sky.png");
-        img.save(&path).unwrap();
-        path
+            }
+        })
     }
 
     /// `render --quick` end to end, as CI runs it: every output file, the exact

@@ -122,7 +122,6 @@ impl IrradianceBlocks {
     /// The blocks of `map` that hold light, in row-major block order.
     fn new(map: &EnvmapDensity) -> Self {
         let (w, h, b) = (map.width, map.height, IRRADIANCE_BLOCK);
-        let cells = |row, col| lit_cells(map, row, col);
         let corners: Vec<(usize, usize)> = (0..h.div_ceil(b))
             .flat_map(|by| (0..w.div_ceil(b)).map(move |bx| (by * b, bx * b)))
             .collect();
@@ -132,7 +131,7 @@ impl IrradianceBlocks {
                 let mut moment = DVec3::ZERO;
                 let mut sum = DVec3::ZERO;
                 let mut lit = 0usize;
-                for (c, r) in cells(row, col) {
+                for (c, r) in lit_cells(map, row, col) {
                     let d = map.pixel_center(c, r);
                     moment += map.mass[r * w + c] * d;
                     sum += d;
@@ -144,7 +143,7 @@ impl IrradianceBlocks {
                 // A block of a tiny map can span half the sphere, its centres'
                 // sum near 0: any axis then, and a radius past 90° below.
                 let axis = sum.try_normalize().unwrap_or(DVec3::Z);
-                let min_cos = cells(row, col)
+                let min_cos = lit_cells(map, row, col)
                     .map(|(c, r)| axis.dot(map.pixel_center(c, r)))
                     .fold(1.0f64, f64::min);
                 let sin_radius = match min_cos > 0.0 {

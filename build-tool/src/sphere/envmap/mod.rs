@@ -446,17 +446,11 @@ impl DirectionDensity for EnvmapDensity {
 /// into `dir`, for tests that need a map file.
 #[cfg(test)]
 pub(crate) fn tiny_map(dir: &Path) -> std::path::PathBuf {
-    std::fs::create_dir_all(dir).unwrap();
-    let path = dir.join("sky.png");
-    image::RgbImage::from_fn(32, 16, |x, y| {
-        let v = if (x, y) == (5, 3) {
+    test_support::grey_map(dir, "sky.png", [32, 16], |x, y| {
+        if (x, y) == (5, 3) {
             255
         } else {
             (40 + 8 * (16 - y)) as u8
-        };
-        image::Rgb([v, v, v])
+        }
     })
-    .save(&path)
-    .unwrap();
-    path
 }

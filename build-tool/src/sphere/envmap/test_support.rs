@@ -1,5 +1,6 @@
 //! What the tests of a map's samplers share: the check that a sampler's estimate
-//! of the irradiance is unbiased against an independent quadrature.
+//! of the irradiance is unbiased against an independent quadrature, and small
+//! maps written as files ([`grey_map`]).
 
 use super::EnvmapDensity;
 use crate::sphere::DirectionDensity;
@@ -7,6 +8,7 @@ use glam::{DVec2, DVec3};
 use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
 use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
 
 /// `∫ g(l) dl` over the sphere by the midpoint rule on `q^2` points of the
 /// sphere's equal-area square (`dl = 4 pi` times the square's area element).
@@ -82,4 +84,21 @@ pub(crate) fn assert_unbiased_irradiance(
             "n {n}: {estimate} vs {e} (se {se})"
         );
     }
+}
+
+/// A grey map of `size = [width, height]` pixels, pixel `(x, y)` of value
+/// `value(x, y)`, written as PNG to `dir/name` (`dir` created if missing): the
+/// map file of a test.
+pub(crate) fn grey_map(
+    dir: &Path,
+    name: &str,
+    size: [u32; 2],
+    value: impl Fn(u32, u32) -> u8,
+) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let path = dir.join(name);
+    image::RgbImage::from_fn(size[0], size[1], |x, y| image::Rgb([value(x, y); 3]))
+        .save(&path)
+        .unwrap();
+    path
 }
