@@ -195,6 +195,9 @@ const fn node_count_const(levels: u32) -> usize {
     ((1usize << (2 * (levels + 1))) - 4) / 3
 }
 
+/// Records of levels `1..=`[`TOP_LEVELS`]: one top-table row's entries.
+const TOP_NODES: usize = node_count_const(TOP_LEVELS);
+
 /// Share of the bound that stands under a tabulated top-level weight.
 pub const TOP_FLOOR: f64 = 1e-3;
 
@@ -506,10 +509,14 @@ impl<'a> EnvmapTree<'a> {
             let j0 = (s.floor().to_f64() as u32).min(g - 1);
             (j0, s - T::of(j0 as f64))
         });
+        let [(x0, tx), (y0, ty)] = cell;
+        let (g, per) = (self.grid as usize, TOP_NODES);
+        let row = |dx: usize, dy: usize| ((y0 as usize + dy) * g + x0 as usize + dx) * per;
         Lit {
             tree: *self,
             n,
-            cell,
+            top_rows: [row(0, 0), row(1, 0), row(0, 1), row(1, 1)],
+            top_at: [tx, ty],
         }
     }
 
@@ -581,22 +588,24 @@ impl<'a> EnvmapTree<'a> {
 pub struct Lit<'a, T> {
     tree: EnvmapTree<'a>,
     n: [T; 3],
-    /// The top table's cell: lower node and fraction per axis.
-    cell: [(u32, T); 2],
+    /// Where the top table's rows for the four grid normals around the query
+    /// start (`[00, 10, 01, 11]`), worked out once per query rather than per
+    /// node.
+    top_rows: [usize; 4],
+    /// The query's fraction of the way across its top-table cell, per axis.
+    top_at: [T; 2],
 }
 
 impl<T: Real> Lit<'_, T> {
     /// Bilinear interpolation of top-table node `node`'s weight at the normal.
     #[inline]
     fn top_weight(&self, node: usize) -> T {
-        let (g, per) = (self.tree.grid as usize, node_count(TOP_LEVELS));
-        let [(x0, tx), (y0, ty)] = self.cell;
-        let at = |dx: usize, dy: usize| {
-            let row = (y0 as usize + dy) * g + x0 as usize + dx;
-            T::of(self.tree.top.get(row * per + node).copied().unwrap_or(0.0) as f64)
-        };
-        let a = at(0, 0) + (at(1, 0) - at(0, 0)) * tx;
-        let b = at(0, 1) + (at(1, 1) - at(0, 1)) * tx;
+        let [tx, ty] = self.top_at;
+        let v = self
+            .top_rows
+            .map(|r| T::of(self.tree.top.get(r + node).copied().unwrap_or(0.0) as f64));
+        let a = v[0] + (v[1] - v[0]) * tx;
+        let b = v[2] + (v[3] - v[2]) * tx;
         a + (b - a) * ty
     }
 }

@@ -449,8 +449,15 @@ fn choose<T: Real>(w: [T; 4], ux: &mut T, uy: &mut T) -> Step<T> {
         *ux = clamp_unit((*ux - px) / (T::ONE - px));
         1
     };
-    let (bottom, top) = (w[i], w[i + 2]);
-    let py = bottom / (bottom + top);
+    // Both columns' row splits, worked out beside the column's, so that the row's
+    // choice waits on no division once the column is known.
+    let py_of = |c: usize| w[c] / (w[c] + w[c + 2]);
+    let (py0, py1) = (py_of(0), py_of(1));
+    let (bottom, top, py) = if i == 0 {
+        (w[0], w[2], py0)
+    } else {
+        (w[1], w[3], py1)
+    };
     let j = if (*uy < py && bottom > T::ZERO) || top <= T::ZERO {
         *uy = clamp_unit(*uy / py);
         0
