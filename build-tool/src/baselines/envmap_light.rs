@@ -39,7 +39,8 @@ pub struct EnvmapLight {
 impl EnvmapLight {
     /// Tabulates `img`'s luminance times `sin θ_j`, `θ_j = π j / (H - 1)` on
     /// vertex row `j` (module docs); negative or non-finite pixels count as 0.
-    /// Errors on a map under 2 pixels tall or without light.
+    /// Errors on a map under 2 pixels tall or without light off its first and
+    /// last rows.
     pub fn new(img: &LuminanceImage) -> Result<Self> {
         let (w, h) = (img.width, img.height);
         ensure!(
@@ -64,6 +65,14 @@ impl EnvmapLight {
                 }
             }));
         }
+        // The first and last vertex rows sit at the poles, where `sin θ` is 0:
+        // light there alone (any map 2 pixels tall) leaves nothing to sample.
+        ensure!(
+            data.iter().any(|&v| v > 0.0),
+            "the map's luminance warp has no light to sample: it weighs each pixel row by \
+             sin θ, which is 0 on the first and last rows, and the map has no light on the \
+             others"
+        );
         let mut marginal = vec![0.0; ny];
         let mut conditional = vec![0.0; nx * ny];
         tabulate(shape, &mut data, &mut marginal, &mut conditional)
@@ -212,6 +221,24 @@ mod tests {
             values: vec![0.0; 8],
         };
         let e = EnvmapLight::new(&dark).unwrap_err().to_string();
-        assert!(e.contains("no mass"), "{e}");
+        assert!(e.contains("no light to sample"), "{e}");
+    }
+
+    /// Light on the pole rows alone is weighed by `sin θ = 0`: refused with
+    /// the reason, where one lit pixel on the row between them is enough.
+    #[test]
+    fn light_on_the_pole_rows_alone_is_refused() {
+        let map = |values: Vec<f64>| LuminanceImage {
+            width: 2,
+            height: 3,
+            values,
+        };
+        let e = EnvmapLight::new(&map(vec![5.0, 5.0, 0.0, 0.0, 5.0, 5.0]))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("first and last rows"), "{e}");
+        let light = EnvmapLight::new(&map(vec![5.0, 5.0, 0.0, 1.0, 5.0, 5.0])).unwrap();
+        let (d, p) = light.sampler().sample([0.3, 0.6]);
+        assert!(p > 0.0 && d[2].abs() < 0.9, "{d:?} {p}");
     }
 }
