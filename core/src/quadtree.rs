@@ -386,12 +386,11 @@ pub fn invert<T: Real>(tree: &impl ChildWeights<T>, p: [T; 2]) -> [T; 2] {
         let shift = levels - l as u32 - 1;
         let w = usable(tree.children(l as u32, lx >> (shift + 1), ly >> (shift + 1)));
         let (i, j) = (((lx >> shift) & 1) as usize, ((ly >> shift) & 1) as usize);
-        let (left, right) = (w[0] + w[2], w[1] + w[3]);
-        let col = [w[i], w[i + 2]];
+        let (px, py) = splits(w);
         *step = Step {
-            px: left / (left + right),
+            px,
             i,
-            py: col[0] / (col[0] + col[1]),
+            py: py[i],
             j,
         };
     }
@@ -441,7 +440,9 @@ pub fn leaf_point<T: Real>(levels: u32, leaf: [u32; 2], local: [T; 2]) -> [T; 2]
 /// rescales `u` into the chosen part; an empty part is never picked.
 fn choose<T: Real>(w: [T; 4], ux: &mut T, uy: &mut T) -> Step<T> {
     let (left, right) = (w[0] + w[2], w[1] + w[3]);
-    let px = left / (left + right);
+    // Both columns' row splits are worked out beside the column's, so that the
+    // row's choice waits on no division once the column is known.
+    let (px, py) = splits(w);
     let i = if (*ux < px && left > T::ZERO) || right <= T::ZERO {
         *ux = clamp_unit(*ux / px);
         0
@@ -449,14 +450,10 @@ fn choose<T: Real>(w: [T; 4], ux: &mut T, uy: &mut T) -> Step<T> {
         *ux = clamp_unit((*ux - px) / (T::ONE - px));
         1
     };
-    // Both columns' row splits, worked out beside the column's, so that the row's
-    // choice waits on no division once the column is known.
-    let py_of = |c: usize| w[c] / (w[c] + w[c + 2]);
-    let (py0, py1) = (py_of(0), py_of(1));
     let (bottom, top, py) = if i == 0 {
-        (w[0], w[2], py0)
+        (w[0], w[2], py[0])
     } else {
-        (w[1], w[3], py1)
+        (w[1], w[3], py[1])
     };
     let j = if (*uy < py && bottom > T::ZERO) || top <= T::ZERO {
         *uy = clamp_unit(*uy / py);
@@ -466,6 +463,16 @@ fn choose<T: Real>(w: [T; 4], ux: &mut T, uy: &mut T) -> Step<T> {
         1
     };
     Step { px, i, py, j }
+}
+
+/// A node's splits: the left column's share of the four children's weights, and
+/// in each column the lower child's share, `(w0 + w2) / Σ w` and `[w0 / (w0 + w2),
+/// w1 / (w1 + w3)]`. What [`sample`] cuts `u` at and [`invert`] scales it back by.
+#[inline]
+fn splits<T: Real>(w: [T; 4]) -> (T, [T; 2]) {
+    let (left, right) = (w[0] + w[2], w[1] + w[3]);
+    let py = [w[0] / (w[0] + w[2]), w[1] / (w[1] + w[3])];
+    (left / (left + right), py)
 }
 
 /// The share of the chosen child among the four.

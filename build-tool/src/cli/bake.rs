@@ -76,8 +76,8 @@ pub struct BakeArgs {
     /// Initial Adam step.
     #[arg(long, default_value_t = TrainConfig::default().learning_rate)]
     pub lr: f64,
-    /// Sharpness of the cap loss's sigmoid at the end of training, in inverse
-    /// point spacings (it ramps up from 8; smaller: a softer, wider gradient).
+    /// The cap loss's end sharpness (`None`: the target's default); its help,
+    /// with both defaults, is [`alpha_end_help`]'s.
     #[arg(long, value_name = "A1", help = alpha_end_help())]
     pub alpha_end: Option<f64>,
     /// Held-out conditions per axis of the quality check in the report (0: none).
