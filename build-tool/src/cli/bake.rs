@@ -77,7 +77,7 @@ pub struct BakeArgs {
     #[arg(long, default_value_t = TrainConfig::default().learning_rate)]
     pub lr: f64,
     /// The cap loss's end sharpness (`None`: the target's default); its help,
-    /// with both defaults, is [`alpha_end_help`]'s.
+    /// with both defaults, is `alpha_end_help`'s.
     #[arg(long, value_name = "A1", help = alpha_end_help())]
     pub alpha_end: Option<f64>,
     /// Held-out conditions per axis of the quality check in the report (0: none).
