@@ -470,6 +470,15 @@ impl<'a, T: Real> BrdfPrior<'a, T> {
         (wi, pdf, if weight.is_finite() { weight } else { T::ZERO })
     }
 
+    /// The table point of primary sample `u` at `cond`, before the half-vector
+    /// map ([`Self::sample`]'s direction is [`half_vector_direction`] of it with
+    /// [`query_stretch`]), its density in the square and its slopes `[dx/du.x,
+    /// dx/du.y, dy/du.y]` ([`Marginal2D::sample_with_slopes`]). What a trainer
+    /// chains its gradients through.
+    pub fn square_with_slopes(&self, cond: [T; 3], u: [T; 2]) -> ([T; 2], T, [T; 3]) {
+        self.warp.sample_with_slopes(u, &self.blend(cond))
+    }
+
     /// [`Self::sample`] for the view `wo` of `cond` (`view_direction_real(cond[1])`).
     #[inline]
     fn sample_from(&self, wo: [T; 3], cond: [T; 3], u: [T; 2]) -> ([T; 3], T) {

@@ -542,6 +542,46 @@ impl<'a, T: Real> Marginal2D<'a, T> {
         (p, self.pdf_known(p, blend, total, corners))
     }
 
+    /// [`Self::sample`] (the same point and density) and the point's slopes
+    /// `[dx/du.x, dx/du.y, dy/du.y]` (`y` comes from the marginal alone, so
+    /// `dy/du.x = 0`), exact within the table cell the point falls in. With `M`
+    /// the blend's mass, `r(y)` its row mass at `y`, `f(x, y)` its bilinear
+    /// density and `C(x, y)` its conditional CDF (`C(x, y) = u.x r(y)`):
+    /// `dy/du.y = M / r(y)`, `dx/du.x = r(y) / f(x, y)`, `dx/du.y = (u.x r'(y) -
+    /// ∂C/∂y) / f(x, y) dy/du.y`. All 0 where `r(y)` or `f(x, y)` is 0. What a
+    /// trainer chains its gradients through: one warp instead of the five of
+    /// central differences.
+    pub fn sample_with_slopes(&self, u: [T; 2], blend: &Blend<T>) -> ([T; 2], T, [T; 3]) {
+        by_blend_size!(self, blend, sample_with_slopes_picked(u))
+    }
+
+    fn sample_with_slopes_picked<const N: usize>(
+        &self,
+        u: [T; 2],
+        blend: &Picked<T, N>,
+    ) -> ([T; 2], T, [T; 3]) {
+        let (p, pdf) = self.sample_picked(u, blend);
+        let (nx, ny) = (self.nx, self.ny);
+        let (i, s) = cell(p[0], nx);
+        let (j, t) = cell(p[1], ny);
+        let dx = T::ONE / T::of((nx - 1) as f64);
+        let dy = T::ONE / T::of((ny - 1) as f64);
+        let (r0, r1) = (self.c(j, nx - 1, blend), self.c(j + 1, nx - 1, blend));
+        let row = (T::ONE - t) * r0 + t * r1;
+        let f = [(j, i), (j, i + 1), (j + 1, i), (j + 1, i + 1)].map(|(b, a)| self.f(b, a, blend));
+        let g =
+            (T::ONE - t) * ((T::ONE - s) * f[0] + s * f[1]) + t * ((T::ONE - s) * f[2] + s * f[3]);
+        if !(positive(row) && positive(g)) {
+            return (p, pdf, [T::ZERO; 3]);
+        }
+        let dy_duy = self.m(ny - 1, blend) / row;
+        // The row CDFs at x of the cell's two rows; C(x, y) blends them by t.
+        let lower = self.c(j, i, blend) + linear_integral(f[0] * dx, f[1] * dx, s);
+        let upper = self.c(j + 1, i, blend) + linear_integral(f[2] * dx, f[3] * dx, s);
+        let dx_dy = (clamp_unit(u[0]) * (r1 - r0) - (upper - lower)) / (dy * g);
+        (p, pdf, [row / g, dx_dy * dy_duy, dy_duy])
+    }
+
     /// The density at `p` in `[0,1]^2` (clamped into it) of the points
     /// [`Self::sample`] draws: the blend's bilinear value over the blend's mass
     /// (per unit area of the square).

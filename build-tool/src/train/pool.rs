@@ -31,7 +31,8 @@ use crate::sphere::{BrdfTarget, CapMeasureTable, DirectionDensity, EnvmapTree, T
 use anyhow::Result;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
-use nuld_core::brdf::{gltf_metallic, view_direction};
+use nuld_core::brdf::{gltf_metallic, view_direction, view_direction_real};
+use nuld_core::brdf_prior::{half_vector_direction, query_stretch};
 use nuld_core::conditional::{ConditionalTarget, PointWarp};
 use nuld_core::network::{shifted_lattice_point, Shape};
 use nuld_core::sphere::{hemisphere_to_square, sphere_to_square, square_to_sphere};
@@ -223,32 +224,48 @@ impl PoolCondition {
 
 /// The direction of the BRDF prior's primary point `p` at `[roughness, θo,
 /// metallic]` (`f64` warp over the prior's tables, [`BrdfPrior::core_f64`]) and
-/// its central differences of step `1e-6` along `p.x` and `p.y`, zeroed where
-/// they straddle the edge of the prior's support (a jump to `+z`, which no
-/// gradient can follow).
+/// its derivatives along `p.x` and `p.y`: the table's exact slopes
+/// ([`nuld_core::brdf_prior::BrdfPrior::square_with_slopes`], one warp) through
+/// the half-vector map's central differences of step `1e-6` in the square (no
+/// table read), a column zeroed where they straddle the edge of the prior's
+/// support (a jump to `+z`, which no gradient can follow).
 pub fn brdf_table_direction(prior: &BrdfPrior, cond: [f64; 3], p: DVec2) -> (DVec3, DVec3, DVec3) {
     let core = prior
         .core_f64()
         .expect("the BRDF sampler's prior is half-vector");
-    let at = |q: DVec2| core.sample(cond, q.to_array());
-    let (d, pdf) = at(p);
+    let (q, pdf, [dx_dux, dx_duy, dy_duy]) = core.square_with_slopes(cond, p.to_array());
+    let (wo, k) = (
+        view_direction_real(cond[1]),
+        query_stretch(core.grid(), cond),
+    );
+    let at =
+        |q: DVec2| half_vector_direction(wo, q.to_array(), k).map(|(wi, _)| DVec3::from_array(wi));
+    let q = DVec2::from(q);
+    let Some(d) = at(q).filter(|_| pdf > 0.0) else {
+        return (DVec3::Z, DVec3::ZERO, DVec3::ZERO);
+    };
     let h = 1e-6;
+    // The map's derivative along `e`, on a step kept inside the square.
     let diff = |e: DVec2| {
-        let (hi, p_hi) = at(p + h * e);
-        let (lo, p_lo) = at(p - h * e);
-        let j = (DVec3::from_array(hi) - DVec3::from_array(lo)) / (2.0 * h);
-        if p_hi > 0.0 && p_lo > 0.0 && j.is_finite() && j.length() < 1e3 {
+        let (hi, lo) = (
+            (q + h * e).clamp(DVec2::ZERO, DVec2::ONE),
+            (q - h * e).clamp(DVec2::ZERO, DVec2::ONE),
+        );
+        match (at(hi), at(lo)) {
+            (Some(a), Some(b)) => (a - b) / (hi - lo).dot(e),
+            _ => DVec3::ZERO,
+        }
+    };
+    let (d_dx, d_dy) = (diff(DVec2::X), diff(DVec2::Y));
+    // A smooth warp moves a direction by at most ~1/alpha per unit of p.
+    let keep = |j: DVec3| {
+        if j.is_finite() && j.length() < 1e3 {
             j
         } else {
             DVec3::ZERO
         }
     };
-    let d = if pdf > 0.0 {
-        DVec3::from_array(d)
-    } else {
-        DVec3::Z
-    };
-    (d, diff(DVec2::X), diff(DVec2::Y))
+    (d, keep(d_dx * dx_dux), keep(d_dx * dx_duy + d_dy * dy_duy))
 }
 
 /// Instances with pretraining targets per pool condition.
@@ -526,6 +543,62 @@ mod tests {
     /// pixels are 11 degrees tall, and a pixel lit at its centre reaches below the
     /// horizon); the lit map integrates to the irradiance; and the density
     /// integrates to 1 (midpoint rule on the sphere's equal-area square).
+    /// The BRDF prior's direction derivatives are the central differences of
+    /// its whole warp (`sample`, five table searches) wherever those stay in one
+    /// table cell (a cell boundary is a kink) and alive, at dielectric,
+    /// intermediate and metal conditions on and between the nodes.
+    #[test]
+    fn brdf_direction_derivatives_are_the_warps() {
+        use crate::sphere::brdf_prior::PRIOR_SIZE;
+        let prior = BrdfPrior::shared();
+        let core = prior.core_f64().unwrap();
+        let mut r = crate::seeding::rng(5, 0);
+        let (h, mut checked) = (1e-7, 0);
+        for _ in 0..3000 {
+            use rand::Rng;
+            let cond = [
+                r.random_range(0.1..1.0),
+                r.random_range(0.0..85.0),
+                [0.0, 0.3, 1.0][r.random_range(0..3)],
+            ];
+            let u = DVec2::new(r.random_range(0.01..0.99), r.random_range(0.01..0.99));
+            let (d, jx, jy) = brdf_table_direction(&prior, cond, u);
+            let (want, pdf) = core.sample(cond, u.to_array());
+            if pdf <= 0.0 {
+                assert_eq!((d, jx, jy), (DVec3::Z, DVec3::ZERO, DVec3::ZERO));
+                continue;
+            }
+            assert!(d.distance(DVec3::from_array(want)) < 1e-12);
+            // The table cell of a primary point's square point.
+            let cell = |v: DVec2| {
+                let q = DVec2::from(core.square_with_slopes(cond, v.to_array()).0);
+                (q * f64::from(PRIOR_SIZE - 1)).floor()
+            };
+            let ends = [
+                u + h * DVec2::X,
+                u - h * DVec2::X,
+                u + h * DVec2::Y,
+                u - h * DVec2::Y,
+            ];
+            let alive = ends.iter().all(|e| core.sample(cond, e.to_array()).1 > 0.0);
+            if !alive || ends.iter().any(|&e| cell(e) != cell(u)) {
+                continue;
+            }
+            let at = |v: DVec2| DVec3::from_array(core.sample(cond, v.to_array()).0);
+            for (got, want) in [
+                (jx, (at(ends[0]) - at(ends[1])) / (2.0 * h)),
+                (jy, (at(ends[2]) - at(ends[3])) / (2.0 * h)),
+            ] {
+                assert!(
+                    got.distance(want) <= 1e-4 * want.length().max(1.0),
+                    "{cond:?} {u}: {got} vs {want}"
+                );
+            }
+            checked += 1;
+        }
+        assert!(checked > 2000, "only {checked} points checked");
+    }
+
     /// A BRDF condition's baseline is Owen-Sobol through the exact tabulated
     /// inverse CDF: the same points' loss, recomputed here, and at a sharp grazing
     /// lobe lower than through the renderer's mixture, which `eval conditional`

@@ -187,6 +187,45 @@ fn invert_undoes_sample_and_sample_undoes_invert() {
     assert!(worst < 1e-9, "worst round trip {worst}");
 }
 
+/// `sample_with_slopes` draws `sample`'s point and density, bit for bit, and its
+/// slopes are the central differences of `sample` where the differences stay in
+/// one table cell (a cell boundary is a kink of the piecewise warp); and `dy/du.x`
+/// is 0 there: `y` reads `u.y` alone.
+#[test]
+fn the_slopes_are_the_derivatives_of_the_warp() {
+    let t = four_nodes();
+    let w = t.warp();
+    let mut r = Rng(23);
+    let (h, mut checked) = (1e-6, 0);
+    let cells = |p: [f64; 2]| (cell(p[0], 9).0, cell(p[1], 7).0);
+    for _ in 0..5000 {
+        let blend = Blend::multilinear(&[r.next(), r.next()], &[2, 2]);
+        let u = [0.02 + 0.96 * r.next(), 0.02 + 0.96 * r.next()];
+        let (p, pdf, [dx_dux, dx_duy, dy_duy]) = w.sample_with_slopes(u, &blend);
+        assert_eq!((p, pdf), w.sample(u, &blend));
+        let at = |du: [f64; 2]| w.sample([u[0] + du[0], u[1] + du[1]], &blend).0;
+        let ends = [at([h, 0.0]), at([-h, 0.0]), at([0.0, h]), at([0.0, -h])];
+        if ends.iter().any(|&q| cells(q) != cells(p)) {
+            continue;
+        }
+        let slope = |a: [f64; 2], b: [f64; 2], k: usize| (a[k] - b[k]) / (2.0 * h);
+        let want = [
+            slope(ends[0], ends[1], 0),
+            slope(ends[2], ends[3], 0),
+            slope(ends[2], ends[3], 1),
+        ];
+        for (got, want) in [dx_dux, dx_duy, dy_duy].into_iter().zip(want) {
+            assert!(
+                (got - want).abs() <= 1e-5 * want.abs().max(1.0),
+                "u {u:?}: {got} vs {want}"
+            );
+        }
+        assert!(slope(ends[0], ends[1], 1).abs() < 1e-9);
+        checked += 1;
+    }
+    assert!(checked > 4000, "only {checked} points inside a cell");
+}
+
 /// The warp keeps one copy per blend size (1, 2, 4 and 8 slots, 3 and 5 to 7
 /// nodes padded with empty slots): every size samples its own pdf, which is the
 /// weighted average of the nodes' densities computed here from the data alone,
