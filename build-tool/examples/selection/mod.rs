@@ -1,6 +1,6 @@
-//! What the two selection examples (`envmap_selection`, `brdf_selection`)
-//! share: the candidate sets a table of choices would choose among, and their
-//! ranking.
+//! What the selection examples (`envmap_selection`, `envmap_instance_selection`,
+//! `brdf_selection`) share: the candidate sets a table of choices would choose
+//! among, and their ranking.
 use glam::DVec2;
 use nuld_core::network::{shifted_lattice_point, OffsetHash};
 
