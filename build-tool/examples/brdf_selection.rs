@@ -45,7 +45,7 @@ fn push_choice(row: &mut Vec<f64>, at_c: &[f64], choice: &[f64]) {
     let order = selection::ranking(choice);
     for kept in KEPT {
         let kept = kept.min(order.len());
-        row.push(order[..kept].iter().map(|&k| at_c[k]).sum::<f64>() / kept as f64);
+        row.push(selection::mean_of(at_c, &order, kept));
     }
 }
 
@@ -72,9 +72,6 @@ fn main() {
             .map(|set| set.iter().map(|&p| prior.sample(&warp, c, p).0).collect())
             .collect()
     };
-    let scores = |sets: &[Vec<DVec3>], j: &Judge<BrdfTarget>| -> Vec<f64> {
-        sets.iter().map(|d| j.d(d) / j.baseline()).collect()
-    };
     let parsed = blob.as_ref().map(|b| {
         nuld_runtime::Blob::parse(b.as_slice())
             .unwrap()
@@ -88,7 +85,7 @@ fn main() {
         .enumerate()
         .map(|(index, &c)| {
             let held = judge(c, index as u64);
-            let at_c = scores(&sets_at(c), &held);
+            let at_c = selection::scores(&sets_at(c), &held);
             let mut row = vec![at_c.iter().sum::<f64>() / at_c.len() as f64];
             push_choice(&mut row, &at_c, &at_c);
             let unit = unit_condition(c);
@@ -112,7 +109,11 @@ fn main() {
                     metallic,
                 ];
                 let node_judge = judge(node, 1000 + (16 * j + index) as u64);
-                push_choice(&mut row, &at_c, &scores(&sets_at(node), &node_judge));
+                push_choice(
+                    &mut row,
+                    &at_c,
+                    &selection::scores(&sets_at(node), &node_judge),
+                );
             }
             if let Some(cs) = &parsed {
                 let cond = Vec2::new(c[0] as f32, c[1] as f32);

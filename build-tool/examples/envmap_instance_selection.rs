@@ -32,11 +32,6 @@ const KEPT: usize = 8;
 /// default bake's 64 stored instances).
 const TRAINED: u32 = 64;
 
-/// Mean of `scores` at the first `count` indices of `order`.
-fn mean_of(scores: &[f64], order: &[usize], count: usize) -> f64 {
-    order[..count].iter().map(|&k| scores[k]).sum::<f64>() / count as f64
-}
-
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if !(3..=4).contains(&args.len()) {
@@ -73,11 +68,6 @@ fn main() {
         }));
         sets
     };
-    let scores = |sets: &[Vec<DVec3>], judge: &Judge<[f64; 2]>| -> Vec<f64> {
-        sets.iter()
-            .map(|dirs| judge.d(dirs) / judge.baseline())
-            .collect()
-    };
     let judge = |u: [f64; 2], index: u64| -> Option<Judge<[f64; 2]>> {
         Some(check::judge(&check::lit(&env.map, u)?, u, n, index))
     };
@@ -90,7 +80,7 @@ fn main() {
                 .into_iter()
                 .map(|k| k + range.start)
                 .collect();
-            mean_of(at_u, &order, KEPT)
+            selection::mean_of(at_u, &order, KEPT)
         };
         [pick(0..t), pick(t..choice.len()), pick(0..choice.len())]
     };
@@ -99,20 +89,23 @@ fn main() {
         .filter_map(|index| {
             let u = check::held_out(index);
             let held_out = judge(u, index as u64)?;
-            let at_u = scores(&sets_at(u), &held_out);
+            let at_u = selection::scores(&sets_at(u), &held_out);
             let mut row = vec![
                 at_u[..t].iter().sum::<f64>() / t as f64,
                 at_u[..8].iter().sum::<f64>() / 8.0,
                 at_u[t..].iter().sum::<f64>() / (at_u.len() - t) as f64,
             ];
             let other = judge(u, 2000 + index as u64)?;
-            row.extend(choices(&at_u, &scores(&sets_at(u), &other)));
+            row.extend(choices(&at_u, &selection::scores(&sets_at(u), &other)));
             for (j, grid) in GRIDS.iter().enumerate() {
                 for (e, frac) in [0.5, 0.25].into_iter().enumerate() {
                     let d = frac / (grid - 1) as f64;
                     let node = [u[0] + d, u[1] + d];
                     let node_judge = judge(node, 1000 + (32 * j + 16 * e + index) as u64)?;
-                    row.extend(choices(&at_u, &scores(&sets_at(node), &node_judge)));
+                    row.extend(choices(
+                        &at_u,
+                        &selection::scores(&sets_at(node), &node_judge),
+                    ));
                 }
             }
             eprintln!("normal {index:2}: {row:.3?}");

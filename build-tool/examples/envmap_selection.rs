@@ -64,17 +64,12 @@ const FAST_CAPS: usize = 1024;
 /// How many chosen candidates a table keeps per node (its instances).
 const KEPT: usize = 8;
 
-/// Mean of `scores` at the first `count` indices of `order`.
-fn mean_of(scores: &[f64], order: &[usize], count: usize) -> f64 {
-    order[..count].iter().map(|&k| scores[k]).sum::<f64>() / count as f64
-}
-
 /// A choice's two columns: the held-out scores `at_u` of the best candidate by
 /// `choice` (lower is better), and their mean over its best [`KEPT`].
 fn push_choice(row: &mut Vec<f64>, at_u: &[f64], choice: &[f64]) {
     let order = selection::ranking(choice);
     row.push(at_u[order[0]]);
-    row.push(mean_of(at_u, &order, KEPT));
+    row.push(selection::mean_of(at_u, &order, KEPT));
 }
 
 fn main() {
@@ -109,12 +104,6 @@ fn main() {
             .map(|set| set.iter().map(|&p| warp(u, p)).collect())
             .collect()
     };
-    // The check's judge of every set, over its baseline.
-    let scores = |sets: &[Vec<DVec3>], judge: &Judge<[f64; 2]>| -> Vec<f64> {
-        sets.iter()
-            .map(|dirs| judge.d(dirs) / judge.baseline())
-            .collect()
-    };
     // The squared cap L2 of every candidate at `u` on caps measured by the lit
     // map's mass rule (as the bake's pool measures), for ranking only: no baseline.
     let fast_scores = |u: [f64; 2], sets: &[Vec<DVec3>], seed: u64| -> Option<Vec<f64>> {
@@ -138,13 +127,13 @@ fn main() {
             let u = check::held_out(index);
             let held_out = judge(u, index as u64)?;
             let sets = sets_at(u);
-            let at_u = scores(&sets, &held_out);
+            let at_u = selection::scores(&sets, &held_out);
             let mut row = vec![at_u.iter().sum::<f64>() / at_u.len() as f64];
             push_choice(&mut row, &at_u, &at_u);
             // The same normal judged on other caps: what the judge's own noise
             // leaves of a choice.
             let other = judge(u, 2000 + index as u64)?;
-            push_choice(&mut row, &at_u, &scores(&sets, &other));
+            push_choice(&mut row, &at_u, &selection::scores(&sets, &other));
             for (j, grid) in GRIDS.iter().enumerate() {
                 let half = 0.5 / (grid - 1) as f64;
                 let node = [u[0] + half, u[1] + half];
@@ -169,7 +158,7 @@ fn main() {
                 let clock = std::time::Instant::now();
                 let node_judge = judge(node, 1000 + (16 * j + index) as u64)?;
                 let judged = clock.elapsed().as_secs_f64();
-                push_choice(&mut row, &at_u, &scores(&node_sets, &node_judge));
+                push_choice(&mut row, &at_u, &selection::scores(&node_sets, &node_judge));
                 eprintln!(
                     "normal {index:2} grid {grid}: a node's choice took {:.3} s (judge {judged:.3} s)",
                     warped + clock.elapsed().as_secs_f64()

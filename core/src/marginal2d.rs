@@ -500,6 +500,13 @@ impl<'a, T: Real> Marginal2D<'a, T> {
         (T::ONE - t) * self.f(j, i, p) + t * self.f(j + 1, i, p)
     }
 
+    /// The blended densities at the corners `(j, i), (j, i + 1), (j + 1, i),
+    /// (j + 1, i + 1)` of cell `(i, j)`.
+    #[inline(always)]
+    fn corners<const N: usize>(&self, i: usize, j: usize, p: &Picked<T, N>) -> [T; 4] {
+        [(j, i), (j, i + 1), (j + 1, i), (j + 1, i + 1)].map(|(b, a)| self.f(b, a, p))
+    }
+
     /// Draws the point at primary sample `u` in `[0,1]^2` from the blend's
     /// density and returns it with its density ([`Self::pdf`]). `u` outside the
     /// square is clamped into it (NaN as 0).
@@ -528,8 +535,7 @@ impl<'a, T: Real> Marginal2D<'a, T> {
             let target = clamp_unit(u[0]) * row_total;
             let (i, c_i) = search(nx, target, |i| self.c_at(j, t, i, blend));
             let dx = T::ONE / T::of((nx - 1) as f64);
-            let f =
-                [(j, i), (j, i + 1), (j + 1, i), (j + 1, i + 1)].map(|(b, a)| self.f(b, a, blend));
+            let f = self.corners(i, j, blend);
             let g0 = (T::ONE - t) * f[0] + t * f[2];
             let g1 = (T::ONE - t) * f[1] + t * f[3];
             let s = solve_linear(g0 * dx, g1 * dx, target - c_i);
@@ -568,9 +574,8 @@ impl<'a, T: Real> Marginal2D<'a, T> {
         let dy = T::ONE / T::of((ny - 1) as f64);
         let (r0, r1) = (self.c(j, nx - 1, blend), self.c(j + 1, nx - 1, blend));
         let row = (T::ONE - t) * r0 + t * r1;
-        let f = [(j, i), (j, i + 1), (j + 1, i), (j + 1, i + 1)].map(|(b, a)| self.f(b, a, blend));
-        let g =
-            (T::ONE - t) * ((T::ONE - s) * f[0] + s * f[1]) + t * ((T::ONE - s) * f[2] + s * f[3]);
+        let f = self.corners(i, j, blend);
+        let g = bilinear(f, s, t);
         if !(positive(row) && positive(g)) {
             return (p, pdf, [T::ZERO; 3]);
         }
@@ -612,11 +617,9 @@ impl<'a, T: Real> Marginal2D<'a, T> {
         let (j, t) = cell(p[1], self.ny);
         let f = match corners {
             Some((at, f)) if at == (i, j) => f,
-            _ => [(j, i), (j, i + 1), (j + 1, i), (j + 1, i + 1)].map(|(b, a)| self.f(b, a, blend)),
+            _ => self.corners(i, j, blend),
         };
-        let lo = (T::ONE - s) * f[0] + s * f[1];
-        let hi = (T::ONE - s) * f[2] + s * f[3];
-        ((T::ONE - t) * lo + t * hi) / total
+        bilinear(f, s, t) / total
     }
 
     /// The primary sample that [`Self::sample`] maps to `p` (clamped into the
@@ -687,6 +690,15 @@ impl<T: Real, const N: usize> Picked<T, N> {
         }
         terms[0]
     }
+}
+
+/// The bilinear value at `(s, t)` in a cell of corner values `f` (in
+/// [`Marginal2D::corners`]' order): along `x` on both rows, then between them.
+#[inline(always)]
+fn bilinear<T: Real>(f: [T; 4], s: T, t: T) -> T {
+    let lo = (T::ONE - s) * f[0] + s * f[1];
+    let hi = (T::ONE - s) * f[2] + s * f[3];
+    (T::ONE - t) * lo + t * hi
 }
 
 /// Whether `x > 0` (false for NaN).

@@ -1,7 +1,8 @@
 //! What the selection examples (`envmap_selection`, `envmap_instance_selection`,
 //! `brdf_selection`) share: the candidate sets a table of choices would choose
 //! among, and their ranking.
-use glam::DVec2;
+use glam::{DVec2, DVec3};
+use nuld_build_tool::lab::eval::prior_judge::Judge;
 use nuld_core::network::{shifted_lattice_point, OffsetHash};
 
 /// The rank-1 lattice of `n` points with generator `g` shifted by the first
@@ -24,4 +25,16 @@ pub fn ranking(scores: &[f64]) -> Vec<usize> {
     let mut order: Vec<usize> = (0..scores.len()).collect();
     order.sort_by(|&a, &b| scores[a].total_cmp(&scores[b]));
     order
+}
+
+/// Every set's judged cap L2 over the judge's baseline (lower is better).
+pub fn scores<C: Sync>(sets: &[Vec<DVec3>], judge: &Judge<C>) -> Vec<f64> {
+    sets.iter()
+        .map(|dirs| judge.d(dirs) / judge.baseline())
+        .collect()
+}
+
+/// Mean of `scores` at the first `count` indices of `order`.
+pub fn mean_of(scores: &[f64], order: &[usize], count: usize) -> f64 {
+    order[..count].iter().map(|&k| scores[k]).sum::<f64>() / count as f64
 }

@@ -209,15 +209,7 @@ impl PoolCondition {
                 p.to_array(),
                 1e-6,
             )
-            .map(|j| {
-                let j = DVec3::from_array(j);
-                // A smooth warp moves a direction by at most ~1/alpha per unit of p.
-                if j.is_finite() && j.length() < 1e3 {
-                    j
-                } else {
-                    DVec3::ZERO
-                }
-            });
+            .map(|j| followable(DVec3::from_array(j)));
         (warp(p), jx, jy)
     }
 }
@@ -257,15 +249,23 @@ pub fn brdf_table_direction(prior: &BrdfPrior, cond: [f64; 3], p: DVec2) -> (DVe
         }
     };
     let (d_dx, d_dy) = (diff(DVec2::X), diff(DVec2::Y));
-    // A smooth warp moves a direction by at most ~1/alpha per unit of p.
-    let keep = |j: DVec3| {
-        if j.is_finite() && j.length() < 1e3 {
-            j
-        } else {
-            DVec3::ZERO
-        }
-    };
-    (d, keep(d_dx * dx_dux), keep(d_dx * dx_duy + d_dy * dy_duy))
+    (
+        d,
+        followable(d_dx * dx_dux),
+        followable(d_dx * dx_duy + d_dy * dy_duy),
+    )
+}
+
+/// A direction's derivative `j` along a primary coordinate, or 0 where no
+/// gradient should follow it: a smooth warp moves a direction by at most about
+/// `1 / alpha` per unit of the square, so a finite difference that is not
+/// finite or exceeds `1e3` straddles a jump.
+fn followable(j: DVec3) -> DVec3 {
+    if j.is_finite() && j.length() < 1e3 {
+        j
+    } else {
+        DVec3::ZERO
+    }
 }
 
 /// Instances with pretraining targets per pool condition.
@@ -535,14 +535,6 @@ mod tests {
     use crate::sphere::envmap::test_support::grey_map;
     use nuld_core::network::Activation;
 
-    /// An environment pool condition measures its caps on the lit map: its
-    /// measures agree with the exact cap measure of the lit map
-    /// ([`crate::sphere::EnvmapDensity::cap_measure`], a quadrature independent of the rule); a
-    /// cap a little wider than the hemisphere about the normal holds all the mass,
-    /// one a little narrower than the opposite hemisphere none (the tiny map's
-    /// pixels are 11 degrees tall, and a pixel lit at its centre reaches below the
-    /// horizon); the lit map integrates to the irradiance; and the density
-    /// integrates to 1 (midpoint rule on the sphere's equal-area square).
     /// The BRDF prior's direction derivatives are the central differences of
     /// its whole warp (`sample`, five table searches) wherever those stay in one
     /// table cell (a cell boundary is a kink) and alive, at dielectric,
@@ -550,12 +542,12 @@ mod tests {
     #[test]
     fn brdf_direction_derivatives_are_the_warps() {
         use crate::sphere::brdf_prior::PRIOR_SIZE;
+        use rand::Rng;
         let prior = BrdfPrior::shared();
         let core = prior.core_f64().unwrap();
         let mut r = crate::seeding::rng(5, 0);
         let (h, mut checked) = (1e-7, 0);
         for _ in 0..3000 {
-            use rand::Rng;
             let cond = [
                 r.random_range(0.1..1.0),
                 r.random_range(0.0..85.0),
@@ -688,6 +680,14 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    /// An environment pool condition measures its caps on the lit map: its
+    /// measures agree with the exact cap measure of the lit map
+    /// ([`crate::sphere::EnvmapDensity::cap_measure`], a quadrature independent of the rule); a
+    /// cap a little wider than the hemisphere about the normal holds all the mass,
+    /// one a little narrower than the opposite hemisphere none (the tiny map's
+    /// pixels are 11 degrees tall, and a pixel lit at its centre reaches below the
+    /// horizon); the lit map integrates to the irradiance; and the density
+    /// integrates to 1 (midpoint rule on the sphere's equal-area square).
     #[test]
     fn envmap_conditions_hold_the_lit_map() {
         let dir = std::env::temp_dir().join(format!("nuld-pool-envmap-{}", std::process::id()));

@@ -197,7 +197,8 @@ fn the_slopes_are_the_derivatives_of_the_warp() {
     let w = t.warp();
     let mut r = Rng(23);
     let (h, mut checked) = (1e-6, 0);
-    let cells = |p: [f64; 2]| (cell(p[0], 9).0, cell(p[1], 7).0);
+    let [nx, ny] = t.shape.size.map(|n| n as usize);
+    let cells = |p: [f64; 2]| (cell(p[0], nx).0, cell(p[1], ny).0);
     for _ in 0..5000 {
         let blend = Blend::multilinear(&[r.next(), r.next()], &[2, 2]);
         let u = [0.02 + 0.96 * r.next(), 0.02 + 0.96 * r.next()];
