@@ -118,6 +118,7 @@ impl BakeConfig {
 
     /// An environment sampler's sizes before its map is known: [`ENVMAP_GRID`],
     /// [`ENVMAP_WEIGHT_GRID`], [`ENVMAP_STEPS`], [`ENVMAP_POOL_CONDITIONS`],
+    /// [`ENVMAP_ALPHA_END`],
     /// otherwise [`BakeConfig::default`] (what `render` bakes for each map it
     /// is given, through [`Self::with_envmap`]).
     pub fn envmap_sizes() -> Self {
@@ -127,6 +128,7 @@ impl BakeConfig {
             train: TrainConfig {
                 steps: ENVMAP_STEPS,
                 pool_conditions: ENVMAP_POOL_CONDITIONS,
+                alpha_end: ENVMAP_ALPHA_END,
                 ..TrainConfig::default()
             },
             ..Self::default()
@@ -184,6 +186,12 @@ pub const ENVMAP_UNION_WEIGHT: f64 = 1.5;
 /// steps scored as 12 000 did (courtyard N = 64: 0.755 and 0.759 of the
 /// baseline), in a quarter of the time.
 pub const ENVMAP_STEPS: usize = 3000;
+
+/// The cap loss's end sharpness for an environment sampler, in inverse point
+/// spacings: 32 (the BRDF sampler's) gained 0.003 to 0.011 of the baseline on
+/// the shared maps at N = 64 and nothing on a map of small lamps, whose worst
+/// normal lost 0.014, and took longer (docs/results/envmap.md#alpha-end).
+pub const ENVMAP_ALPHA_END: f64 = 64.0;
 
 /// Training conditions in an environment sampler's pool: the normals' pool
 /// holds the map's caps per normal, and its bake time is a goal (`bake
