@@ -1,7 +1,7 @@
 //! `build-tool bake --brdf` / `bake --envmap MAP`: train a conditional sampler and
 //! write its blob, report and pictures (library: [`crate::conditional::bake`]).
 
-use crate::conditional::bake::{bake, BakeConfig, ENVMAP_POOL_CONDITIONS};
+use crate::conditional::bake::{bake, BakeConfig, ENVMAP_ALPHA_END, ENVMAP_POOL_CONDITIONS};
 use crate::sphere::envmap::shape_warning;
 use crate::train::{TrainConfig, TrainTarget};
 use anyhow::{ensure, Result};
@@ -107,7 +107,7 @@ fn alpha_end_help() -> String {
          (it ramps up from {}; smaller: a softer, wider gradient) [default: {} for --brdf, {} for --envmap]",
         TrainConfig::default().alpha_start,
         TrainConfig::default().alpha_end,
-        BakeConfig::envmap_sizes().train.alpha_end
+        ENVMAP_ALPHA_END
     )
 }
 

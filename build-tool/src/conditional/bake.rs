@@ -118,7 +118,6 @@ impl BakeConfig {
 
     /// An environment sampler's sizes before its map is known: [`ENVMAP_GRID`],
     /// [`ENVMAP_WEIGHT_GRID`], [`ENVMAP_STEPS`], [`ENVMAP_POOL_CONDITIONS`],
-    /// [`ENVMAP_ALPHA_END`],
     /// otherwise [`BakeConfig::default`] (what `render` bakes for each map it
     /// is given, through [`Self::with_envmap`]).
     pub fn envmap_sizes() -> Self {
@@ -128,7 +127,6 @@ impl BakeConfig {
             train: TrainConfig {
                 steps: ENVMAP_STEPS,
                 pool_conditions: ENVMAP_POOL_CONDITIONS,
-                alpha_end: ENVMAP_ALPHA_END,
                 ..TrainConfig::default()
             },
             ..Self::default()
@@ -137,8 +135,8 @@ impl BakeConfig {
 
     /// These settings for an environment sampler of `target`: the network refines
     /// the primary space of the map's tree (the exact prior), with
-    /// [`ENVMAP_INSTANCE_SLOTS`] instance slots and the union weight
-    /// [`ENVMAP_UNION_WEIGHT`].
+    /// [`ENVMAP_INSTANCE_SLOTS`] instance slots, the union weight
+    /// [`ENVMAP_UNION_WEIGHT`] and the end sharpness [`ENVMAP_ALPHA_END`].
     pub fn with_envmap(self, target: TrainTarget) -> Self {
         Self {
             train: TrainConfig {
@@ -146,6 +144,7 @@ impl BakeConfig {
                 prior: true,
                 instance_slots: ENVMAP_INSTANCE_SLOTS,
                 union_weight: ENVMAP_UNION_WEIGHT,
+                alpha_end: ENVMAP_ALPHA_END,
                 ..self.train
             },
             ..self
