@@ -28,7 +28,8 @@ pub struct RenderArgs {
     #[arg(long, allow_negative_numbers = true, value_parser = super::count)]
     pub reference_spp: Option<usize>,
     /// A baked BRDF sampler blob; serves the spp equal to its N. Repeat for
-    /// several; counts without one are baked into DIR/brdf-nN/.
+    /// several; counts without one are baked into DIR/brdf-nN/ when brdf is
+    /// among the techniques (mis uses the blobs at hand for ours on both halves).
     #[arg(long)]
     pub brdf_blob: Vec<PathBuf>,
     /// A baked environment sampler blob of the same map (`bake --envmap`); serves
@@ -46,7 +47,8 @@ pub struct RenderArgs {
     pub seeds: Option<u32>,
     /// Techniques, comma-separated: brdf (BRDF sampling), envmap (environment
     /// sampling), mis (both, power heuristic) [default: all three]. Without brdf
-    /// no BRDF blob is baked.
+    /// no BRDF blob is baked, and mis pairs ours for both halves only at the
+    /// counts a --brdf-blob serves.
     #[arg(long, value_delimiter = ',', value_parser = technique)]
     pub techniques: Vec<Technique>,
     /// How our environment sampler's fixed instances weigh a sample `l`: pdf

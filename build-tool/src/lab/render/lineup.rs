@@ -45,24 +45,46 @@ pub const ENVMAP_SAMPLERS: [&str; 11] = [
     "owen-sobol-hierarchical",
 ];
 
-/// The sampler names of multiple importance sampling: each environment sampler
-/// with Owen-Sobol through the BRDF mixture warp ([`super::mis`]).
-pub const MIS_SAMPLERS: [&str; 11] = ENVMAP_SAMPLERS;
+/// The sampler names of multiple importance sampling ([`super::mis`]): ours
+/// for both halves (our environment sampler with our BRDF sampler, each in
+/// table mode, network mode, the unbiased mode), then each environment sampler
+/// of [`ENVMAP_SAMPLERS`] with Owen-Sobol through the BRDF mixture warp.
+pub const MIS_SAMPLERS: [&str; MIS_OURS_BOTH + ENVMAP_SAMPLERS.len()] = {
+    let both = ["nuld-both-table", "nuld-both-network", "nuld-both-unbiased"];
+    let mut all = [""; MIS_OURS_BOTH + ENVMAP_SAMPLERS.len()];
+    let mut i = 0;
+    while i < all.len() {
+        all[i] = match i < MIS_OURS_BOTH {
+            true => both[i],
+            false => ENVMAP_SAMPLERS[i - MIS_OURS_BOTH],
+        };
+        i += 1;
+    }
+    all
+};
 
-/// The names of `technique`'s samplers in table order.
-pub fn names(technique: Technique) -> &'static [&'static str] {
+/// How many of [`MIS_SAMPLERS`] pair ours for both halves (and need a BRDF
+/// blob as well as the environment blob).
+const MIS_OURS_BOTH: usize = 3;
+
+/// The names of `technique`'s samplers in table order, with both blobs at hand
+/// or, when `brdf_blob` is false, without the BRDF blob (MIS then leaves out
+/// the rows of ours for both halves).
+pub fn names(technique: Technique, brdf_blob: bool) -> &'static [&'static str] {
     match technique {
         Technique::Brdf => &BRDF_SAMPLERS,
         Technique::Envmap => &ENVMAP_SAMPLERS,
-        Technique::Mis => &MIS_SAMPLERS,
+        Technique::Mis if brdf_blob => &MIS_SAMPLERS,
+        Technique::Mis => &MIS_SAMPLERS[MIS_OURS_BOTH..],
     }
 }
 
 /// The samplers of `techniques` at `n` samples per pixel, in the order of
 /// [`Technique::ALL`] and named as [`names`]: ours from the blobs `blob` (BRDF;
-/// without it ours is left out of the BRDF samplers) and `envmap_blob` (the
-/// environment sampler of `env`; without it ours is left out of the environment
-/// and MIS samplers), whose `N` should be `n`; the
+/// without it ours is left out of the BRDF samplers and MIS has ours for the
+/// environment half only) and `envmap_blob` (the environment sampler of `env`;
+/// without it ours is left out of the environment and MIS samplers), whose `N`
+/// should be `n`; the
 /// baselines' points from `seed` (SOT and GBN generate their pools now, once for
 /// all techniques). Our network mode reads its weights decoded into
 /// `network_weights` (BRDF, environment; [`NuldSampler::decoded`]). An error if
@@ -97,7 +119,6 @@ pub fn weighted_samplers<'a>(
     network_weights: &'a mut [Vec<f32>; 2],
 ) -> Result<Vec<Shared<'a>>, NuldBlobError> {
     let [brdf_weights, envmap_weights] = network_weights;
-    let mut brdf_weights = Some(brdf_weights);
     let generators = [
         Generator::OwenSobol,
         Generator::Halton,
@@ -148,6 +169,16 @@ pub fn weighted_samplers<'a>(
         envmaps.push(envmap(Generator::OwenSobol, EnvWarp::Hierarchical));
     }
 
+    // Ours for the BRDF, shared by BRDF sampling and MIS: table, network,
+    // unbiased mode.
+    let mut ours_brdf: Vec<Shared<'a>> = Vec::new();
+    if let Some(b) = blob.filter(|_| techniques.iter().any(|t| *t != Technique::Envmap)) {
+        ours_brdf.push(Arc::new(NuldSampler::new(b, NuldMode::Table)?));
+        let network = NuldSampler::new(b, NuldMode::Network)?;
+        ours_brdf.push(Arc::new(network.decoded(brdf_weights)));
+        ours_brdf.push(Arc::new(NuldSampler::new(b, NuldMode::Table)?.unbiased()));
+    }
+
     let mut all: Vec<Shared<'a>> = Vec::new();
     for technique in Technique::ALL {
         if !techniques.contains(&technique) {
@@ -155,14 +186,7 @@ pub fn weighted_samplers<'a>(
         }
         match technique {
             Technique::Brdf => {
-                if let (Some(blob), Some(weights)) = (blob, brdf_weights.take()) {
-                    all.push(Arc::new(NuldSampler::new(blob, NuldMode::Table)?));
-                    let network = NuldSampler::new(blob, NuldMode::Network)?;
-                    all.push(Arc::new(network.decoded(weights)));
-                    all.push(Arc::new(
-                        NuldSampler::new(blob, NuldMode::Table)?.unbiased(),
-                    ));
-                }
+                all.extend(ours_brdf.iter().cloned());
                 for g in [
                     Generator::OwenSobol,
                     Generator::Random,
@@ -179,6 +203,13 @@ pub fn weighted_samplers<'a>(
                     wo: DVec3::Z,
                     material: Material::dielectric(0.5),
                 };
+                // Ours for both halves, mode by mode, when both blobs are here.
+                let ours_envmap = envmaps.iter().take(envmap_blob.map_or(0, |_| 3));
+                let both = ours_envmap.zip(&ours_brdf).zip(MIS_SAMPLERS);
+                for ((e, b), name) in both {
+                    let mis = MisSampler::new(e.clone(), b.clone(), &probe);
+                    all.extend(mis.map(|m| Arc::new(m.named(name)) as Shared<'a>));
+                }
                 for s in &envmaps {
                     let mis = MisSampler::new(s.clone(), brdf(Generator::OwenSobol), &probe);
                     all.extend(mis.map(|m| Arc::new(m) as Shared<'a>));
@@ -220,7 +251,7 @@ mod tests {
                 .filter(|s| s.technique() == t)
                 .map(|s| s.name())
                 .collect();
-            assert_eq!(got, names(t), "{}", t.name());
+            assert_eq!(got, names(t, true), "{}", t.name());
         }
         let fails = |blob: &[u8], envmap_blob: Option<&[u8]>| {
             samplers(
@@ -252,8 +283,9 @@ mod tests {
             &mut spare,
         )
         .unwrap();
-        // Ours' three environment samplers, alone and in MIS.
-        assert_eq!(without.len(), all.len() - 6);
+        // Ours' three environment samplers, alone and in MIS, and ours for
+        // both halves of MIS.
+        assert_eq!(without.len(), all.len() - 9);
         let mut spare = Default::default();
         let mis = samplers(
             &[Technique::Mis],
@@ -266,8 +298,11 @@ mod tests {
             &mut spare,
         )
         .unwrap();
+        // Without the BRDF blob, MIS has ours for the environment half only.
         assert!(mis.iter().all(|s| s.technique() == Technique::Mis));
-        assert_eq!(mis.len(), MIS_SAMPLERS.len());
+        let got: Vec<&str> = mis.iter().map(|s| s.name()).collect();
+        assert_eq!(got, names(Technique::Mis, false));
+        assert_eq!(got.len(), MIS_SAMPLERS.len() - 3);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

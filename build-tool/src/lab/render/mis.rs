@@ -38,10 +38,11 @@ pub fn power_heuristic(p: f64, q: f64) -> f64 {
 }
 
 /// An environment sampler and a BRDF sampler combined (module docs); named as
-/// its environment sampler.
+/// its environment sampler unless [`MisSampler::named`].
 pub struct MisSampler<'a> {
     envmap: Arc<dyn DirectionSampler + 'a>,
     brdf: Arc<dyn DirectionSampler + 'a>,
+    name: &'static str,
 }
 
 impl<'a> MisSampler<'a> {
@@ -57,7 +58,16 @@ impl<'a> MisSampler<'a> {
             && brdf.technique() == Technique::Brdf
             && knows(envmap.as_ref())
             && knows(brdf.as_ref()))
-        .then_some(Self { envmap, brdf })
+        .then(|| Self {
+            name: envmap.name(),
+            envmap,
+            brdf,
+        })
+    }
+
+    /// The combination named `name` (in `render.csv`).
+    pub fn named(self, name: &'static str) -> Self {
+        Self { name, ..self }
     }
 }
 
@@ -67,7 +77,7 @@ impl DirectionSampler for MisSampler<'_> {
     }
 
     fn name(&self) -> &'static str {
-        self.envmap.name()
+        self.name
     }
 
     /// `n` environment samples then `n` BRDF samples, each weight times its

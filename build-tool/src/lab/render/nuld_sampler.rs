@@ -15,7 +15,11 @@
 //!   bits as its random number): the unbiased mode weighs by the sample's own
 //!   `f cos / pdf` and knows its pdf ([`BrdfSampler::pdf`]), a fixed instance
 //!   weighs by the albedo at the material ([`BrdfSampler::albedo`]; its set
-//!   follows the target `f cos / A`, as below) and has no pdf;
+//!   follows the target `f cos / A`, as below) and its density is that target,
+//!   `p(l) = f(wo, l) cos / A` (so that its weight is `f cos / p` as every
+//!   other sampler's, and multiple importance sampling can weigh its samples
+//!   against the environment sampler's; blobs of the earlier mixture prior,
+//!   which store no albedo table, know no density);
 //! * environment sampling: [`EnvmapSampler::sample`] or
 //!   [`EnvmapNetwork::sample`] at the world normal, or their unbiased mode
 //!   ([`EnvmapSampler::sample_randomized`], `nuld-unbiased`, the pixel key's low
@@ -297,7 +301,9 @@ impl DirectionSampler for NuldSampler<'_> {
     fn pdf(&self, at: &ShadingPoint, l: DVec3) -> Option<f64> {
         let normal = at.frame.normal().as_vec3();
         let prior = match self.kind {
-            Kind::Brdf(_) | Kind::BrdfNetwork(_) if !self.randomized => return None,
+            Kind::Brdf(_) | Kind::BrdfNetwork(_) if !self.randomized => {
+                return self.target_pdf(at, l);
+            }
             Kind::Brdf(_) | Kind::BrdfNetwork(_) => {
                 let m = at.material;
                 let (wo, local) = (at.wo.as_vec3(), at.frame.to_local(l).as_vec3());
@@ -323,11 +329,23 @@ impl DirectionSampler for NuldSampler<'_> {
 }
 
 impl NuldSampler<'_> {
+    /// A fixed BRDF instance's density at the world direction `l`: the target
+    /// its sets follow, `f(wo, l) cos / A` with `A` the blob's albedo at the
+    /// material ([`BrdfSampler::albedo`]); `None` for a blob that stores no
+    /// albedo table (the earlier mixture prior) or where `A` is 0.
+    fn target_pdf(&self, at: &ShadingPoint, l: DVec3) -> Option<f64> {
+        let t = BrdfSampler::try_from(self.sampler).ok()?;
+        let m = at.material;
+        let a = t.albedo(at.wo.as_vec3(), m.roughness as f32, m.metallic as f32) as f64;
+        (a > 0.0).then(|| at.cosine_weighted(l) / a)
+    }
+
     /// A BRDF sample in the world frame weighted by the density it follows
     /// (module docs): the runtime's weight `f cos / pdf` and its pdf in the
-    /// unbiased mode; the albedo `A` at the material for a fixed instance, whose
-    /// set follows the target `f cos / A` (the weight of blobs of the earlier
-    /// mixture prior in either mode, whose samples carry no pdf), and no pdf.
+    /// unbiased mode; for a fixed instance, whose set follows the target
+    /// `f cos / A`, the albedo `A` at the material and that target as its pdf
+    /// (the weight of blobs of the earlier mixture prior in either mode, whose
+    /// samples carry no pdf, with pdf 0).
     /// The unbiased mode keeps the runtime's weight even where its pdf is 0 (a
     /// sample the prior's table leaks past the horizon: weight 0, which keeps
     /// the estimate unbiased; the albedo there would add the leaked mass). The
@@ -342,10 +360,15 @@ impl NuldSampler<'_> {
             (false, Ok(t)) => t.albedo(wo, roughness, metallic),
             _ => s.weight,
         };
+        let direction = at.frame.to_world(s.direction.as_dvec3());
+        let pdf = match self.randomized {
+            true => s.pdf as f64,
+            false => self.target_pdf(at, direction).unwrap_or(0.0),
+        };
         Sample {
-            direction: at.frame.to_world(s.direction.as_dvec3()),
+            direction,
             weight: weight as f64,
-            pdf: if self.randomized { s.pdf as f64 } else { 0.0 },
+            pdf,
         }
     }
 
@@ -515,9 +538,20 @@ mod tests {
                         unbiased_checked += (want.pdf > 0.0) as usize;
                     } else {
                         // A fixed instance weighs by the albedo at the material
-                        // (module docs) and has no pdf.
-                        assert_eq!(s.weight, cs.albedo(wo, r, metallic) as f64);
-                        assert_eq!((s.pdf, ours.pdf(&at, s.direction)), (0.0, None));
+                        // and its density is the target f cos / A (module docs):
+                        // f cos from the core's glTF BRDF at the runtime's
+                        // direction, in f64.
+                        let a = cs.albedo(wo, r, metallic) as f64;
+                        assert_eq!(s.weight, a);
+                        let l = s.direction;
+                        let f_cos = nuld_core::brdf::gltf_metallic(
+                            at.wo.to_array(),
+                            l.to_array(),
+                            r as f64,
+                            metallic as f64,
+                        ) * l.z.max(0.0);
+                        assert!(a > 0.0 && (s.pdf - f_cos / a).abs() <= 1e-12 * s.pdf.max(1.0));
+                        assert_eq!(ours.pdf(&at, s.direction), Some(s.pdf));
                     }
                 }
                 // At a tilted normal the world directions are the runtime's local

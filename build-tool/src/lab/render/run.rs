@@ -155,6 +155,7 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
     }
     let wants_brdf = config.techniques.contains(&Technique::Brdf);
     let wants_envmap = config.techniques.iter().any(|t| *t != Technique::Brdf);
+    let wants_mis = config.techniques.contains(&Technique::Mis);
     let map_bytes = std::fs::read(&config.envmap)
         .with_context(|| format!("cannot read environment map {}", config.envmap.display()))?;
     let env = Environment::from_file(&config.envmap)?;
@@ -227,14 +228,18 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
     let exposure = exposure(&reference.image);
     tone_map(&reference.image, exposure).write_png(&out.join("reference.png"))?;
 
-    let per_spp: usize = config
-        .techniques
-        .iter()
-        .map(|t| lineup::names(*t).len())
+    // MIS pairs ours for both halves where a BRDF blob serves the count: one
+    // baked for BRDF sampling, or one given.
+    let brdf_blob_at = |n: u32| blobs.get(n).filter(|_| wants_brdf || wants_mis);
+    let per_seed: usize = (config.spp.iter())
+        .flat_map(|&n| {
+            let brdf = brdf_blob_at(n).is_some();
+            (config.techniques.iter()).map(move |t| lineup::names(*t, brdf).len())
+        })
         .sum();
     let progress = Progress::stderr(
         "render",
-        (per_spp * config.spp.len() * config.seeds as usize) as u64 * h as u64,
+        (per_seed * config.seeds as usize) as u64 * h as u64,
         "row",
     );
     // Every seed's row; the first seed's image and tone-mapped picture.
@@ -249,7 +254,7 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
                     .get(n)
                     .with_context(|| format!("no BRDF blob with N = {n}"))?,
             ),
-            false => None,
+            false => brdf_blob_at(n),
         };
         let envmap = match wants_envmap {
             true => Some(
@@ -377,7 +382,13 @@ fn composite<'a>(
     pictures: &'a [Picture],
     suffix: &str,
 ) -> Composite<'a> {
-    let names = lineup::names(technique);
+    // The rows rendered (MIS's of ours for both halves need a BRDF blob).
+    let names: Vec<&str> = (lineup::names(technique, true).iter().copied())
+        .filter(|name| {
+            rows.iter()
+                .any(|r| r.technique == technique.name() && r.sampler == *name)
+        })
+        .collect();
     let cells = names
         .iter()
         .map(|name| {
@@ -453,11 +464,13 @@ mod tests {
         assert_eq!(lines.next(), Some(CSV_HEADER));
         assert_eq!(CSV_HEADER, "technique,sampler,spp,seed,rmse,bias,seconds");
         let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
-        let per_seed: usize = Technique::ALL.iter().map(|t| lineup::names(*t).len()).sum();
+        let per_seed: usize = (Technique::ALL.iter())
+            .map(|t| lineup::names(*t, true).len())
+            .sum();
         assert_eq!(rows.len(), per_seed * 2 * config.seeds as usize);
         for t in Technique::ALL {
             let technique = t.name();
-            for name in lineup::names(t) {
+            for name in lineup::names(t, true) {
                 for spp in ["4", "16"] {
                     for seed in ["0", "1"] {
                         let row = rows

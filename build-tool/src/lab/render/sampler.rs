@@ -8,7 +8,8 @@
 //! visibility. The weight carries what the sampler knows of the rest:
 //! * BRDF sampling: `w = f(wo, l) cos / p(l)` for the renderer's warp, and the
 //!   stored albedo `A(roughness, theta_o, metallic)` for ours' fixed instances
-//!   (`∫ L f cos ≈ (A/n) Σ L(l_i)`), the runtime's `f cos / pdf` for ours'
+//!   (`∫ L f cos ≈ (A/n) Σ L(l_i)`: `f cos / p` with `p = f cos / A`, the
+//!   target their sets follow), the runtime's `f cos / pdf` for ours'
 //!   unbiased mode;
 //! * environment sampling: `w = f(wo, l) cos / pdf_env(l)`, ours included (its
 //!   exact pdf);
@@ -30,7 +31,9 @@ pub struct Sample {
     pub weight: f64,
     /// Solid-angle density of the sampler's warp at `direction` (per steradian),
     /// what [`DirectionSampler::pdf`] returns there; 0 where the sampler knows
-    /// none (ours' fixed instances for the BRDF).
+    /// none (ours' fixed BRDF instances of blobs of the earlier mixture prior).
+    /// For ours' fixed instances it is the density their sets were made to
+    /// follow, the target the weight assumes.
     pub pdf: f64,
 }
 
@@ -140,7 +143,7 @@ pub trait DirectionSampler: Send + Sync {
 
     /// The solid-angle density with which the sampler's warp at `at` produces the
     /// world direction `l` (0 where it never does), for multiple importance
-    /// sampling; `None` when the sampler cannot say (ours' fixed instances for
-    /// the BRDF, whose samples carry no pdf).
+    /// sampling; `None` when the sampler cannot say (ours' fixed BRDF instances
+    /// of blobs of the earlier mixture prior, which store no albedo table).
     fn pdf(&self, at: &ShadingPoint, l: DVec3) -> Option<f64>;
 }
