@@ -231,6 +231,9 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
     // MIS pairs ours for both halves where a BRDF blob serves the count: one
     // baked for BRDF sampling, or one given.
     let brdf_blob_at = |n: u32| blobs.get(n).filter(|_| wants_brdf || wants_mis);
+    if let Some(w) = mis_without_brdf(wants_mis, &config.spp, |n| brdf_blob_at(n).is_some()) {
+        eprintln!("warning: {w}");
+    }
     let per_seed: usize = (config.spp.iter())
         .flat_map(|&n| {
             let brdf = brdf_blob_at(n).is_some();
@@ -371,6 +374,26 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
 /// `T-S-N.png`.
 fn file_name(row: &Row) -> String {
     format!("{}-{}-{}.png", row.technique, row.sampler, row.spp)
+}
+
+/// The warning that MIS leaves out ours for both halves at the counts of `spp`
+/// where no BRDF blob serves (`has_blob` false); `None` when MIS is not
+/// wanted or every count has one.
+fn mis_without_brdf(
+    wants_mis: bool,
+    spp: &[u32],
+    has_blob: impl Fn(u32) -> bool,
+) -> Option<String> {
+    let without: Vec<String> = (spp.iter())
+        .filter(|&&n| wants_mis && !has_blob(n))
+        .map(|n| n.to_string())
+        .collect();
+    (!without.is_empty()).then(|| {
+        format!(
+            "no BRDF blob at {} spp: mis leaves out ours for both halves (nuld-both-*) there; give --brdf-blob or add brdf to --techniques",
+            without.join(", ")
+        )
+    })
 }
 
 /// The Fig. 8 grid of one technique: rows = its samplers, columns = `spp`;
@@ -529,6 +552,20 @@ mod tests {
             );
         }
         std::fs::remove_dir_all(&out).unwrap();
+    }
+
+    /// MIS without a BRDF blob at some counts says which, and nothing when
+    /// every count has one or MIS is not wanted.
+    #[test]
+    fn mis_without_a_brdf_blob_is_a_warning_naming_the_counts() {
+        let w = mis_without_brdf(true, &[16, 64, 256], |n| n == 64).unwrap();
+        assert!(w.starts_with("no BRDF blob at 16, 256 spp: "), "{w}");
+        assert!(
+            w.contains("nuld-both-*") && w.contains("--brdf-blob"),
+            "{w}"
+        );
+        assert_eq!(mis_without_brdf(true, &[16, 64], |_| true), None);
+        assert_eq!(mis_without_brdf(false, &[16, 64], |_| false), None);
     }
 
     /// A blob `render` bakes is the one `bake --envmap` would: every setting equal.
