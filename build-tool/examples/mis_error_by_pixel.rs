@@ -14,19 +14,16 @@
 use nuld_build_tool::lab::render::brdf_warp::LobeTable;
 use nuld_build_tool::lab::render::camera::Camera;
 use nuld_build_tool::lab::render::environment::Environment;
-use nuld_build_tool::lab::render::integrator::{Primary, Setup};
+use nuld_build_tool::lab::render::integrator::Setup;
 use nuld_build_tool::lab::render::lineup;
 use nuld_build_tool::lab::render::reference::Reference;
 use nuld_build_tool::lab::render::sampler::Technique;
 use nuld_build_tool::lab::render::scene::Scene;
 use nuld_build_tool::pointset::AlignedBytes;
 use std::path::Path;
+use surfaces::{surface_pixels, SurfacePixel, CLASSES};
 
-/// The surface classes, in print order.
-const CLASSES: [&str; 3] = ["dielectric", "metal", "ground"];
-
-/// A surface pixel: its class, roughness and view angle in degrees.
-type Pixel = (usize, f64, f64);
+mod surfaces;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -46,19 +43,7 @@ fn main() {
     };
     let lobes = LobeTable::new(&scene.materials());
     let reference = cached_reference(Path::new(&args[2]), width, height);
-    let pixels: Vec<Option<Pixel>> = (0..height)
-        .flat_map(|y| (0..width).map(move |x| (x, y)))
-        .map(|(x, y)| match setup.primary(x, y) {
-            Primary::Surface { position, at, .. } => {
-                let class = match position.z < 1e-9 {
-                    true => 2,
-                    false => usize::from(at.material.metallic > 0.5),
-                };
-                Some((class, at.material.roughness, at.theta_o_deg()))
-            }
-            Primary::Background(_) => None,
-        })
-        .collect();
+    let pixels = surface_pixels(&setup);
     let brdf = AlignedBytes::read(Path::new(&args[4])).unwrap();
     let envmap = AlignedBytes::read(Path::new(&args[5])).unwrap();
     for seed in 0..4u64 {
@@ -83,7 +68,7 @@ fn main() {
             let mut by_class = [0.0f64; 3];
             let mut errors: Vec<(f64, usize)> = Vec::new();
             for (i, p) in pixels.iter().enumerate() {
-                if let Some((class, _, _)) = *p {
+                if let Some(SurfacePixel { class, .. }) = *p {
                     let e = img.values[i] - reference.image.values[i];
                     by_class[class] += e * e;
                     errors.push((e * e, i));
@@ -97,7 +82,11 @@ fn main() {
                 .collect();
             let worst: Vec<String> = (errors.iter().take(4))
                 .map(|&(e2, i)| {
-                    let (class, r, t) = pixels[i].unwrap();
+                    let SurfacePixel {
+                        class,
+                        roughness: r,
+                        theta_o_deg: t,
+                    } = pixels[i].unwrap();
                     let (x, y) = (i as u32 % width, i as u32 / width);
                     let v = reference.image.values[i];
                     format!(

@@ -11,16 +11,16 @@
 use nuld_build_tool::lab::render::brdf_warp::LobeTable;
 use nuld_build_tool::lab::render::camera::Camera;
 use nuld_build_tool::lab::render::environment::Environment;
-use nuld_build_tool::lab::render::integrator::{Primary, Setup};
+use nuld_build_tool::lab::render::integrator::Setup;
 use nuld_build_tool::lab::render::lineup;
 use nuld_build_tool::lab::render::reference::Reference;
 use nuld_build_tool::lab::render::sampler::Technique;
 use nuld_build_tool::lab::render::scene::Scene;
 use nuld_build_tool::pointset::AlignedBytes;
 use std::path::Path;
+use surfaces::{surface_pixels, CLASSES};
 
-/// The surface classes, in print order.
-const CLASSES: [&str; 3] = ["dielectric spheres", "metal spheres", "ground"];
+mod surfaces;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -38,15 +38,8 @@ fn main() {
     };
     let lobes = LobeTable::new(&scene.materials());
     let reference = Reference::render(&setup, &lobes, 1024, 7, &|| {});
-    // Each pixel's class: the ground is the plane z = 0, the spheres' material
-    // tells the rest.
-    let class: Vec<Option<usize>> = (0..camera.height())
-        .flat_map(|y| (0..camera.width()).map(move |x| (x, y)))
-        .map(|(x, y)| match setup.primary(x, y) {
-            Primary::Surface { position, .. } if position.z < 1e-9 => Some(2),
-            Primary::Surface { at, .. } => Some(usize::from(at.material.metallic > 0.5)),
-            Primary::Background(_) => None,
-        })
+    let class: Vec<Option<usize>> = (surface_pixels(&setup).iter())
+        .map(|p| p.map(|p| p.class))
         .collect();
     for arg in &args[2..] {
         let (n, path) = arg.split_once('=').expect("N=BLOB");

@@ -204,7 +204,9 @@ pub fn weighted_samplers<'a>(
                     material: Material::dielectric(0.5),
                 };
                 // Ours for both halves, mode by mode, when both blobs are here.
-                let ours_envmap = envmaps.iter().take(envmap_blob.map_or(0, |_| 3));
+                let ours_envmap = envmaps
+                    .iter()
+                    .take(envmap_blob.map_or(0, |_| MIS_OURS_BOTH));
                 let both = ours_envmap.zip(&ours_brdf).zip(MIS_SAMPLERS);
                 for ((e, b), name) in both {
                     let mis = MisSampler::new(e.clone(), b.clone(), &probe);
@@ -302,7 +304,7 @@ mod tests {
         assert!(mis.iter().all(|s| s.technique() == Technique::Mis));
         let got: Vec<&str> = mis.iter().map(|s| s.name()).collect();
         assert_eq!(got, names(Technique::Mis, false));
-        assert_eq!(got.len(), MIS_SAMPLERS.len() - 3);
+        assert_eq!(got.len(), MIS_SAMPLERS.len() - MIS_OURS_BOTH);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

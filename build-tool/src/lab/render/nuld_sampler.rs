@@ -266,20 +266,25 @@ impl DirectionSampler for NuldSampler<'_> {
         let normal = at.frame.to_world(DVec3::Z).as_vec3();
         let m = at.material;
         let (wo, r, m) = (at.wo.as_vec3(), m.roughness as f32, m.metallic as f32);
+        // A fixed BRDF instance's albedo, the same for the whole set.
+        let albedo = match self.kind {
+            Kind::Brdf(_) | Kind::BrdfNetwork(_) if !self.randomized => self.albedo(at),
+            _ => None,
+        };
         match self.kind {
             Kind::Brdf(t) => out.extend((0..n).map(|i| {
                 let s = match self.randomized {
                     false => t.sample(wo, r, m, k, i),
                     true => t.sample_randomized(wo, r, m, k, i, key.scramble()),
                 };
-                self.brdf_sample(at, s, (wo, r, m))
+                self.brdf_sample(at, s, albedo)
             })),
             Kind::BrdfNetwork(t) => out.extend((0..n).map(|i| {
                 let s = match self.randomized {
                     false => t.sample(wo, r, m, k, i),
                     true => t.sample_randomized(wo, r, m, k, i, key.scramble()),
                 };
-                self.brdf_sample(at, s, (wo, r, m))
+                self.brdf_sample(at, s, albedo)
             })),
             Kind::Envmap(t, env) => {
                 let set = (0..n).map(|i| match self.randomized {
@@ -302,7 +307,7 @@ impl DirectionSampler for NuldSampler<'_> {
         let normal = at.frame.normal().as_vec3();
         let prior = match self.kind {
             Kind::Brdf(_) | Kind::BrdfNetwork(_) if !self.randomized => {
-                return self.target_pdf(at, l);
+                return Self::target_pdf(at, self.albedo(at)?, l);
             }
             Kind::Brdf(_) | Kind::BrdfNetwork(_) => {
                 let m = at.material;
@@ -329,14 +334,20 @@ impl DirectionSampler for NuldSampler<'_> {
 }
 
 impl NuldSampler<'_> {
-    /// A fixed BRDF instance's density at the world direction `l`: the target
-    /// its sets follow, `f(wo, l) cos / A` with `A` the blob's albedo at the
-    /// material ([`BrdfSampler::albedo`]); `None` for a blob that stores no
-    /// albedo table (the earlier mixture prior) or where `A` is 0.
-    fn target_pdf(&self, at: &ShadingPoint, l: DVec3) -> Option<f64> {
+    /// The blob's albedo `A` at the shading point's view and material
+    /// ([`BrdfSampler::albedo`]): the weight of a fixed BRDF instance's
+    /// samples; `None` for a blob that stores no albedo table (the earlier
+    /// mixture prior).
+    fn albedo(&self, at: &ShadingPoint) -> Option<f64> {
         let t = BrdfSampler::try_from(self.sampler).ok()?;
         let m = at.material;
-        let a = t.albedo(at.wo.as_vec3(), m.roughness as f32, m.metallic as f32) as f64;
+        Some(t.albedo(at.wo.as_vec3(), m.roughness as f32, m.metallic as f32) as f64)
+    }
+
+    /// A fixed BRDF instance's density at the world direction `l`: the target
+    /// its sets follow, `f(wo, l) cos / A` with `A` the albedo `a`; `None`
+    /// where `A` is 0.
+    fn target_pdf(at: &ShadingPoint, a: f64, l: DVec3) -> Option<f64> {
         (a > 0.0).then(|| at.cosine_weighted(l) / a)
     }
 
@@ -350,24 +361,22 @@ impl NuldSampler<'_> {
     /// sample the prior's table leaks past the horizon: weight 0, which keeps
     /// the estimate unbiased; the albedo there would add the leaked mass). The
     /// runtime's directions are unit to f32 rounding; used as they come.
+    /// `albedo`: [`Self::albedo`] at `at` (read by a fixed instance only).
     fn brdf_sample(
         &self,
         at: &ShadingPoint,
         s: nuld_runtime::Sample,
-        (wo, roughness, metallic): (nuld_runtime::glam::Vec3, f32, f32),
+        albedo: Option<f64>,
     ) -> Sample {
-        let weight = match (self.randomized, BrdfSampler::try_from(self.sampler)) {
-            (false, Ok(t)) => t.albedo(wo, roughness, metallic),
-            _ => s.weight,
-        };
         let direction = at.frame.to_world(s.direction.as_dvec3());
-        let pdf = match self.randomized {
-            true => s.pdf as f64,
-            false => self.target_pdf(at, direction).unwrap_or(0.0),
+        let (weight, pdf) = match (self.randomized, albedo) {
+            (true, _) => (s.weight as f64, s.pdf as f64),
+            (false, Some(a)) => (a, Self::target_pdf(at, a, direction).unwrap_or(0.0)),
+            (false, None) => (s.weight as f64, 0.0),
         };
         Sample {
             direction,
-            weight: weight as f64,
+            weight,
             pdf,
         }
     }

@@ -230,13 +230,12 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
 
     // MIS pairs ours for both halves where a BRDF blob serves the count: one
     // baked for BRDF sampling, or one given.
-    let brdf_blob_at = |n: u32| blobs.get(n).filter(|_| wants_brdf || wants_mis);
-    if let Some(w) = mis_without_brdf(wants_mis, &config.spp, |n| brdf_blob_at(n).is_some()) {
+    if let Some(w) = mis_without_brdf(wants_mis, &config.spp, |n| blobs.get(n).is_some()) {
         eprintln!("warning: {w}");
     }
     let per_seed: usize = (config.spp.iter())
         .flat_map(|&n| {
-            let brdf = brdf_blob_at(n).is_some();
+            let brdf = blobs.get(n).is_some();
             (config.techniques.iter()).map(move |t| lineup::names(*t, brdf).len())
         })
         .sum();
@@ -257,7 +256,7 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
                     .get(n)
                     .with_context(|| format!("no BRDF blob with N = {n}"))?,
             ),
-            false => brdf_blob_at(n),
+            false => blobs.get(n),
         };
         let envmap = match wants_envmap {
             true => Some(
@@ -384,8 +383,11 @@ fn mis_without_brdf(
     spp: &[u32],
     has_blob: impl Fn(u32) -> bool,
 ) -> Option<String> {
+    if !wants_mis {
+        return None;
+    }
     let without: Vec<String> = (spp.iter())
-        .filter(|&&n| wants_mis && !has_blob(n))
+        .filter(|&&n| !has_blob(n))
         .map(|n| n.to_string())
         .collect();
     (!without.is_empty()).then(|| {
