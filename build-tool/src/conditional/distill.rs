@@ -24,7 +24,7 @@
 
 use super::blob::{MetalParts, Prior};
 use super::ConditionalParts;
-use crate::network::Params;
+use crate::network::{square_point, Interleaved, Params};
 use crate::progress::Progress;
 use crate::sphere::brdf_albedo::{directional_albedo, directional_albedo_metallic};
 use crate::sphere::EnvmapDensity;
@@ -143,6 +143,7 @@ fn point_table(
     progress: &Progress,
 ) -> Vec<u32> {
     let shipped = params.rounded_to_f16();
+    let forward = Interleaved::new(&shipped);
     let n = shipped.shape.n();
     let nodes = (grid[0] * grid[1]) as usize;
     (0..nodes)
@@ -155,10 +156,10 @@ fn point_table(
                 (node as u32 % grid[0]) as f64 / (grid[0] - 1) as f64,
                 (node as u32 / grid[0]) as f64 / (grid[1] - 1) as f64,
             ];
-            let shipped = &shipped;
+            let net = forward.network();
             (0..instances).flat_map(move |k| {
                 (0..n).map(move |i| {
-                    let p = shipped.square_point(unit, m, k, i);
+                    let p = square_point(&net, unit, m, k, i);
                     pack_point(unorm16_encode(p[0]), unorm16_encode(p[1]))
                 })
             })

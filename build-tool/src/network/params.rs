@@ -2,7 +2,9 @@
 //! [`nuld_core::network`], with a deterministic initialization and f16 rounding.
 
 use crate::seeding::rng;
-use nuld_core::network::{input_features, Network, Shape, Trace};
+use nuld_core::network::{
+    input_features, interleave, InterleavedParams, Network, Parameters, Shape, Trace,
+};
 use nuld_core::quantize::{f16_decode, f16_encode};
 use rand::Rng;
 
@@ -55,21 +57,13 @@ impl Params {
     /// [`Self::trace`] written into `trace` ([`Network::forward_into`]: the
     /// same bits, no 3 kB trace cleared and moved per point).
     pub fn trace_into(&self, c: [f64; 2], m: f64, k: u32, i: u32, trace: &mut Trace<f64>) {
-        self.network().forward_into(
-            self.shape.embedding_row(k, i),
-            input_features(&self.shape, c, m, k, i),
-            trace,
-        )
+        trace_into(&self.network(), c, m, k, i, trace)
     }
-
     /// The point of the unit square of index `i`, instance `k`, normalized condition
     /// `c` and metallic `m`: [`Network::square_point`], the same bits as
     /// `self.trace(c, m, k, i).square_point()` without recording a [`Trace`].
     pub fn square_point(&self, c: [f64; 2], m: f64, k: u32, i: u32) -> [f64; 2] {
-        self.network().square_point(
-            self.shape.embedding_row(k, i),
-            input_features(&self.shape, c, m, k, i),
-        )
+        square_point(&self.network(), c, m, k, i)
     }
 
     /// The parameters as f16 bits (round to nearest even through `f32`).
@@ -89,6 +83,82 @@ impl Params {
                 .collect(),
         }
     }
+}
+
+/// A copy of a network's parameters in the layout the forward pass reads
+/// fastest ([`InterleavedParams`]): [`Interleaved::network`] gives the traces
+/// of [`Params::network`] bit for bit, faster (a quarter of the forward pass at
+/// [32, 32]). A copy: [`Interleaved::refresh`] it after each update.
+#[derive(Clone, Debug)]
+pub struct Interleaved {
+    shape: Shape,
+    values: Vec<f64>,
+}
+
+impl Interleaved {
+    /// `params`, copied and interleaved.
+    pub fn new(params: &Params) -> Self {
+        let mut copy = Self {
+            shape: params.shape,
+            values: Vec::with_capacity(params.values.len()),
+        };
+        copy.refresh(params);
+        copy
+    }
+
+    /// Copies `params` in again (any shape; no allocation for the same one).
+    pub fn refresh(&mut self, params: &Params) {
+        self.shape = params.shape;
+        self.values.clear();
+        self.values.extend_from_slice(&params.values);
+        let done = interleave(&self.shape, &mut self.values);
+        debug_assert!(
+            done.is_some(),
+            "a Params holds its shape's param_len values"
+        );
+    }
+
+    /// The network over the copy.
+    pub fn network(&self) -> Network<InterleavedParams<'_, f64>> {
+        Network {
+            shape: self.shape,
+            params: InterleavedParams::new(self.shape, &self.values),
+        }
+    }
+}
+
+/// The forward pass of index `i`, instance `k`, normalized condition `c` and
+/// metallic `m` through `net`, written into `trace` ([`Params::trace_into`]
+/// over any storage of the parameters).
+pub fn trace_into<W: Parameters<f64>>(
+    net: &Network<W>,
+    c: [f64; 2],
+    m: f64,
+    k: u32,
+    i: u32,
+    trace: &mut Trace<f64>,
+) {
+    net.forward_into(
+        net.shape.embedding_row(k, i),
+        input_features(&net.shape, c, m, k, i),
+        trace,
+    )
+}
+
+/// The point of the unit square of index `i`, instance `k`, normalized
+/// condition `c` and metallic `m` through `net` ([`Params::square_point`] over
+/// any storage of the parameters).
+pub fn square_point<W: Parameters<f64>>(
+    net: &Network<W>,
+    c: [f64; 2],
+    m: f64,
+    k: u32,
+    i: u32,
+) -> [f64; 2] {
+    net.square_point(
+        net.shape.embedding_row(k, i),
+        input_features(&net.shape, c, m, k, i),
+    )
 }
 
 #[cfg(test)]
@@ -111,6 +181,34 @@ mod tests {
         assert!(a.values[128 + 8 * INPUTS..128 + 8 * INPUTS + 8]
             .iter()
             .all(|&x| x == 0.0));
+    }
+
+    /// The interleaved copy traces every point as the parameters do, bit for bit,
+    /// and follows the parameters when refreshed.
+    #[test]
+    fn the_interleaved_copy_traces_the_same_bits() {
+        let shape = Shape::new(8, &[12, 9], Activation::Relu, 3).unwrap();
+        let mut p = Params::init(shape, 5);
+        p.values
+            .iter_mut()
+            .enumerate()
+            .for_each(|(j, v)| *v += j as f64 * 1e-4);
+        let mut copy = Interleaved::new(&p);
+        for round in 0..2 {
+            let net = copy.network();
+            for (k, i) in [(0, 0), (3, 7), (11, 2)] {
+                let c = [0.3, 0.8];
+                let mut t = Trace::default();
+                trace_into(&net, c, 0.0, k, i, &mut t);
+                let want = p.trace(c, 0.0, k, i);
+                assert_eq!(t.output.map(f64::to_bits), want.output.map(f64::to_bits));
+                assert_eq!(t.pre[0].map(f64::to_bits), want.pre[0].map(f64::to_bits));
+                let sq = square_point(&net, c, 0.0, k, i);
+                assert_eq!(sq, p.square_point(c, 0.0, k, i), "round {round}");
+            }
+            p.values.iter_mut().for_each(|v| *v = -*v);
+            copy.refresh(&p);
+        }
     }
 
     #[test]

@@ -9,10 +9,10 @@ use super::{pool, ConditionPool, PoolCondition, TrainConfig, TOURNAMENT};
 use crate::descent::EpochLoss;
 use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use crate::discrepancy::GradientPath;
-use crate::network::{backward, output_gradient, Params};
+use crate::network::{backward, output_gradient, trace_into, Interleaved, Params};
 use crate::seeding::rng;
 use glam::{DVec2, DVec3};
-use nuld_core::network::{Shape, Trace};
+use nuld_core::network::{InterleavedParams, Network, Shape, Trace};
 use rand::Rng;
 use rayon::prelude::*;
 
@@ -59,9 +59,14 @@ impl EpochLoss<f64> for BatchLoss<'_> {
             let start = r.random_range(0..cfg.pool_caps);
             batch.push((pick, instances, start));
         }
-        let StepScratch { params, slots } = &mut *self.scratch;
+        let StepScratch {
+            params,
+            forward,
+            slots,
+        } = &mut *self.scratch;
         params.values.copy_from_slice(values);
-        let params = &*params;
+        forward.refresh(params);
+        let (params, net) = (&*params, &forward.network());
         let results: Vec<(f64, f64)> = batch
             .par_iter()
             .zip(slots.par_iter_mut())
@@ -69,9 +74,9 @@ impl EpochLoss<f64> for BatchLoss<'_> {
                 let pc = &self.pool.conditions[*pick];
                 slot.grad.fill(0.0);
                 if pretraining {
-                    return pretrain_step(cfg, params, pc, instances, &mut slot.grad);
+                    return pretrain_step(cfg, params, net, pc, instances, &mut slot.grad);
                 }
-                condition_step(cfg, params, pc, instances, *start, alpha, slot)
+                condition_step(cfg, params, net, pc, instances, *start, alpha, slot)
             })
             .collect();
         let (mut loss, mut ratio) = (0.0, 0.0);
@@ -123,6 +128,7 @@ pub(super) fn draw_instances(r: &mut impl Rng, count: usize, slots: u32) -> Vec<
 fn pretrain_step(
     cfg: &TrainConfig,
     params: &Params,
+    net: &Network<InterleavedParams<'_, f64>>,
     pc: &PoolCondition,
     instances: &[u32],
     grad: &mut [f64],
@@ -133,7 +139,8 @@ fn pretrain_step(
     for &r in instances {
         let k = r % pool::PRETRAIN_INSTANCES;
         for i in 0..cfg.n {
-            let t = params.trace(pc.unit, pc.metallic, k, i);
+            let mut t = Trace::default();
+            trace_into(net, pc.unit, pc.metallic, k, i, &mut t);
             let s = t.square_point();
             let d = DVec2::new(s[0], s[1]) - pc.warp_targets[k as usize * n + i as usize];
             loss += d.length_squared() / (instances.len() * n) as f64;
@@ -153,9 +160,11 @@ fn pretrain_step(
 /// kernel's page faults and the allocator. No state: the results are the
 /// same bits.
 pub(super) struct StepScratch {
-    /// The parameters of the step, copied in (the forward and backward passes
-    /// read a [`Params`]).
+    /// The parameters of the step, copied in (the backward pass reads a
+    /// [`Params`]).
     params: Params,
+    /// The same, interleaved for the forward pass ([`Interleaved`]).
+    forward: Interleaved,
     /// One per condition of a batch, in batch order.
     slots: Vec<ConditionScratch>,
 }
@@ -163,11 +172,13 @@ pub(super) struct StepScratch {
 impl StepScratch {
     pub(super) fn new(cfg: &TrainConfig, shape: Shape) -> Self {
         let len = shape.param_len();
+        let params = Params {
+            shape,
+            values: vec![0.0; len],
+        };
         Self {
-            params: Params {
-                shape,
-                values: vec![0.0; len],
-            },
+            forward: Interleaved::new(&params),
+            params,
             slots: (0..cfg.conditions_per_step)
                 .map(|_| ConditionScratch {
                     grad: vec![0.0; len],
@@ -197,9 +208,11 @@ struct ConditionScratch {
 /// The sets of one condition in a batch: `(mean set loss, union loss)`, and
 /// `dL/dparams` added into `scratch.grad`, already scaled by the batch's
 /// weights.
+#[allow(clippy::too_many_arguments)]
 fn condition_step(
     cfg: &TrainConfig,
     params: &Params,
+    net: &Network<InterleavedParams<'_, f64>>,
     pc: &PoolCondition,
     instances: &[u32],
     start: usize,
@@ -235,7 +248,7 @@ fn condition_step(
         .iter()
         .flat_map(|&k| (0..cfg.n).map(move |i| (k, i)));
     for ((k, i), t) in points.zip(traces.iter_mut()) {
-        params.trace_into(pc.unit, pc.metallic, k, i, t);
+        trace_into(net, pc.unit, pc.metallic, k, i, t);
         let sq = t.square_point();
         let (d, jx, jy) = pc.direction(DVec2::new(sq[0], sq[1]));
         jacobians.push((jx, jy));

@@ -74,7 +74,7 @@ pub trait Parameters<T: Real> {
 
 /// [`Parameters::block_dot`] as [`UNIT_BLOCK`] calls of [`Parameters::row_dot`].
 #[inline(always)]
-fn rows_one_by_one<T: Real, W: Parameters<T> + ?Sized>(
+pub(super) fn rows_one_by_one<T: Real, W: Parameters<T> + ?Sized>(
     w: &W,
     start: usize,
     x: &[T],
@@ -86,7 +86,7 @@ fn rows_one_by_one<T: Real, W: Parameters<T> + ?Sized>(
 
 /// [`Parameters::row_dot`] through a copy of the row in `scratch`.
 #[inline(always)]
-fn read_dot<T: Real, W: Parameters<T> + ?Sized>(
+pub(super) fn read_dot<T: Real, W: Parameters<T> + ?Sized>(
     w: &W,
     start: usize,
     x: &[T],
@@ -169,7 +169,9 @@ impl Parameters<f32> for F16Params<'_> {
             }),
         }
     }
-    /// The block's rows decoded into `scratch` in one pass, then [`dot_block`].
+    /// The block's rows decoded into `scratch` in one pass, then [`dot_block`]
+    /// (decoding them interleaved, [`super::dot_block_interleaved`]'s layout,
+    /// scatters the decode's writes: twice as slow).
     #[inline(always)]
     fn block_dot(&self, start: usize, x: &[f32], scratch: &mut [f32]) -> [f32; UNIT_BLOCK] {
         let len = (UNIT_BLOCK * x.len()).min(scratch.len());

@@ -83,3 +83,43 @@ pub fn dot_block<T: Real>(rows: &[T], x: &[T]) -> [T; UNIT_BLOCK] {
     }
     s.map(sum_lanes)
 }
+
+/// [`dot_block`] of [`UNIT_BLOCK`] rows stored **interleaved**: `wt[k UNIT_BLOCK + r]`
+/// is weight `k` of row `r` (`x.len()` weights a row), so that one vector of
+/// `wt` holds weight `k` of every row. The same products go to the same partial
+/// sums in the same order, and each row's partials meet in [`dot`]'s tree, so each
+/// result has the bits `dot` gives its row; but the four rows' partial sums `c`
+/// share a vector, and the tree sums vectors, where [`dot_block`] ends with a
+/// horizontal sum per row. Callers pass whole blocks (`UNIT_BLOCK x.len()`
+/// weights); a shorter `wt` sums the products it holds, without a panic.
+#[inline(always)]
+pub fn dot_block_interleaved<T: Real>(wt: &[T], x: &[T]) -> [T; UNIT_BLOCK] {
+    // `s[c][r]`: partial sum `c` of row `r`.
+    let mut s = [[T::ZERO; UNIT_BLOCK]; DOT_LANES];
+    const CHUNK: usize = DOT_LANES * UNIT_BLOCK;
+    let chunks = x.chunks_exact(DOT_LANES).zip(wt.chunks_exact(CHUNK));
+    let mut done = 0;
+    for (xk, wk) in chunks {
+        for (c, sc) in s.iter_mut().enumerate() {
+            for (r, src) in sc.iter_mut().enumerate() {
+                *src = *src + wk[c * UNIT_BLOCK + r] * xk[c];
+            }
+        }
+        done += DOT_LANES;
+    }
+    let (xt, wt) = (
+        x.get(done..).unwrap_or(&[]),
+        wt.get(done * UNIT_BLOCK..).unwrap_or(&[]),
+    );
+    for (c, sc) in s.iter_mut().enumerate() {
+        let (Some(&xc), Some(wc)) = (xt.get(c), wt.get(c * UNIT_BLOCK..)) else {
+            continue;
+        };
+        for (r, src) in sc.iter_mut().enumerate() {
+            *src = *src + wc.get(r).copied().unwrap_or(T::ZERO) * xc;
+        }
+    }
+    core::array::from_fn(|r| {
+        ((s[0][r] + s[1][r]) + (s[2][r] + s[3][r])) + ((s[4][r] + s[5][r]) + (s[6][r] + s[7][r]))
+    })
+}

@@ -57,6 +57,7 @@ use crate::real::Real;
 
 mod features;
 mod forward;
+mod interleaved;
 mod kernels;
 mod shape;
 #[cfg(test)]
@@ -68,7 +69,8 @@ pub use features::{
     LATTICE_LOGIT_EPS, OFFSET_SALTS,
 };
 pub use forward::{F16Params, Network, Parameters, Trace};
-pub use kernels::{dot, dot_block, DOT_LANES, UNIT_BLOCK};
+pub use interleaved::{interleave, interleaved_index, InterleavedParams};
+pub use kernels::{dot, dot_block, dot_block_interleaved, DOT_LANES, UNIT_BLOCK};
 pub use shape::{LayerSpan, Shape};
 
 /// Number of input features of the network: 5 of the condition, 2 of the instance

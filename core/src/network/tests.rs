@@ -453,3 +453,175 @@ fn parameters_cut_short_read_as_zeros_in_either_storage() {
         }
     }
 }
+
+/// `rows` (`UNIT_BLOCK` rows of `len`) interleaved by hand: weight `k` of row
+/// `r` at `k UNIT_BLOCK + r`.
+fn interleaved_by_hand<T: Copy>(rows: &[T], len: usize) -> Vec<T> {
+    (0..UNIT_BLOCK * len)
+        .map(|j| rows[(j % UNIT_BLOCK) * len + j / UNIT_BLOCK])
+        .collect()
+}
+
+#[test]
+fn dot_block_interleaved_gives_each_row_the_bits_of_dot() {
+    for len in [1, 3, 7, 8, 9, 11, 16, 31, 32, 33, 64, 128] {
+        let rows: Vec<f64> = (0..UNIT_BLOCK * len)
+            .map(|j| noise(j + 1000 * len))
+            .collect();
+        let x: Vec<f64> = (0..len).map(|j| noise(j + 7)).collect();
+        let got = dot_block_interleaved(&interleaved_by_hand(&rows, len), &x);
+        let rows32: Vec<f32> = rows.iter().map(|&v| v as f32).collect();
+        let x32: Vec<f32> = x.iter().map(|&v| v as f32).collect();
+        let got32 = dot_block_interleaved(&interleaved_by_hand(&rows32, len), &x32);
+        for r in 0..UNIT_BLOCK {
+            let row = &rows[r * len..][..len];
+            assert_eq!(
+                got[r].to_bits(),
+                dot(row, &x).to_bits(),
+                "len {len} row {r}"
+            );
+            let row32 = &rows32[r * len..][..len];
+            assert_eq!(
+                got32[r].to_bits(),
+                dot(row32, &x32).to_bits(),
+                "f32 len {len} row {r}"
+            );
+        }
+    }
+    // Cut short: no panic, whatever it sums.
+    let _ = dot_block_interleaved(&[1.0f32; 5], &[1.0; 8]);
+}
+
+/// Shapes with whole blocks and remainders in every layer, one to three layers.
+fn interleaving_shapes() -> [Shape; 4] {
+    [
+        Shape::new(5, &[9, 6], Activation::Silu, 3).unwrap(),
+        Shape::new(3, &[4], Activation::Relu, 2).unwrap(),
+        Shape::new(4, &[32, 32], Activation::Relu, 3).unwrap(),
+        Shape::new(2, &[5, 8, 7], Activation::Silu, 1).unwrap(),
+    ]
+}
+
+/// The interleaved layout moves exactly the weights of whole blocks, weight `k`
+/// of a block's row `r` to `k UNIT_BLOCK + r` within the block's span, and reads
+/// back in the row-major numbering.
+#[test]
+fn interleaving_moves_whole_blocks_only_and_reads_back_row_major() {
+    for shape in interleaving_shapes() {
+        let len = shape.param_len();
+        let row_major: Vec<f64> = (0..len).map(|j| j as f64).collect();
+        let mut p = row_major.clone();
+        interleave(&shape, &mut p).unwrap();
+        let mut moved = 0;
+        let mut want = row_major.clone();
+        for span in shape.layers() {
+            for b in 0..span.width / UNIT_BLOCK {
+                let start = span.weights + b * UNIT_BLOCK * span.fan_in;
+                let block = &row_major[start..][..UNIT_BLOCK * span.fan_in];
+                want[start..][..block.len()]
+                    .copy_from_slice(&interleaved_by_hand(block, span.fan_in));
+                moved += block.len();
+            }
+        }
+        assert_eq!(p, want, "{shape:?}");
+        assert!(moved > 0, "{shape:?} has a whole block");
+        let mut image: Vec<usize> = (0..len).map(|j| interleaved_index(&shape, j)).collect();
+        assert!((0..len).all(|j| p[image[j]] == j as f64));
+        image.sort_unstable();
+        assert!(image.iter().copied().eq(0..len), "a permutation");
+        let view = InterleavedParams::new(shape, &p[..]);
+        assert!((0..len).all(|j| Parameters::get(&view, j) == j as f64));
+        assert_eq!(Parameters::get(&view, len + 3), 0.0);
+        // A read across a block and its biases, and one past the end.
+        let span = shape.layers().next().unwrap();
+        let mut out = [0.0; 40];
+        let across = &mut out[..(len - (span.bias - 20)).min(40)];
+        view.read(span.bias - 20, across);
+        assert!(across
+            .iter()
+            .enumerate()
+            .all(|(k, &v)| v == (span.bias - 20 + k) as f64));
+        view.read(len - 2, &mut out[..4]);
+        assert_eq!(out[..4], [(len - 2) as f64, (len - 1) as f64, 0.0, 0.0]);
+        assert!(interleave(&shape, &mut p[1..]).is_none());
+    }
+}
+
+/// A network over the interleaved layout evaluates to the bits of the row-major
+/// one, every hidden pre-activation included, in both precisions; a row or a
+/// block dotted at any offset (not a block's start) reads the row-major rows.
+#[test]
+fn interleaved_storage_gives_the_bits_of_row_major() {
+    for shape in interleaving_shapes() {
+        let p: Vec<f64> = (0..shape.param_len()).map(|j| noise(j) / 2.0).collect();
+        let mut q = p.clone();
+        interleave(&shape, &mut q).unwrap();
+        let (p32, q32): (Vec<f32>, Vec<f32>) = (
+            p.iter().map(|&v| v as f32).collect(),
+            q.iter().map(|&v| v as f32).collect(),
+        );
+        let rows = Network {
+            shape,
+            params: &p[..],
+        };
+        let inter = Network {
+            shape,
+            params: InterleavedParams::new(shape, &q[..]),
+        };
+        let rows32 = Network {
+            shape,
+            params: &p32[..],
+        };
+        let inter32 = Network {
+            shape,
+            params: InterleavedParams::new(shape, &q32[..]),
+        };
+        for i in 0..2 * shape.embedding_rows() as u32 {
+            let input: [f64; INPUTS] = core::array::from_fn(|k| noise(k + 31 * i as usize));
+            let (a, b) = (rows.forward(i, input), inter.forward(i, input));
+            assert_eq!(a.output.map(f64::to_bits), b.output.map(f64::to_bits));
+            for (l, &w) in shape.hidden().iter().enumerate() {
+                let w = w as usize;
+                assert!(a.pre[l][..w]
+                    .iter()
+                    .zip(&b.pre[l][..w])
+                    .all(|(x, y)| x.to_bits() == y.to_bits()));
+            }
+            let input32 = input.map(|v| v as f32);
+            assert_eq!(
+                rows32.evaluate(i, input32).map(f32::to_bits),
+                inter32.evaluate(i, input32).map(f32::to_bits),
+                "{shape:?} row {i}"
+            );
+        }
+        let span = shape.layers().next().unwrap();
+        let x: Vec<f64> = (0..span.fan_in).map(|k| noise(k + 5)).collect();
+        let mut scratch = [0.0; UNIT_BLOCK * MAX_WIDTH];
+        for start in [
+            span.weights,
+            span.weights + 1,
+            span.weights + span.fan_in,
+            span.bias - 3,
+        ] {
+            let want = (&p[..]).block_dot(start, &x, &mut scratch);
+            let got = inter.params.block_dot(start, &x, &mut scratch);
+            assert_eq!(
+                want.map(f64::to_bits),
+                got.map(f64::to_bits),
+                "block at {start}"
+            );
+            let want = (&p[..]).row_dot(start, &x, &mut scratch);
+            let got = inter.params.row_dot(start, &x, &mut scratch);
+            assert_eq!(want.to_bits(), got.to_bits(), "row at {start}");
+        }
+        // Cut short, it evaluates without a panic.
+        let short = Network {
+            shape,
+            params: InterleavedParams::new(shape, &q32[..q32.len() / 2]),
+        };
+        assert!(short
+            .evaluate(1, [0.5f32; INPUTS])
+            .iter()
+            .all(|v| v.is_finite()));
+    }
+}

@@ -14,7 +14,9 @@ use nuld_core::conditional::{
     PointWarp,
 };
 use nuld_core::envmap_tree::EnvmapTree;
-use nuld_core::network::{input_features, F16Params, Network, Parameters, Shape};
+use nuld_core::network::{
+    input_features, interleave, F16Params, InterleavedParams, Network, Parameters, Shape,
+};
 use nuld_core::quantize::unorm16_decode;
 
 mod network;
@@ -102,6 +104,7 @@ struct MetalPoints<'a> {
 #[derive(Clone, Copy, Debug)]
 enum NetworkParams<'a> {
     F16(&'a [u16]),
+    /// Decoded and interleaved ([`nuld_core::network::interleave`]).
     F32(&'a [f32]),
 }
 
@@ -333,7 +336,11 @@ impl<'a> ConditionalSampler<'a> {
                 params: F16Params(params),
             }
             .square_point(row, input),
-            NetworkParams::F32(params) => Network { shape, params }.square_point(row, input),
+            NetworkParams::F32(params) => Network {
+                shape,
+                params: InterleavedParams::new(shape, params),
+            }
+            .square_point(row, input),
         })
     }
 
@@ -409,10 +416,10 @@ impl<'a> ConditionalSampler<'a> {
         let len = self.shape.param_len();
         let out = buf.get_mut(..self.decoded_network_len())?;
         let (shared, metal_out) = out.split_at_mut(len);
-        decode_params(self.params, shared)?;
+        decode_params(self.params, &self.shape, shared)?;
         let metal = match self.metal {
             Some(m) => {
-                decode_params(m.params, metal_out)?;
+                decode_params(m.params, &self.shape, metal_out)?;
                 Some(MetalPoints {
                     params: NetworkParams::F32(metal_out),
                     table: m.table,
@@ -586,14 +593,17 @@ impl<'a> ConditionalSampler<'a> {
 }
 
 /// Decodes `params` (the blob's f16 bits, or a buffer decoded before) into
-/// `out`, which must be exactly as long; `None` otherwise.
-fn decode_params(params: NetworkParams<'_>, out: &mut [f32]) -> Option<()> {
+/// `out`, which must be exactly as long (`None` otherwise), in the layout that
+/// the CPU's forward pass reads fastest ([`InterleavedParams`]; a decoded
+/// buffer holds it already).
+fn decode_params(params: NetworkParams<'_>, shape: &Shape, out: &mut [f32]) -> Option<()> {
     match params {
         NetworkParams::F16(params) => {
             if params.len() != out.len() {
                 return None;
             }
             F16Params(params).read(0, out);
+            interleave(shape, out)?;
         }
         NetworkParams::F32(params) => out.copy_from_slice(params.get(..out.len())?),
     }

@@ -9,7 +9,7 @@ use nuld_core::conditional::{randomization_shift, sections, torus_shift};
 use nuld_core::envmap_tree::{
     build, node_count, top_len, top_normal, top_row, EnvmapTree, NodeRecord, TreeInfo,
 };
-use nuld_core::network::{instance_offset, lattice_point, Activation};
+use nuld_core::network::{instance_offset, interleaved_index, lattice_point, Activation};
 use nuld_core::quadtree::QuadtreeError;
 use nuld_core::quantize::{f16_decode_finite, f16_encode};
 use std::vec::Vec;
@@ -150,12 +150,21 @@ fn a_decoded_network_samples_the_same_bits() {
     let c = Vec2::new(0.4, 33.0);
     assert_eq!(twice.sample(c, 8, 3), cs.network().sample(c, 8, 3));
     assert_eq!(again, buf[..len]);
-    // The weights are the f16 values decoded; the rest of the buffer is untouched.
+    // The weights are the f16 values decoded, each where the interleaved layout
+    // puts it (the first layer's four rows are a block, interleaved; the rest
+    // keep their places); the rest of the buffer is untouched.
     let Parts { params, .. } = parts();
+    let shape = cs.shape();
     assert!(params
         .iter()
-        .zip(&buf)
-        .all(|(&h, &v)| f16_decode_finite(h) == v));
+        .enumerate()
+        .all(|(j, &h)| f16_decode_finite(h) == buf[interleaved_index(&shape, j)]));
+    let first = shape.layers().next().unwrap();
+    assert_eq!(
+        buf[first.weights + 1],
+        f16_decode_finite(params[first.weights + first.fan_in]),
+        "weight 0 of row 1 follows weight 0 of row 0"
+    );
     assert!(buf[len..].iter().all(|v| v.is_nan()));
 }
 
