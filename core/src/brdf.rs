@@ -465,7 +465,8 @@ pub fn view_direction(theta_o_deg: f64) -> DVec3 {
 #[inline]
 pub fn view_direction_real<T: Real>(theta_o_deg: T) -> [T; 3] {
     let t = clamp_theta_o_deg(theta_o_deg) * T::of(core::f64::consts::PI / 180.0);
-    [t.sin(), T::ZERO, t.cos()]
+    let (sin_t, cos_t) = t.sin_cos();
+    [sin_t, T::ZERO, cos_t]
 }
 
 #[cfg(test)]

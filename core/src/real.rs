@@ -46,6 +46,11 @@ pub trait Real:
     fn cos(self) -> Self;
     /// `sin` of an angle in radians.
     fn sin(self) -> Self;
+    /// `(sin, cos)` of an angle in radians, each with the bits of [`Real::sin`]
+    /// and [`Real::cos`]: libm's `sincos` and `sincosf`, one argument reduction
+    /// for both (their reductions and kernels are those of `sin` and `cos`, up to
+    /// the kernels' evenness and oddness, which are exact; tested).
+    fn sin_cos(self) -> (Self, Self);
     /// `atan`, in radians in `[-pi/2, pi/2]`.
     fn atan(self) -> Self;
     /// Rounded towards negative infinity.
@@ -60,6 +65,12 @@ pub trait Real:
     /// The value as `f64` (exact).
     fn to_f64(self) -> f64;
 }
+
+/// The sign bit of an `f64`.
+const F64_SIGN: u64 = 1 << 63;
+
+/// The sign bit of an `f32`.
+const F32_SIGN: u32 = 1 << 31;
 
 impl Real for f64 {
     const ZERO: Self = 0.0;
@@ -81,9 +92,11 @@ impl Real for f64 {
     fn min(self, other: Self) -> Self {
         f64::min(self, other)
     }
+    /// The sign bit cleared: libm's `fabs` bit for bit, inlined (libm's is a
+    /// call, which the warps' hot paths paid several times per sample).
     #[inline]
     fn abs(self) -> Self {
-        libm::fabs(self)
+        f64::from_bits(self.to_bits() & !F64_SIGN)
     }
     #[inline]
     fn is_nan(self) -> bool {
@@ -102,6 +115,10 @@ impl Real for f64 {
         libm::sin(self)
     }
     #[inline]
+    fn sin_cos(self) -> (Self, Self) {
+        libm::sincos(self)
+    }
+    #[inline]
     fn atan(self) -> Self {
         libm::atan(self)
     }
@@ -111,7 +128,7 @@ impl Real for f64 {
         // x86-64 target): below 2^52 in magnitude the truncation is exact in
         // i64; at or above it, and for NaN and infinities, `self` is its floor.
         // The same value as libm's for every input, -0.0 included.
-        if libm::fabs(self) < 4_503_599_627_370_496.0 {
+        if Real::abs(self) < 4_503_599_627_370_496.0 {
             floor_of_truncation(self, self as i64 as f64)
         } else {
             self
@@ -125,9 +142,11 @@ impl Real for f64 {
     fn ln(self) -> Self {
         libm::log(self)
     }
+    /// `self`'s magnitude with `sign`'s sign bit: libm's `copysign` bit for bit
+    /// (NaNs included), inlined.
     #[inline]
     fn copysign(self, sign: Self) -> Self {
-        libm::copysign(self, sign)
+        f64::from_bits((self.to_bits() & !F64_SIGN) | (sign.to_bits() & F64_SIGN))
     }
     #[inline]
     fn to_f64(self) -> f64 {
@@ -155,9 +174,10 @@ impl Real for f32 {
     fn min(self, other: Self) -> Self {
         f32::min(self, other)
     }
+    /// As for `f64`: libm's `fabsf` bit for bit, inlined.
     #[inline]
     fn abs(self) -> Self {
-        libm::fabsf(self)
+        f32::from_bits(self.to_bits() & !F32_SIGN)
     }
     #[inline]
     fn is_nan(self) -> bool {
@@ -176,6 +196,10 @@ impl Real for f32 {
         libm::sinf(self)
     }
     #[inline]
+    fn sin_cos(self) -> (Self, Self) {
+        libm::sincosf(self)
+    }
+    #[inline]
     fn atan(self) -> Self {
         libm::atanf(self)
     }
@@ -183,7 +207,7 @@ impl Real for f32 {
     fn floor(self) -> Self {
         // As for `f64`, below 2^23 (exact in i32): the warps' hot paths floor
         // several times per sample.
-        if libm::fabsf(self) < 8_388_608.0 {
+        if Real::abs(self) < 8_388_608.0 {
             floor_of_truncation(self, self as i32 as f32)
         } else {
             self
@@ -197,9 +221,10 @@ impl Real for f32 {
     fn ln(self) -> Self {
         libm::logf(self)
     }
+    /// As for `f64`: libm's `copysignf` bit for bit, inlined.
     #[inline]
     fn copysign(self, sign: Self) -> Self {
-        libm::copysignf(self, sign)
+        f32::from_bits((self.to_bits() & !F32_SIGN) | (sign.to_bits() & F32_SIGN))
     }
     #[inline]
     fn to_f64(self) -> f64 {
@@ -253,6 +278,88 @@ mod tests {
 
     fn hypot<T: Real>(a: T, b: T) -> T {
         (a * a + b * b).sqrt()
+    }
+
+    /// `abs` and `copysign` against libm's, bit for bit, on signed zeros,
+    /// infinities, NaNs of either sign, subnormals and pseudo-random bits.
+    #[test]
+    fn abs_and_copysign_are_libms_bit_for_bit() {
+        let mut bits = std::vec![0u64, 1, 1 << 63, (1 << 63) | 1, 0x7ff0_0000_0000_0000];
+        bits.extend([
+            0xfff0_0000_0000_0000,
+            0x7ff8_0000_0000_0001,
+            0xfff8_0000_0000_0002,
+        ]);
+        let mut h = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..2000 {
+            h = h
+                .wrapping_mul(0x5851_f42d_4c95_7f2d)
+                .wrapping_add(0x1405_7b7e_f767_814f);
+            bits.push(h);
+        }
+        for &a in &bits {
+            let x = f64::from_bits(a);
+            assert_eq!(Real::abs(x).to_bits(), libm::fabs(x).to_bits());
+            let x32 = f32::from_bits((a >> 32) as u32);
+            assert_eq!(Real::abs(x32).to_bits(), libm::fabsf(x32).to_bits());
+            for &b in bits.iter().take(40) {
+                let y = f64::from_bits(b);
+                let want = libm::copysign(x, y).to_bits();
+                assert_eq!(Real::copysign(x, y).to_bits(), want);
+                let y32 = f32::from_bits((b >> 32) as u32);
+                let want = libm::copysignf(x32, y32).to_bits();
+                assert_eq!(Real::copysign(x32, y32).to_bits(), want);
+            }
+        }
+    }
+
+    /// `sin_cos` has the bits of `sin` and `cos` in both precisions: on special
+    /// values, on every 97th `f32` of `[0, pi/2]` (the angles the warps feed it),
+    /// on the `f64`s around the kernels' small-argument cut-offs (`2^-27` to
+    /// `2^-25`), and on pseudo-random bits and angles (every range of libm's
+    /// argument reduction).
+    #[test]
+    fn sin_cos_has_the_bits_of_sin_and_cos() {
+        fn check<T: Real>(x: T, bits: impl Fn(T) -> u64) {
+            let (s, c) = Real::sin_cos(x);
+            let want = (bits(Real::sin(x)), bits(Real::cos(x)));
+            assert_eq!((bits(s), bits(c)), want, "{}", x.to_f64());
+        }
+        let b32 = |v: f32| v.to_bits() as u64;
+        for x in [
+            0.0,
+            1e-30,
+            f64::MIN_POSITIVE,
+            f64::INFINITY,
+            f64::NAN,
+            1e30,
+            1e300,
+        ] {
+            for x in [x, -x] {
+                check(x, f64::to_bits);
+                check(x as f32, b32);
+            }
+        }
+        let end = core::f32::consts::FRAC_PI_2.to_bits();
+        (0..=end)
+            .step_by(97)
+            .for_each(|b| check(f32::from_bits(b), b32));
+        let (lo, hi) = ((2f64).powi(-27).to_bits(), (2f64).powi(-25).to_bits());
+        (lo..hi)
+            .step_by(1 << 30)
+            .for_each(|b| check(f64::from_bits(b), f64::to_bits));
+        let mut h = 0x2545_f491_4f6c_dd1du64;
+        for k in 0..1_000_000u64 {
+            h ^= h << 13;
+            h ^= h >> 7;
+            h ^= h << 17;
+            check(f32::from_bits(h as u32), b32);
+            let x = match k % 2 {
+                0 => f64::from_bits(h),
+                _ => (h >> 11) as f64 / (1u64 << 53) as f64 * 20.0 - 10.0,
+            };
+            check(x, f64::to_bits);
+        }
     }
 
     #[test]

@@ -59,8 +59,8 @@ pub fn square_to_sphere_real<T: Real>(p: [T; 2]) -> [T; 3] {
         (vp - up) / r + T::ONE
     } * T::of(FRAC_PI_4);
     let z = (T::ONE - r * r).copysign(signed_distance);
-    let cos_phi = phi.cos().copysign(u);
-    let sin_phi = phi.sin().copysign(v);
+    let (sin_phi, cos_phi) = phi.sin_cos();
+    let (cos_phi, sin_phi) = (cos_phi.copysign(u), sin_phi.copysign(v));
     let s = r * safe_sqrt(two - r * r);
     [cos_phi * s, sin_phi * s, z]
 }
@@ -176,7 +176,8 @@ pub fn square_to_hemisphere_real<T: Real>(p: [T; 2]) -> [T; 3] {
     };
     let r2 = r * r;
     let s = r * safe_sqrt(T::of(2.0) - r2);
-    [s * theta.cos(), s * theta.sin(), T::ONE - r2]
+    let (sin_theta, cos_theta) = theta.sin_cos();
+    [s * cos_theta, s * sin_theta, T::ONE - r2]
 }
 
 /// Inverse of [`square_to_hemisphere`]. Directions below the horizon are mirrored

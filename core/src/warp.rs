@@ -104,7 +104,10 @@ pub fn square_to_disk(u: DVec2) -> DVec2 {
 pub fn square_to_disk_real<T: Real>(u: [T; 2]) -> [T; 2] {
     match concentric_polar(u) {
         None => [T::ZERO, T::ZERO],
-        Some((r, theta)) => [r * theta.cos(), r * theta.sin()],
+        Some((r, theta)) => {
+            let (sin_theta, cos_theta) = theta.sin_cos();
+            [r * cos_theta, r * sin_theta]
+        }
     }
 }
 
@@ -216,8 +219,9 @@ pub fn sample_ggx_vndf_real<T: Real>(wo: [T; 3], alpha: T, u: [T; 2]) -> [T; 3] 
     let [vh, t1, t2] = vndf_frame(wo, alpha);
     let r = u[0].max(zero).min(one).sqrt();
     let phi = T::of(2.0) * T::PI * u[1];
-    let p1 = r * phi.cos();
-    let mut p2 = r * phi.sin();
+    let (sin_phi, cos_phi) = phi.sin_cos();
+    let p1 = r * cos_phi;
+    let mut p2 = r * sin_phi;
     // Squash the disk's lower half onto the part of the projected hemisphere that
     // the stretched view direction sees (Heitz 2018, §4.2).
     let s = half * (one + vh[2]);
