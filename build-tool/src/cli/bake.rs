@@ -33,9 +33,9 @@ pub struct BakeArgs {
     /// [default: 10,12]; the normal's octahedral square u,v for --envmap [default: 13,13].
     #[arg(long, value_delimiter = ',')]
     pub grid: Option<Vec<u32>>,
-    /// Training steps after the 300 steps of pretraining on the warp [default:
-    /// 12000 for --brdf, for each of its two networks (metallic below 1, and the
-    /// metal), 3000 for --envmap].
+    /// Training steps after the 300 steps of pretraining on the warp [default for
+    /// --brdf, each of its two networks (metallic below 1, and the metal): 16000
+    /// at --n 64 to 127, else 12000; 3000 for --envmap].
     #[arg(long, allow_negative_numbers = true, value_parser = super::count)]
     pub steps: Option<usize>,
     /// Seed; fixes the output bit for bit whatever the thread count.
@@ -65,7 +65,9 @@ pub struct BakeArgs {
     /// sets [default: 64].
     #[arg(long, allow_negative_numbers = true, value_parser = super::count)]
     pub instance_slots: Option<usize>,
-    /// Weight of the union-of-instances term [default: 0.5 for --brdf, 1.5 for --envmap].
+    /// Weight of the union-of-instances term [default for --brdf: 0.5 below --n
+    /// 64, else 0 (from 64 points the union of instances stays apart without
+    /// it); 1.5 for --envmap].
     #[arg(long)]
     pub union_weight: Option<f64>,
     /// Training conditions in the pool (`None`: the target's default,
@@ -124,16 +126,21 @@ pub fn run(a: BakeArgs) -> Result<()> {
         a.brdf || a.envmap.is_some(),
         "bake needs a target: --brdf or --envmap MAP"
     );
-    let defaults = match &a.envmap {
-        Some(map) => BakeConfig::envmap(TrainTarget::envmap(map)?),
-        None => BakeConfig::default(),
-    };
-    let grid = a.grid.unwrap_or(defaults.grid.to_vec());
     ensure!(
         a.n >= 1 && a.n <= 1 << 16,
         "--n must be in 1..=65536, got {}",
         a.n
     );
+    let defaults = match &a.envmap {
+        Some(map) => BakeConfig::envmap(TrainTarget::envmap(map)?),
+        None => BakeConfig::default(),
+    };
+    // A BRDF sampler's steps and union weight depend on N (`brdf_recipe`).
+    let defaults = BakeConfig {
+        train: defaults.train.clone().with_points(a.n as u32),
+        ..defaults
+    };
+    let grid = a.grid.unwrap_or(defaults.grid.to_vec());
     ensure!(
         a.instances >= 1 && a.instances <= 1 << 16,
         "--instances must be in 1..=65536, got {}",

@@ -116,18 +116,20 @@ pub struct TrainConfig {
 }
 
 impl Default for TrainConfig {
+    /// The BRDF sampler at N = 64, its steps and union weight [`brdf_recipe`]'s.
     fn default() -> Self {
+        let (steps, union_weight) = brdf_recipe(64);
         Self {
             target: TrainTarget::GltfBrdf,
             n: 64,
             hidden: vec![32, 32],
             silu: false,
             prior: true,
-            steps: 12_000,
+            steps,
             pretrain_steps: 300,
             conditions_per_step: 8,
             instances_per_condition: 8,
-            union_weight: 0.5,
+            union_weight,
             pool_conditions: 1024,
             pool_caps: 2048,
             caps_per_step: 256,
@@ -189,7 +191,60 @@ impl BrdfLayer {
 /// 0.819 (docs/results/brdf-sampler.md).
 pub const METALLIC_NODES: [f64; 3] = [0.0, 0.5, 0.95];
 
+/// Training steps of each of a BRDF sampler's networks at 64 to 127 points per
+/// set ([`brdf_recipe`]).
+pub const BRDF_STEPS_AT_64: usize = 16_000;
+
+/// Training steps of each of a BRDF sampler's networks at other sizes
+/// ([`brdf_recipe`]).
+pub const BRDF_STEPS: usize = 12_000;
+
+/// Weight of the union term of a BRDF sampler below 64 points per set
+/// ([`brdf_recipe`]).
+pub const BRDF_UNION_WEIGHT_BELOW_64: f64 = 0.5;
+
+/// A BRDF sampler's training steps and union weight at `n` points per set,
+/// chosen by measurement (docs/results/brdf-sampler.md#per-n-recipe):
+///
+/// * below 64 points, [`BRDF_STEPS`] steps and the union term at
+///   [`BRDF_UNION_WEIGHT_BELOW_64`]: without it the union of N = 16's instances
+///   reads 0.339 of one set (the goal: at most 0.3) and studio's 16 spp loses by
+///   38 % instead of 18 %;
+/// * from 64 points on no union term: the union stays within the goal without it
+///   (0.25 at N = 64, 0.27 at 256), and the sets, the renders and the bake gain
+///   (N = 256: 1481 s instead of 1673 of its 30 minutes);
+/// * at 64 to 127 points [`BRDF_STEPS_AT_64`] steps, which the bake's time
+///   without the union term affords; from 128 on [`BRDF_STEPS`] (N = 256's
+///   30 minutes).
+pub fn brdf_recipe(n: u32) -> (usize, f64) {
+    match n {
+        0..=63 => (BRDF_STEPS, BRDF_UNION_WEIGHT_BELOW_64),
+        64..=127 => (BRDF_STEPS_AT_64, 0.0),
+        _ => (BRDF_STEPS, 0.0),
+    }
+}
+
 impl TrainConfig {
+    /// These settings at `n` points per set; a BRDF sampler on [`brdf_recipe`]
+    /// (its steps and union weight those of the recipe at its own `n`) moves to
+    /// the recipe's at `n`, any other keeps its own (an environment sampler's, a
+    /// caller's explicit ones).
+    pub fn with_points(self, n: u32) -> Self {
+        let on_recipe = self.target == TrainTarget::GltfBrdf
+            && (self.steps, self.union_weight) == brdf_recipe(self.n);
+        let (steps, union_weight) = if on_recipe {
+            brdf_recipe(n)
+        } else {
+            (self.steps, self.union_weight)
+        };
+        Self {
+            n,
+            steps,
+            union_weight,
+            ..self
+        }
+    }
+
     /// Whether the network reads the metallic ([`Self::metallic_nodes`]): the
     /// shared layer of a BRDF sampler with 2 or more nodes.
     pub fn reads_metallic(&self) -> bool {
@@ -394,6 +449,37 @@ mod tests {
     use super::step::draw_instances;
     use super::*;
     use crate::seeding::rng;
+
+    /// The recipe at the three sizes a renderer bakes, and who follows it: a
+    /// configuration on the recipe moves with `n`, an explicit one or an
+    /// environment sampler's keeps its steps and union weight.
+    #[test]
+    fn the_brdf_recipe_follows_the_points_per_set() {
+        let d = TrainConfig::default();
+        assert_eq!((d.n, d.steps, d.union_weight), (64, 16_000, 0.0));
+        let at = |c: &TrainConfig, n| {
+            let c = c.clone().with_points(n);
+            (c.n, c.steps, c.union_weight)
+        };
+        assert_eq!(at(&d, 16), (16, 12_000, 0.5));
+        assert_eq!(at(&d, 256), (256, 12_000, 0.0));
+        assert_eq!(at(&d.clone().with_points(16), 64), (64, 16_000, 0.0));
+        let explicit = TrainConfig {
+            steps: 4,
+            ..d.clone()
+        };
+        assert_eq!(at(&explicit, 16), (16, 4, 0.0));
+        let env = TrainConfig {
+            target: TrainTarget::Envmap {
+                path: "map.hdr".into(),
+                content_hash: 1,
+            },
+            union_weight: 1.5,
+            steps: 3000,
+            ..d
+        };
+        assert_eq!(at(&env, 16), (16, 3000, 1.5));
+    }
 
     fn tiny() -> TrainConfig {
         TrainConfig {

@@ -115,8 +115,10 @@ impl<'e> SamplerBlobs<'e> {
             let sub = dir.join(format!("{stem}-n{n}"));
             let path = sub.join(template.blob_name());
             if !path.is_file() {
-                let mut config = template.clone();
-                config.train.n = n;
+                let config = BakeConfig {
+                    train: template.train.clone().with_points(n),
+                    ..template.clone()
+                };
                 eprintln!(
                     "render: no {what} blob with N = {n}; baking one into {}",
                     sub.display()
