@@ -131,15 +131,12 @@ pub fn run(a: BakeArgs) -> Result<()> {
         "--n must be in 1..=65536, got {}",
         a.n
     );
+    // A BRDF sampler's steps and union weight depend on N (`brdf_recipe`).
     let defaults = match &a.envmap {
         Some(map) => BakeConfig::envmap(TrainTarget::envmap(map)?),
         None => BakeConfig::default(),
-    };
-    // A BRDF sampler's steps and union weight depend on N (`brdf_recipe`).
-    let defaults = BakeConfig {
-        train: defaults.train.clone().with_points(a.n as u32),
-        ..defaults
-    };
+    }
+    .with_points(a.n as u32);
     let grid = a.grid.unwrap_or(defaults.grid.to_vec());
     ensure!(
         a.instances >= 1 && a.instances <= 1 << 16,

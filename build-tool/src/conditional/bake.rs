@@ -133,6 +133,16 @@ impl BakeConfig {
         }
     }
 
+    /// These settings at `n` points per set ([`TrainConfig::with_points`]: a
+    /// BRDF sampler on the recipe moves to the recipe's steps and union weight
+    /// at `n`).
+    pub fn with_points(self, n: u32) -> Self {
+        Self {
+            train: self.train.with_points(n),
+            ..self
+        }
+    }
+
     /// These settings for an environment sampler of `target`: the network refines
     /// the primary space of the map's tree (the exact prior), with
     /// [`ENVMAP_INSTANCE_SLOTS`] instance slots, the union weight

@@ -24,7 +24,7 @@
 
 use super::blob::{MetalParts, Prior};
 use super::ConditionalParts;
-use crate::network::{square_point, Interleaved, Params};
+use crate::network::{Interleaved, Params};
 use crate::progress::Progress;
 use crate::sphere::brdf_albedo::{directional_albedo, directional_albedo_metallic};
 use crate::sphere::EnvmapDensity;
@@ -143,7 +143,7 @@ fn point_table(
     progress: &Progress,
 ) -> Vec<u32> {
     let shipped = params.rounded_to_f16();
-    let forward = Interleaved::new(&shipped);
+    let forward = Interleaved::new(shipped.shape, &shipped.values);
     let n = shipped.shape.n();
     let nodes = (grid[0] * grid[1]) as usize;
     (0..nodes)
@@ -159,7 +159,7 @@ fn point_table(
             let net = forward.network();
             (0..instances).flat_map(move |k| {
                 (0..n).map(move |i| {
-                    let p = square_point(&net, unit, m, k, i);
+                    let p = net.square_point_at(unit, m, k, i);
                     pack_point(unorm16_encode(p[0]), unorm16_encode(p[1]))
                 })
             })

@@ -9,4 +9,4 @@ pub mod backward;
 pub mod params;
 
 pub use backward::{backward, output_gradient};
-pub use params::{square_point, trace_into, Interleaved, Params};
+pub use params::{Interleaved, Params};

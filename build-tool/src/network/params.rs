@@ -2,9 +2,7 @@
 //! [`nuld_core::network`], with a deterministic initialization and f16 rounding.
 
 use crate::seeding::rng;
-use nuld_core::network::{
-    input_features, interleave, InterleavedParams, Network, Parameters, Shape, Trace,
-};
+use nuld_core::network::{interleave, InterleavedParams, Network, Shape, Trace};
 use nuld_core::quantize::{f16_decode, f16_encode};
 use rand::Rng;
 
@@ -57,13 +55,14 @@ impl Params {
     /// [`Self::trace`] written into `trace` ([`Network::forward_into`]: the
     /// same bits, no 3 kB trace cleared and moved per point).
     pub fn trace_into(&self, c: [f64; 2], m: f64, k: u32, i: u32, trace: &mut Trace<f64>) {
-        trace_into(&self.network(), c, m, k, i, trace)
+        self.network().trace_point_into(c, m, k, i, trace)
     }
+
     /// The point of the unit square of index `i`, instance `k`, normalized condition
     /// `c` and metallic `m`: [`Network::square_point`], the same bits as
     /// `self.trace(c, m, k, i).square_point()` without recording a [`Trace`].
     pub fn square_point(&self, c: [f64; 2], m: f64, k: u32, i: u32) -> [f64; 2] {
-        square_point(&self.network(), c, m, k, i)
+        self.network().square_point_at(c, m, k, i)
     }
 
     /// The parameters as f16 bits (round to nearest even through `f32`).
@@ -96,26 +95,23 @@ pub struct Interleaved {
 }
 
 impl Interleaved {
-    /// `params`, copied and interleaved.
-    pub fn new(params: &Params) -> Self {
+    /// `values`, a row-major parameter array of `shape`, copied and interleaved.
+    pub fn new(shape: Shape, values: &[f64]) -> Self {
         let mut copy = Self {
-            shape: params.shape,
-            values: Vec::with_capacity(params.values.len()),
+            shape,
+            values: Vec::with_capacity(values.len()),
         };
-        copy.refresh(params);
+        copy.refresh(values);
         copy
     }
 
-    /// Copies `params` in again (any shape; no allocation for the same one).
-    pub fn refresh(&mut self, params: &Params) {
-        self.shape = params.shape;
+    /// Copies `values` (the same shape's, after an update) in again; no
+    /// allocation.
+    pub fn refresh(&mut self, values: &[f64]) {
         self.values.clear();
-        self.values.extend_from_slice(&params.values);
+        self.values.extend_from_slice(values);
         let done = interleave(&self.shape, &mut self.values);
-        debug_assert!(
-            done.is_some(),
-            "a Params holds its shape's param_len values"
-        );
+        debug_assert!(done.is_some(), "an array of its shape's param_len values");
     }
 
     /// The network over the copy.
@@ -125,40 +121,6 @@ impl Interleaved {
             params: InterleavedParams::new(self.shape, &self.values),
         }
     }
-}
-
-/// The forward pass of index `i`, instance `k`, normalized condition `c` and
-/// metallic `m` through `net`, written into `trace` ([`Params::trace_into`]
-/// over any storage of the parameters).
-pub fn trace_into<W: Parameters<f64>>(
-    net: &Network<W>,
-    c: [f64; 2],
-    m: f64,
-    k: u32,
-    i: u32,
-    trace: &mut Trace<f64>,
-) {
-    net.forward_into(
-        net.shape.embedding_row(k, i),
-        input_features(&net.shape, c, m, k, i),
-        trace,
-    )
-}
-
-/// The point of the unit square of index `i`, instance `k`, normalized
-/// condition `c` and metallic `m` through `net` ([`Params::square_point`] over
-/// any storage of the parameters).
-pub fn square_point<W: Parameters<f64>>(
-    net: &Network<W>,
-    c: [f64; 2],
-    m: f64,
-    k: u32,
-    i: u32,
-) -> [f64; 2] {
-    net.square_point(
-        net.shape.embedding_row(k, i),
-        input_features(&net.shape, c, m, k, i),
-    )
 }
 
 #[cfg(test)]
@@ -193,21 +155,21 @@ mod tests {
             .iter_mut()
             .enumerate()
             .for_each(|(j, v)| *v += j as f64 * 1e-4);
-        let mut copy = Interleaved::new(&p);
+        let mut copy = Interleaved::new(shape, &p.values);
         for round in 0..2 {
             let net = copy.network();
             for (k, i) in [(0, 0), (3, 7), (11, 2)] {
                 let c = [0.3, 0.8];
                 let mut t = Trace::default();
-                trace_into(&net, c, 0.0, k, i, &mut t);
+                net.trace_point_into(c, 0.0, k, i, &mut t);
                 let want = p.trace(c, 0.0, k, i);
                 assert_eq!(t.output.map(f64::to_bits), want.output.map(f64::to_bits));
                 assert_eq!(t.pre[0].map(f64::to_bits), want.pre[0].map(f64::to_bits));
-                let sq = square_point(&net, c, 0.0, k, i);
+                let sq = net.square_point_at(c, 0.0, k, i);
                 assert_eq!(sq, p.square_point(c, 0.0, k, i), "round {round}");
             }
             p.values.iter_mut().for_each(|v| *v = -*v);
-            copy.refresh(&p);
+            copy.refresh(&p.values);
         }
     }
 

@@ -9,10 +9,10 @@ use super::{pool, ConditionPool, PoolCondition, TrainConfig, TOURNAMENT};
 use crate::descent::EpochLoss;
 use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use crate::discrepancy::GradientPath;
-use crate::network::{backward, output_gradient, trace_into, Interleaved, Params};
+use crate::network::{backward, output_gradient, Interleaved};
 use crate::seeding::rng;
 use glam::{DVec2, DVec3};
-use nuld_core::network::{InterleavedParams, Network, Shape, Trace};
+use nuld_core::network::{InterleavedParams, Network, Shape, Trace, OUTPUTS};
 use rand::Rng;
 use rayon::prelude::*;
 
@@ -59,14 +59,12 @@ impl EpochLoss<f64> for BatchLoss<'_> {
             let start = r.random_range(0..cfg.pool_caps);
             batch.push((pick, instances, start));
         }
-        let StepScratch {
-            params,
-            forward,
-            slots,
-        } = &mut *self.scratch;
-        params.values.copy_from_slice(values);
-        forward.refresh(params);
-        let (params, net) = (&*params, &forward.network());
+        let StepScratch { forward, slots } = &mut *self.scratch;
+        forward.refresh(values);
+        let net = &StepNetwork {
+            values,
+            forward: forward.network(),
+        };
         let results: Vec<(f64, f64)> = batch
             .par_iter()
             .zip(slots.par_iter_mut())
@@ -74,9 +72,9 @@ impl EpochLoss<f64> for BatchLoss<'_> {
                 let pc = &self.pool.conditions[*pick];
                 slot.grad.fill(0.0);
                 if pretraining {
-                    return pretrain_step(cfg, params, net, pc, instances, &mut slot.grad);
+                    return pretrain_step(cfg, net, pc, instances, &mut slot.grad);
                 }
-                condition_step(cfg, params, net, pc, instances, *start, alpha, slot)
+                condition_step(cfg, net, pc, instances, *start, alpha, slot)
             })
             .collect();
         let (mut loss, mut ratio) = (0.0, 0.0);
@@ -127,8 +125,7 @@ pub(super) fn draw_instances(r: &mut impl Rng, count: usize, slots: u32) -> Vec<
 /// `(mean squared distance, 0)` and adds the gradient into `grad`.
 fn pretrain_step(
     cfg: &TrainConfig,
-    params: &Params,
-    net: &Network<InterleavedParams<'_, f64>>,
+    net: &StepNetwork<'_>,
     pc: &PoolCondition,
     instances: &[u32],
     grad: &mut [f64],
@@ -140,30 +137,50 @@ fn pretrain_step(
         let k = r % pool::PRETRAIN_INSTANCES;
         for i in 0..cfg.n {
             let mut t = Trace::default();
-            trace_into(net, pc.unit, pc.metallic, k, i, &mut t);
+            net.forward
+                .trace_point_into(pc.unit, pc.metallic, k, i, &mut t);
             let s = t.square_point();
             let d = DVec2::new(s[0], s[1]) - pc.warp_targets[k as usize * n + i as usize];
             loss += d.length_squared() / (instances.len() * n) as f64;
             let d_out = output_gradient(&t, 2.0 * w * d);
-            let row = params.shape.embedding_row(k, i);
-            backward(&params.shape, &params.values, &t, row, d_out, grad);
+            net.backward(&t, k, i, d_out, grad);
         }
     }
     (loss, 0.0)
 }
 
+/// The parameters of a step: as the optimizer holds them (row-major, what the
+/// backward pass reads) and interleaved for the forward pass ([`Interleaved`]),
+/// the same network.
+struct StepNetwork<'a> {
+    values: &'a [f64],
+    forward: Network<InterleavedParams<'a, f64>>,
+}
+
+impl StepNetwork<'_> {
+    /// [`backward`] of point `i` of instance `k` from its trace `t`, into `grad`.
+    fn backward(&self, t: &Trace<f64>, k: u32, i: u32, d_out: [f64; OUTPUTS], grad: &mut [f64]) {
+        let shape = &self.forward.shape;
+        backward(
+            shape,
+            self.values,
+            t,
+            shape.embedding_row(k, i),
+            d_out,
+            grad,
+        );
+    }
+}
+
 /// Buffers that every training step reuses, so that a step allocates no
-/// large arrays: a copy of the parameters and, per condition of a batch, its
+/// large arrays: an interleaved copy of the parameters and, per condition of a batch, its
 /// forward passes and gradients. A step's memory was allocated afresh
 /// before (about 24 MB a step at N = 64, from the network's traces and a
 /// dense gradient per condition) and a quarter of training went to the
 /// kernel's page faults and the allocator. No state: the results are the
 /// same bits.
 pub(super) struct StepScratch {
-    /// The parameters of the step, copied in (the backward pass reads a
-    /// [`Params`]).
-    params: Params,
-    /// The same, interleaved for the forward pass ([`Interleaved`]).
+    /// The parameters of the step, interleaved for the forward pass.
     forward: Interleaved,
     /// One per condition of a batch, in batch order.
     slots: Vec<ConditionScratch>,
@@ -172,13 +189,8 @@ pub(super) struct StepScratch {
 impl StepScratch {
     pub(super) fn new(cfg: &TrainConfig, shape: Shape) -> Self {
         let len = shape.param_len();
-        let params = Params {
-            shape,
-            values: vec![0.0; len],
-        };
         Self {
-            forward: Interleaved::new(&params),
-            params,
+            forward: Interleaved::new(shape, &vec![0.0; len]),
             slots: (0..cfg.conditions_per_step)
                 .map(|_| ConditionScratch {
                     grad: vec![0.0; len],
@@ -208,11 +220,9 @@ struct ConditionScratch {
 /// The sets of one condition in a batch: `(mean set loss, union loss)`, and
 /// `dL/dparams` added into `scratch.grad`, already scaled by the batch's
 /// weights.
-#[allow(clippy::too_many_arguments)]
 fn condition_step(
     cfg: &TrainConfig,
-    params: &Params,
-    net: &Network<InterleavedParams<'_, f64>>,
+    net: &StepNetwork<'_>,
     pc: &PoolCondition,
     instances: &[u32],
     start: usize,
@@ -248,7 +258,7 @@ fn condition_step(
         .iter()
         .flat_map(|&k| (0..cfg.n).map(move |i| (k, i)));
     for ((k, i), t) in points.zip(traces.iter_mut()) {
-        trace_into(net, pc.unit, pc.metallic, k, i, t);
+        net.forward.trace_point_into(pc.unit, pc.metallic, k, i, t);
         let sq = t.square_point();
         let (d, jx, jy) = pc.direction(DVec2::new(sq[0], sq[1]));
         jacobians.push((jx, jy));
@@ -302,8 +312,7 @@ fn condition_step(
         .enumerate()
     {
         let d_out = output_gradient(t, DVec2::new(jx.dot(g3), jy.dot(g3)));
-        let row = params.shape.embedding_row(instances[j / n], (j % n) as u32);
-        backward(&params.shape, &params.values, t, row, d_out, grad);
+        net.backward(t, instances[j / n], (j % n) as u32, d_out, grad);
     }
     (set_loss, union_loss)
 }

@@ -4,7 +4,8 @@
 
 use super::kernels::{dot, dot_block, UNIT_BLOCK};
 use super::{
-    lattice_logit, sigmoid, LayerSpan, Shape, INPUTS, MAX_HIDDEN_LAYERS, MAX_WIDTH, OUTPUTS,
+    input_features, lattice_logit, sigmoid, LayerSpan, Shape, INPUTS, MAX_HIDDEN_LAYERS, MAX_WIDTH,
+    OUTPUTS,
 };
 use crate::quantize::f16_decode_finite;
 use crate::real::Real;
@@ -243,6 +244,30 @@ impl<W> Network<W> {
         W: Parameters<T>,
     {
         self.evaluate(row, input).map(sigmoid)
+    }
+
+    /// [`Network::forward_into`] of index `i` of instance `k` at the normalized
+    /// condition `c` and metallic `m`: embedding row [`Shape::embedding_row`]`(k, i)`,
+    /// input [`input_features`]`(shape, c, m, k, i)`.
+    #[inline]
+    pub fn trace_point_into<T: Real>(&self, c: [T; 2], m: T, k: u32, i: u32, trace: &mut Trace<T>)
+    where
+        W: Parameters<T>,
+    {
+        let input = input_features(&self.shape, c, m, k, i);
+        self.forward_into(self.shape.embedding_row(k, i), input, trace);
+    }
+
+    /// [`Network::square_point`] of index `i` of instance `k` at the normalized
+    /// condition `c` and metallic `m` (the row and input of
+    /// [`Network::trace_point_into`]): what samplers serve.
+    #[inline]
+    pub fn square_point_at<T: Real>(&self, c: [T; 2], m: T, k: u32, i: u32) -> [T; 2]
+    where
+        W: Parameters<T>,
+    {
+        let input = input_features(&self.shape, c, m, k, i);
+        self.square_point(self.shape.embedding_row(k, i), input)
     }
 
     /// The forward pass, in this order of operations (which readers in other

@@ -24,11 +24,15 @@ use crate::real::Real;
 /// row-major numbering; reads past the end give 0 (never a panic).
 #[derive(Clone, Copy, Debug)]
 pub struct InterleavedParams<'a, T> {
-    /// Each layer's blocked weights: `(start, end, fan_in)` (empty past the
-    /// layers), worked out once rather than per read.
-    blocks: [(usize, usize, usize); LAYERS],
+    /// Worked out once rather than per read.
+    blocks: Blocks,
     params: &'a [T],
 }
+
+/// Each layer's weights that whole blocks of rows hold: `(start, end, fan_in)`
+/// (empty past the layers).
+#[derive(Clone, Copy, Debug)]
+struct Blocks([(usize, usize, usize); LAYERS]);
 
 /// Most dense layers a network has: the hidden ones and the output layer.
 const LAYERS: usize = MAX_HIDDEN_LAYERS + 1;
@@ -36,12 +40,43 @@ const LAYERS: usize = MAX_HIDDEN_LAYERS + 1;
 impl<'a, T> InterleavedParams<'a, T> {
     /// `params` in the interleaved layout of `shape`'s network ([`interleave`]).
     pub fn new(shape: Shape, params: &'a [T]) -> Self {
+        Self {
+            blocks: Blocks::new(&shape),
+            params,
+        }
+    }
+}
+
+impl Blocks {
+    fn new(shape: &Shape) -> Self {
         let mut blocks = [(0, 0, 1); LAYERS];
         for (b, span) in blocks.iter_mut().zip(shape.layers()) {
             let (start, end) = blocked(&span);
             *b = (start, end, span.fan_in);
         }
-        Self { blocks, params }
+        Self(blocks)
+    }
+
+    /// The blocked weights `(start, fan_in)` of the layer that holds `j`, if any.
+    #[inline(always)]
+    fn holding(&self, j: usize) -> Option<(usize, usize)> {
+        (self.0.iter())
+            .find(|&&(b0, b1, _)| (b0..b1).contains(&j))
+            .map(|&(b0, _, fan_in)| (b0, fan_in))
+    }
+
+    /// [`interleaved_index`] of `j`.
+    #[inline(always)]
+    fn index(&self, j: usize) -> usize {
+        self.holding(j)
+            .map_or(j, |(start, fan_in)| block_index(start, fan_in, j))
+    }
+
+    /// Whether `start..start + len` meets the weights of a whole block.
+    #[inline(always)]
+    fn meet(&self, start: usize, len: usize) -> bool {
+        let end = start.saturating_add(len);
+        self.0.iter().any(|&(b0, b1, _)| start < b1 && b0 < end)
     }
 }
 
@@ -57,13 +92,7 @@ fn blocked(span: &LayerSpan) -> (usize, usize) {
 /// `weights + b UNIT_BLOCK fan_in + k UNIT_BLOCK + r`; every other parameter
 /// where it was. A permutation of `0..shape.param_len()`; `O(layers)`.
 pub fn interleaved_index(shape: &Shape, j: usize) -> usize {
-    for span in shape.layers() {
-        let (start, end) = blocked(&span);
-        if (start..end).contains(&j) {
-            return block_index(start, span.fan_in, j);
-        }
-    }
-    j
+    Blocks::new(shape).index(j)
 }
 
 /// [`interleaved_index`] of `j` within the blocked weights from `start` of a
@@ -86,13 +115,12 @@ pub fn interleave<T: Real>(shape: &Shape, params: &mut [T]) -> Option<()> {
         return None;
     }
     let mut block = [T::ZERO; UNIT_BLOCK * MAX_WIDTH];
-    for span in shape.layers() {
-        let (start, end) = blocked(&span);
-        let len = UNIT_BLOCK * span.fan_in;
+    for &(start, end, fan_in) in &Blocks::new(shape).0 {
+        let len = UNIT_BLOCK * fan_in;
         for rows in params.get_mut(start..end)?.chunks_exact_mut(len) {
             let copy = block.get_mut(..len)?;
             copy.copy_from_slice(rows);
-            for (r, row) in copy.chunks_exact(span.fan_in).enumerate() {
+            for (r, row) in copy.chunks_exact(fan_in).enumerate() {
                 for (k, &w) in row.iter().enumerate() {
                     if let Some(slot) = rows.get_mut(k * UNIT_BLOCK + r) {
                         *slot = w;
@@ -105,23 +133,11 @@ pub fn interleave<T: Real>(shape: &Shape, params: &mut [T]) -> Option<()> {
 }
 
 impl<T: Real> InterleavedParams<'_, T> {
-    /// Whether `start..start + len` meets the weights of a whole block.
-    #[inline(always)]
-    fn meets_a_block(&self, start: usize, len: usize) -> bool {
-        let end = start.saturating_add(len);
-        self.blocks
-            .iter()
-            .any(|&(b0, b1, _)| start < b1 && b0 < end)
-    }
-
     /// The interleaved block of rows that starts at row-major offset `start`
     /// with rows of length `len`, if one does.
     #[inline(always)]
     fn block_at(&self, start: usize, len: usize) -> Option<&[T]> {
-        let &(b0, _, fan_in) = self
-            .blocks
-            .iter()
-            .find(|&&(b0, b1, _)| (b0..b1).contains(&start))?;
+        let (b0, fan_in) = self.blocks.holding(start)?;
         let block = UNIT_BLOCK * fan_in;
         if fan_in != len || (start - b0).checked_rem(block) != Some(0) {
             return None;
@@ -135,11 +151,7 @@ impl<T: Real> Parameters<T> for InterleavedParams<'_, T> {
 
     #[inline]
     fn get(&self, j: usize) -> T {
-        let at = self
-            .blocks
-            .iter()
-            .find(|&&(b0, b1, _)| (b0..b1).contains(&j))
-            .map_or(j, |&(b0, _, fan_in)| block_index(b0, fan_in, j));
+        let at = self.blocks.index(j);
         self.params.get(at).copied().unwrap_or(T::ZERO)
     }
 
@@ -147,7 +159,7 @@ impl<T: Real> Parameters<T> for InterleavedParams<'_, T> {
     /// pass's reads), else parameter by parameter.
     #[inline]
     fn read(&self, start: usize, out: &mut [T]) {
-        if self.meets_a_block(start, out.len()) {
+        if self.blocks.meet(start, out.len()) {
             for (k, o) in out.iter_mut().enumerate() {
                 *o = self.get(start.saturating_add(k));
             }
@@ -165,7 +177,7 @@ impl<T: Real> Parameters<T> for InterleavedParams<'_, T> {
             .checked_add(len)
             .and_then(|end| self.params.get(start..end));
         match row {
-            Some(row) if !self.meets_a_block(start, len) => dot(row, &x[..len]),
+            Some(row) if !self.blocks.meet(start, len) => dot(row, &x[..len]),
             _ => read_dot(self, start, x, scratch),
         }
     }

@@ -310,21 +310,25 @@ fn noise(j: usize) -> f64 {
     (hash_u32(j as u32) as f64 / 2f64.powi(31)) - 1.0
 }
 
-/// `dot_block` of `rows` against `dot` of each row, compared by `bits`.
+/// `dot_block` of `rows`, and `dot_block_interleaved` of the same rows
+/// interleaved, against `dot` of each row, compared by `bits`.
 fn assert_block_is_dot<T: Real>(rows: &[T], x: &[T], bits: impl Fn(T) -> u64, what: &str) {
     let got = dot_block(rows, x);
+    let interleaved = dot_block_interleaved(&interleaved_by_hand(rows, x.len()), x);
     for (r, row) in rows.chunks_exact(x.len()).enumerate() {
+        let want = bits(dot(row, x));
+        let len = x.len();
+        assert_eq!(bits(got[r]), want, "{what} len {len} row {r}");
         assert_eq!(
-            bits(got[r]),
-            bits(dot(row, x)),
-            "{what} len {} row {r}",
-            x.len()
+            bits(interleaved[r]),
+            want,
+            "{what} interleaved, len {len} row {r}"
         );
     }
 }
 
 #[test]
-fn dot_block_gives_each_row_the_bits_of_dot() {
+fn dot_blocks_give_each_row_the_bits_of_dot() {
     for len in [1, 3, 7, 8, 9, 11, 16, 31, 32, 33, 64, 128] {
         let rows: Vec<f64> = (0..UNIT_BLOCK * len)
             .map(|j| noise(j + 1000 * len))
@@ -340,6 +344,8 @@ fn dot_block_gives_each_row_the_bits_of_dot() {
         assert_eq!(short[2], dot(&rows[2 * len..2 * len + 1], &x));
         assert_eq!(short[3], 0.0);
     }
+    // An interleaved block cut short: no panic, whatever it sums.
+    let _ = dot_block_interleaved(&[1.0f32; 5], &[1.0; 8]);
 }
 
 /// A network wide enough for blocks of units and a remainder in every layer
@@ -460,36 +466,6 @@ fn interleaved_by_hand<T: Copy>(rows: &[T], len: usize) -> Vec<T> {
     (0..UNIT_BLOCK * len)
         .map(|j| rows[(j % UNIT_BLOCK) * len + j / UNIT_BLOCK])
         .collect()
-}
-
-#[test]
-fn dot_block_interleaved_gives_each_row_the_bits_of_dot() {
-    for len in [1, 3, 7, 8, 9, 11, 16, 31, 32, 33, 64, 128] {
-        let rows: Vec<f64> = (0..UNIT_BLOCK * len)
-            .map(|j| noise(j + 1000 * len))
-            .collect();
-        let x: Vec<f64> = (0..len).map(|j| noise(j + 7)).collect();
-        let got = dot_block_interleaved(&interleaved_by_hand(&rows, len), &x);
-        let rows32: Vec<f32> = rows.iter().map(|&v| v as f32).collect();
-        let x32: Vec<f32> = x.iter().map(|&v| v as f32).collect();
-        let got32 = dot_block_interleaved(&interleaved_by_hand(&rows32, len), &x32);
-        for r in 0..UNIT_BLOCK {
-            let row = &rows[r * len..][..len];
-            assert_eq!(
-                got[r].to_bits(),
-                dot(row, &x).to_bits(),
-                "len {len} row {r}"
-            );
-            let row32 = &rows32[r * len..][..len];
-            assert_eq!(
-                got32[r].to_bits(),
-                dot(row32, &x32).to_bits(),
-                "f32 len {len} row {r}"
-            );
-        }
-    }
-    // Cut short: no panic, whatever it sums.
-    let _ = dot_block_interleaved(&[1.0f32; 5], &[1.0; 8]);
 }
 
 /// Shapes with whole blocks and remainders in every layer, one to three layers.

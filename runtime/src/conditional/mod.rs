@@ -14,9 +14,7 @@ use nuld_core::conditional::{
     PointWarp,
 };
 use nuld_core::envmap_tree::EnvmapTree;
-use nuld_core::network::{
-    input_features, interleave, F16Params, InterleavedParams, Network, Parameters, Shape,
-};
+use nuld_core::network::{interleave, F16Params, InterleavedParams, Network, Parameters, Shape};
 use nuld_core::quantize::unorm16_decode;
 
 mod network;
@@ -326,21 +324,19 @@ impl<'a> ConditionalSampler<'a> {
         instance: u32,
         i: u32,
     ) -> Vec2 {
-        let input = input_features::<f32>(&self.shape, u, metallic, instance, i);
         let shape = self.shape;
-        let row = shape.embedding_row(instance, i);
         Vec2::from_array(match self.params {
             // Every index below `param_len` exists and is finite (`validate`).
             NetworkParams::F16(params) => Network {
                 shape,
                 params: F16Params(params),
             }
-            .square_point(row, input),
+            .square_point_at(u, metallic, instance, i),
             NetworkParams::F32(params) => Network {
                 shape,
                 params: InterleavedParams::new(shape, params),
             }
-            .square_point(row, input),
+            .square_point_at(u, metallic, instance, i),
         })
     }
 

@@ -115,10 +115,7 @@ impl<'e> SamplerBlobs<'e> {
             let sub = dir.join(format!("{stem}-n{n}"));
             let path = sub.join(template.blob_name());
             if !path.is_file() {
-                let config = BakeConfig {
-                    train: template.train.clone().with_points(n),
-                    ..template.clone()
-                };
+                let config = template.clone().with_points(n);
                 eprintln!(
                     "render: no {what} blob with N = {n}; baking one into {}",
                     sub.display()
