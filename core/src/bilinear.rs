@@ -24,7 +24,7 @@
 //! identity with density 1. Everything is
 //! generic over [`Real`], allocates nothing and never panics.
 
-use crate::real::{clamp_unit, positive, Real};
+use crate::real::{clamp_unit, is_positive_finite, positive, Real};
 
 /// The corners as the warp reads them ([`positive`]: negative and non-finite as 0), or `None` where none is
 /// positive (or their sum is not finite): the identity.
@@ -32,7 +32,7 @@ use crate::real::{clamp_unit, positive, Real};
 fn corners<T: Real>(w: [T; 4]) -> Option<[T; 4]> {
     let w = w.map(positive);
     let sum = (w[0] + w[1]) + (w[2] + w[3]);
-    (sum > T::ZERO && sum.is_finite()).then_some(w)
+    is_positive_finite(sum).then_some(w)
 }
 
 #[inline]

@@ -48,7 +48,7 @@
 //! shaders, `f64` in the tool), allocates nothing and never panics.
 
 use crate::bilinear;
-use crate::quadtree::{self, ChildWeights, QuadtreeError, MAX_LEVELS};
+use crate::quadtree::{self, ChildWeights, Node, QuadtreeError, MAX_LEVELS};
 use crate::real::{clamp_unit, Real};
 use crate::sphere::{sphere_to_square_real, square_to_sphere_real};
 use bytemuck::{Pod, Zeroable};
@@ -170,20 +170,15 @@ pub fn node_count(levels: u32) -> usize {
 /// layout). `x, y < 2^level`.
 #[inline]
 pub fn node_index(level: u32, x: u32, y: u32) -> usize {
-    quadtree::level_offset(level) - 1 + morton(x, y) as usize
+    quadtree::level_offset(level) - 1 + quadtree::morton(x, y) as usize
 }
 
-/// `x` on the even bits, `y` on the odd bits (16 bits each).
+/// Index of the first of `node`'s four children in the records,
+/// [`node_index`] of child `(2x, 2y)`: `4 z` past the next level's first record
+/// (`z` the node's Morton code, which a descent keeps as it goes).
 #[inline]
-fn morton(x: u32, y: u32) -> u32 {
-    fn spread(mut v: u32) -> u32 {
-        v &= 0xffff;
-        v = (v | (v << 8)) & 0x00ff_00ff;
-        v = (v | (v << 4)) & 0x0f0f_0f0f;
-        v = (v | (v << 2)) & 0x3333_3333;
-        (v | (v << 1)) & 0x5555_5555
-    }
-    spread(x) | (spread(y) << 1)
+fn first_child(node: Node) -> usize {
+    quadtree::level_offset(node.level + 1) - 1 + 4 * node.z as usize
 }
 
 /// Levels whose nodes' weights are tabulated over a grid of normals (module docs).
@@ -616,8 +611,8 @@ impl<T: Real> ChildWeights<T> for Lit<'_, T> {
     }
 
     #[inline]
-    fn children(&self, level: u32, x: u32, y: u32) -> [T; 4] {
-        let first = node_index(level + 1, 2 * x, 2 * y);
+    fn children(&self, node: Node) -> [T; 4] {
+        let (level, first) = (node.level, first_child(node));
         let Some(c) = self.tree.nodes.get(first..first + 4) else {
             return [T::ONE; 4];
         };

@@ -25,7 +25,7 @@
 //!
 //! Work per sample `O(L)` (four weights per level), no allocation, no panic.
 
-use crate::real::{clamp_unit, positive, Real};
+use crate::real::{clamp_unit, is_positive_finite, positive, Real};
 
 /// Most levels below the root (`4^24` leaves is far beyond any table).
 pub const MAX_LEVELS: u32 = 24;
@@ -232,9 +232,9 @@ impl<T: Real, F: Fn(u32, u32, u32, T) -> T> ChildWeights<T> for Query<'_, '_, T,
         self.warp.levels
     }
 
-    fn children(&self, level: u32, x: u32, y: u32) -> [T; 4] {
+    fn children(&self, node: Node) -> [T; 4] {
         self.warp
-            .weights(level, x as usize, y as usize, &self.weight)
+            .weights(node.level, node.x as usize, node.y as usize, &self.weight)
     }
 }
 
@@ -247,12 +247,92 @@ pub trait ChildWeights<T> {
     /// Levels below the root (`2^L x 2^L` leaves), at most [`MAX_LEVELS`].
     fn levels(&self) -> u32;
 
-    /// The weights of the four children of node `(x, y)` of level `level <
-    /// levels()` (`[i + 2 j]` for child `(2x + i, 2y + j)` of level `level + 1`),
+    /// The weights of the four children of `node` (`[i + 2 j]` for child `(2x +
+    /// i, 2y + j)` of level `node.level + 1`, `node.level < levels()`),
     /// proportional to the share of samples each receives. Negative and NaN
     /// weights count as 0; where all four are 0 (or one is infinite) the four
     /// children share equally.
-    fn children(&self, level: u32, x: u32, y: u32) -> [T; 4];
+    fn children(&self, node: Node) -> [T; 4];
+}
+
+/// A node of a quadtree as a descent reaches it: its level, column `x` and row
+/// `y` (each below `2^level`) and its Morton code `z`, `x`'s bits on the even
+/// bits and `y`'s on the odd ones ([`morton`]). A descent keeps `z` as it goes,
+/// `z' = 4 z + i + 2 j` for child `(2x + i, 2y + j)`, so that a table in Morton
+/// order ([`crate::envmap_tree`]) finds a node's children without interleaving
+/// bits on the path from one level's choice to the next level's reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Node {
+    /// Levels below the root, at most [`MAX_LEVELS`].
+    pub level: u32,
+    /// Column, below `2^level`.
+    pub x: u32,
+    /// Row, below `2^level`.
+    pub y: u32,
+    /// [`morton`]`(x, y)`.
+    pub z: u64,
+}
+
+impl Node {
+    /// The root.
+    pub const ROOT: Self = Self {
+        level: 0,
+        x: 0,
+        y: 0,
+        z: 0,
+    };
+
+    /// Node `(x, y)` of level `level`, its Morton code computed.
+    #[inline]
+    pub fn new(level: u32, x: u32, y: u32) -> Self {
+        Self {
+            level,
+            x,
+            y,
+            z: morton(x, y),
+        }
+    }
+
+    /// Child `k = i + 2 j` (`k < 4`), node `(2x + i, 2y + j)` of the next level.
+    #[inline]
+    pub fn child(self, k: u32) -> Self {
+        let (i, j) = (k & 1, (k >> 1) & 1);
+        Self {
+            level: self.level + 1,
+            x: 2 * self.x + i,
+            y: 2 * self.y + j,
+            z: 4 * self.z + (k & 3) as u64,
+        }
+    }
+
+    /// The ancestor of leaf `leaf` on level `level` of a tree of `levels >=
+    /// level` levels, its Morton code `leaf_z >> 2 (levels - level)` (`leaf_z`
+    /// the leaf's).
+    #[inline]
+    fn ancestor(levels: u32, leaf: [u32; 2], leaf_z: u64, level: u32) -> Self {
+        let shift = levels - level;
+        Self {
+            level,
+            x: leaf[0] >> shift,
+            y: leaf[1] >> shift,
+            z: leaf_z >> (2 * shift),
+        }
+    }
+}
+
+/// The Morton code of `(x, y)`: `x`'s bits on the even bits, `y`'s on the odd
+/// bits (32 bits each).
+#[inline]
+pub fn morton(x: u32, y: u32) -> u64 {
+    fn spread(v: u32) -> u64 {
+        let mut v = v as u64;
+        v = (v | (v << 16)) & 0x0000_ffff_0000_ffff;
+        v = (v | (v << 8)) & 0x00ff_00ff_00ff_00ff;
+        v = (v | (v << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
+        v = (v | (v << 2)) & 0x3333_3333_3333_3333;
+        (v | (v << 1)) & 0x5555_5555_5555_5555
+    }
+    spread(x) | (spread(y) << 1)
 }
 
 /// The children's weights of a node, made usable: negative, NaN and infinite
@@ -260,7 +340,7 @@ pub trait ChildWeights<T> {
 #[inline]
 fn usable<T: Real>(w: [T; 4]) -> [T; 4] {
     let w = w.map(positive);
-    if sum4(w) > T::ZERO && sum4(w).is_finite() {
+    if is_positive_finite(sum4(w)) {
         w
     } else {
         [T::ONE; 4]
@@ -321,11 +401,11 @@ pub struct Descent<T> {
 pub fn descend<T: Real>(tree: &impl ChildWeights<T>, u: [T; 2]) -> Descent<T> {
     let levels = tree.levels().min(MAX_LEVELS);
     let (mut ux, mut uy) = (clamp_unit(u[0]), clamp_unit(u[1]));
-    let (mut x, mut y) = (0u32, 0u32);
+    let mut node = Node::ROOT;
     let mut p = T::ONE;
     let (mut column, mut row) = (T::ONE, T::ONE);
-    for l in 0..levels {
-        let w = usable(tree.children(l, x, y));
+    for _ in 0..levels {
+        let w = usable(tree.children(node));
         let step = choose(w, &mut ux, &mut uy);
         p = p * share(w, step);
         column = column
@@ -340,11 +420,10 @@ pub fn descend<T: Real>(tree: &impl ChildWeights<T>, u: [T; 2]) -> Descent<T> {
             } else {
                 T::ONE - step.py
             };
-        x = 2 * x + step.i as u32;
-        y = 2 * y + step.j as u32;
+        node = node.child((step.i + 2 * step.j) as u32);
     }
     Descent {
-        leaf: [x, y],
+        leaf: [node.x, node.y],
         local: [ux, uy],
         share: p,
         column,
@@ -359,10 +438,11 @@ pub fn descend<T: Real>(tree: &impl ChildWeights<T>, u: [T; 2]) -> Descent<T> {
 pub fn pdf<T: Real>(tree: &impl ChildWeights<T>, p: [T; 2]) -> T {
     let levels = tree.levels().min(MAX_LEVELS);
     let (lx, ly) = (leaf(levels, p[0]), leaf(levels, p[1]));
+    let z = morton(lx, ly);
     let mut prob = T::ONE;
     for l in 0..levels {
         let shift = levels - l - 1;
-        let w = usable(tree.children(l, lx >> (shift + 1), ly >> (shift + 1)));
+        let w = usable(tree.children(Node::ancestor(levels, [lx, ly], z, l)));
         let k = ((lx >> shift) & 1) + 2 * ((ly >> shift) & 1);
         // `share`'s order of operations: the pdf of a sample is its pdf bit for bit.
         prob = prob * (w[k as usize] / sum4(w));
@@ -376,6 +456,7 @@ pub fn pdf<T: Real>(tree: &impl ChildWeights<T>, p: [T; 2]) -> T {
 pub fn invert<T: Real>(tree: &impl ChildWeights<T>, p: [T; 2]) -> [T; 2] {
     let levels = tree.levels().min(MAX_LEVELS);
     let ([lx, ly], [mut ux, mut uy]) = locate(levels, p);
+    let z = morton(lx, ly);
     let mut steps = [Step {
         px: T::ZERO,
         i: 0,
@@ -384,7 +465,7 @@ pub fn invert<T: Real>(tree: &impl ChildWeights<T>, p: [T; 2]) -> [T; 2] {
     }; MAX_LEVELS as usize];
     for (l, step) in steps.iter_mut().enumerate().take(levels as usize) {
         let shift = levels - l as u32 - 1;
-        let w = usable(tree.children(l as u32, lx >> (shift + 1), ly >> (shift + 1)));
+        let w = usable(tree.children(Node::ancestor(levels, [lx, ly], z, l as u32)));
         let (i, j) = (((lx >> shift) & 1) as usize, ((ly >> shift) & 1) as usize);
         let (px, py) = splits(w);
         *step = Step {

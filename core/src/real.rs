@@ -28,6 +28,8 @@ pub trait Real:
     const ONE: Self;
     /// `pi`.
     const PI: Self;
+    /// The largest finite value.
+    const MAX: Self;
     /// `x` rounded to the nearest value of `Self` (exact for `f64`).
     fn of(x: f64) -> Self;
     /// The square root (NaN for negative arguments).
@@ -66,16 +68,11 @@ pub trait Real:
     fn to_f64(self) -> f64;
 }
 
-/// The sign bit of an `f64`.
-const F64_SIGN: u64 = 1 << 63;
-
-/// The sign bit of an `f32`.
-const F32_SIGN: u32 = 1 << 31;
-
 impl Real for f64 {
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;
     const PI: Self = core::f64::consts::PI;
+    const MAX: Self = f64::MAX;
     #[inline]
     fn of(x: f64) -> Self {
         x
@@ -93,10 +90,13 @@ impl Real for f64 {
         f64::min(self, other)
     }
     /// The sign bit cleared: libm's `fabs` bit for bit, inlined (libm's is a
-    /// call, which the warps' hot paths paid several times per sample).
+    /// call, which the warps' hot paths paid several times per sample). Core's
+    /// own `abs` (LLVM's `fabs`: a mask in the vector register), not the bits
+    /// moved through an integer register and back, which put about 5 % on the
+    /// environment sampler's `pdf` (docs/results/runtime-cost.md#morton).
     #[inline]
     fn abs(self) -> Self {
-        f64::from_bits(self.to_bits() & !F64_SIGN)
+        f64::abs(self)
     }
     #[inline]
     fn is_nan(self) -> bool {
@@ -143,10 +143,10 @@ impl Real for f64 {
         libm::log(self)
     }
     /// `self`'s magnitude with `sign`'s sign bit: libm's `copysign` bit for bit
-    /// (NaNs included), inlined.
+    /// (NaNs included), inlined (core's own, as for [`Real::abs`]).
     #[inline]
     fn copysign(self, sign: Self) -> Self {
-        f64::from_bits((self.to_bits() & !F64_SIGN) | (sign.to_bits() & F64_SIGN))
+        f64::copysign(self, sign)
     }
     #[inline]
     fn to_f64(self) -> f64 {
@@ -158,6 +158,7 @@ impl Real for f32 {
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;
     const PI: Self = core::f32::consts::PI;
+    const MAX: Self = f32::MAX;
     #[inline]
     fn of(x: f64) -> Self {
         x as f32
@@ -177,7 +178,7 @@ impl Real for f32 {
     /// As for `f64`: libm's `fabsf` bit for bit, inlined.
     #[inline]
     fn abs(self) -> Self {
-        f32::from_bits(self.to_bits() & !F32_SIGN)
+        f32::abs(self)
     }
     #[inline]
     fn is_nan(self) -> bool {
@@ -224,7 +225,7 @@ impl Real for f32 {
     /// As for `f64`: libm's `copysignf` bit for bit, inlined.
     #[inline]
     fn copysign(self, sign: Self) -> Self {
-        f32::from_bits((self.to_bits() & !F32_SIGN) | (sign.to_bits() & F32_SIGN))
+        f32::copysign(self, sign)
     }
     #[inline]
     fn to_f64(self) -> f64 {
@@ -247,11 +248,21 @@ pub fn clamp_unit<T: Real>(x: T) -> T {
 /// sum and divide by (the warps of [`crate::quadtree`] and [`crate::bilinear`]).
 #[inline]
 pub fn positive<T: Real>(v: T) -> T {
-    if v > T::ZERO && v.is_finite() {
+    if is_positive_finite(v) {
         v
     } else {
         T::ZERO
     }
+}
+
+/// Whether `v` is positive and finite (not NaN): `0 < v <= MAX`, two
+/// comparisons that stay in the vector registers. (`v > 0 && v.is_finite()`,
+/// the same test, compiles to a test of the bits' class in the integer
+/// registers, and the warps' descents waited on the moves there and back at
+/// every level: docs/results/runtime-cost.md#morton.)
+#[inline]
+pub fn is_positive_finite<T: Real>(v: T) -> bool {
+    v > T::ZERO && v <= T::MAX
 }
 
 /// The floor of `x` from its truncation toward zero `t` (exact): `x` itself
@@ -280,6 +291,17 @@ mod tests {
         (a * a + b * b).sqrt()
     }
 
+    /// `count` pseudo-random bit patterns from `seed` (a linear congruential
+    /// sequence).
+    fn random_bits(seed: u64, count: usize) -> impl Iterator<Item = u64> {
+        (0..count).scan(seed, |h, _| {
+            *h = h
+                .wrapping_mul(0x5851_f42d_4c95_7f2d)
+                .wrapping_add(0x1405_7b7e_f767_814f);
+            Some(*h)
+        })
+    }
+
     /// `abs` and `copysign` against libm's, bit for bit, on signed zeros,
     /// infinities, NaNs of either sign, subnormals and pseudo-random bits.
     #[test]
@@ -290,13 +312,7 @@ mod tests {
             0x7ff8_0000_0000_0001,
             0xfff8_0000_0000_0002,
         ]);
-        let mut h = 0x9e37_79b9_7f4a_7c15u64;
-        for _ in 0..2000 {
-            h = h
-                .wrapping_mul(0x5851_f42d_4c95_7f2d)
-                .wrapping_add(0x1405_7b7e_f767_814f);
-            bits.push(h);
-        }
+        bits.extend(random_bits(0x9e37_79b9_7f4a_7c15, 2000));
         for &a in &bits {
             let x = f64::from_bits(a);
             assert_eq!(Real::abs(x).to_bits(), libm::fabs(x).to_bits());
@@ -310,6 +326,47 @@ mod tests {
                 let want = libm::copysignf(x32, y32).to_bits();
                 assert_eq!(Real::copysign(x32, y32).to_bits(), want);
             }
+        }
+    }
+
+    /// `is_positive_finite` (and `positive`) against the class test it stands
+    /// for, `v > 0 && v.is_finite()`, on signed zeros, the smallest and largest
+    /// values of both signs, infinities, NaNs of either sign and pseudo-random
+    /// bits, in both precisions.
+    #[test]
+    fn positive_finite_is_the_class_test() {
+        let mut bits = std::vec![0u64, 1, 1 << 63, (1 << 63) | 1, 0x7ff0_0000_0000_0000];
+        bits.extend([
+            0xfff0_0000_0000_0000,
+            0x7fef_ffff_ffff_ffff,
+            0xffef_ffff_ffff_ffff,
+            0x7ff8_0000_0000_0001,
+            0xfff8_0000_0000_0002,
+            0x0010_0000_0000_0000,
+        ]);
+        bits.extend(random_bits(0x2545_f491_4f6c_dd1d, 20_000));
+        let mut f32_bits: std::vec::Vec<u32> = bits.iter().map(|&b| (b >> 32) as u32).collect();
+        f32_bits.extend([
+            0,
+            1,
+            1 << 31,
+            0x7f7f_ffff,
+            0xff7f_ffff,
+            0x7f80_0000,
+            0xff80_0000,
+        ]);
+        f32_bits.extend([0x7fc0_0001, 0xffc0_0000, 0x0080_0000]);
+        for &b in &bits {
+            let x = f64::from_bits(b);
+            let want = x > 0.0 && x.is_finite();
+            assert_eq!(is_positive_finite(x), want, "{x:e}");
+            assert_eq!(positive(x).to_bits(), if want { b } else { 0 });
+        }
+        for &b in &f32_bits {
+            let x = f32::from_bits(b);
+            let want = x > 0.0 && x.is_finite();
+            assert_eq!(is_positive_finite(x), want, "{x:e}");
+            assert_eq!(positive(x).to_bits(), if want { b } else { 0 });
         }
     }
 

@@ -170,7 +170,7 @@ fn top_weights_are_exact_at_grid_normals_and_positive_where_lit() {
             let s = 1u32 << l;
             for node in 0..s * s {
                 let (x, y) = (node % s, node / s);
-                let w = lit.children(l, x, y);
+                let w = lit.children(Node::new(l, x, y));
                 for k in 0..4u32 {
                     let exact = lit_mass(
                         DVec3::from_array(n),
@@ -191,7 +191,7 @@ fn top_weights_are_exact_at_grid_normals_and_positive_where_lit() {
         let n = DVec3::new(r.next() - 0.5, r.next() - 0.5, r.next() - 0.5).normalize();
         let lit = tree.lit(n.to_array());
         for k in 0..4u32 {
-            let w = lit.children(0, 0, 0)[k as usize];
+            let w = lit.children(Node::ROOT)[k as usize];
             if lit_mass(n, 1, k & 1, k >> 1) > 0.0 {
                 assert!(w > 0.0);
             }

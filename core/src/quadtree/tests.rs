@@ -229,3 +229,35 @@ fn bad_pyramids_are_refused_and_queries_do_not_panic() {
     let (x, pdf) = w32.sample([0.3, 0.6], |_, _, _, m: f32| m);
     assert!(x[0] > 0.0 && pdf > 0.0);
 }
+
+/// A node's Morton code against the bits interleaved one at a time, kept by
+/// [`Node::child`] down a path as [`Node::new`] computes it, and an ancestor's
+/// taken from its leaf's code as computed afresh.
+#[test]
+fn morton_codes_kept_along_a_path_match_the_interleaved_bits() {
+    let brute = |x: u32, y: u32| {
+        (0..32).fold(0u64, |z, b| {
+            z | (((x >> b) & 1) as u64) << (2 * b) | (((y >> b) & 1) as u64) << (2 * b + 1)
+        })
+    };
+    let mut r = Rng(3);
+    for _ in 0..2000 {
+        let (x, y) = ((r.next() * 4.0e9) as u32, (r.next() * 4.0e9) as u32);
+        assert_eq!(morton(x, y), brute(x, y), "({x}, {y})");
+    }
+    assert_eq!(morton(u32::MAX, u32::MAX), u64::MAX);
+    for _ in 0..200 {
+        let levels = 1 + (r.next() * MAX_LEVELS as f64) as u32 % MAX_LEVELS;
+        let mut node = Node::ROOT;
+        let mut path = Vec::new();
+        for _ in 0..levels {
+            node = node.child((r.next() * 4.0) as u32 % 4);
+            assert_eq!(node, Node::new(node.level, node.x, node.y));
+            path.push(node);
+        }
+        for &a in &path {
+            let up = Node::ancestor(levels, [node.x, node.y], node.z, a.level);
+            assert_eq!(up, a);
+        }
+    }
+}

@@ -1,0 +1,111 @@
+//! The environment sampler's table mode and `pdf` in a loop of their own, each
+//! the only caller of the runtime's sampler, so that the compiler inlines the
+//! whole sample into the loop as a renderer's build of one call site would:
+//! `cargo run --release -p nuld-build-tool --example envmap_loop -- [BLOB |
+//! lattice] [NORMALS]`.
+//!
+//! Without `BLOB`, the blob of `build-tool bench --only envmap-prior` (the
+//! default bake's shapes on courtyard's tree, random learned contents); with
+//! `lattice`, the same blob whose table holds each instance's shifted rank-1
+//! lattice at every node (an untrained bake's points, whose interpolation
+//! between nodes keeps them where a trained table's would be, where random
+//! contents interpolate towards the square's middle). Sample `s` has normal
+//! `s / 64 mod NORMALS` (default 64) of a fixed pseudo-random set, instance `s
+//! / 64` and index `s mod 64`; `pdf` is asked for pseudo-random directions.
+//! Prints ns per sample, the best of three runs of 4·10^6 samples each, one
+//! thread. (`bench` times every method through one harness, where the sampler
+//! has several callers and is compiled apart from them.)
+use nuld_build_tool::lab::bench::runtime::{envmap_parts, random_parts, random_shape};
+use nuld_build_tool::pointset::AlignedBytes;
+use nuld_build_tool::sphere::envmap_tree::{prior_levels, PRIOR_GRID};
+use nuld_build_tool::sphere::{EnvmapDensity, EnvmapTree};
+use nuld_core::blob::{Domain, Metadata};
+use nuld_core::conditional::PointWarp;
+use nuld_core::network::Activation;
+use nuld_runtime::glam::Vec3;
+use std::hint::black_box;
+use std::sync::Arc;
+use std::time::Instant;
+
+const SAMPLES: u32 = 4_000_000;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let bytes = match args.get(1) {
+        Some(a) if a == "lattice" => bench_blob(true),
+        Some(path) => AlignedBytes::read(std::path::Path::new(path)).unwrap(),
+        None => bench_blob(false),
+    };
+    let count: usize = args.get(2).map_or(64, |a| a.parse().unwrap());
+    let env = nuld_runtime::Blob::parse(bytes.as_slice())
+        .unwrap()
+        .envmap()
+        .unwrap();
+    let mut h = 7u64;
+    let mut r = || {
+        h = h
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (h >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+    };
+    let normals: Vec<Vec3> = (0..count)
+        .map(|_| Vec3::new(r(), r(), r()).normalize())
+        .collect();
+    let directions: Vec<Vec3> = (0..4096)
+        .map(|_| Vec3::new(r(), r(), r()).normalize())
+        .collect();
+    let best = |f: &dyn Fn(u32)| {
+        (0..3)
+            .map(|_| {
+                let t = Instant::now();
+                (0..SAMPLES).for_each(f);
+                t.elapsed().as_nanos() as f64 / SAMPLES as f64
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let n = |s: u32| normals[(s / 64) as usize % count];
+    let table = best(&|s| {
+        black_box(env.sample(n(s), s / 64, s % 64));
+    });
+    let pdf = best(&|s| {
+        black_box(env.pdf(n(s), directions[s as usize % 4096]));
+    });
+    println!("table mode {table:.1} ns, pdf {pdf:.1} ns per sample ({count} normals)");
+}
+
+/// The blob `bench --only envmap-prior` times, on courtyard.
+fn bench_blob(lattice: bool) -> AlignedBytes {
+    let path = std::path::Path::new("../shared/data/envmaps/courtyard.hdr");
+    let map = EnvmapDensity::from_file_filtered(path, Domain::Sphere).unwrap();
+    let tree = EnvmapTree::new(&map, prior_levels(&map), PRIOR_GRID).unwrap();
+    let bake = nuld_build_tool::conditional::bake::BakeConfig::default();
+    let slots = nuld_build_tool::conditional::bake::ENVMAP_INSTANCE_SLOTS;
+    let shape = random_shape(
+        64,
+        &bake.train.hidden,
+        Activation::Relu,
+        PointWarp::EnvmapTree,
+        slots,
+    )
+    .unwrap();
+    let grid = nuld_build_tool::conditional::bake::ENVMAP_GRID;
+    let mut parts = random_parts(shape, PointWarp::EnvmapTree, 64, grid, 3).unwrap();
+    if lattice {
+        let g = shape.lattice_generator();
+        for (at, code) in parts.table.iter_mut().enumerate() {
+            let (k, i) = ((at / 64) as u32 % 64, at as u32 % 64);
+            let l = nuld_core::network::lattice_point::<f64>(i, 64, g);
+            let p = nuld_core::conditional::torus_shift(l, shape.instance_offset(k));
+            *code = nuld_core::conditional::pack_point(
+                nuld_core::quantize::unorm16_encode(p[0]),
+                nuld_core::quantize::unorm16_encode(p[1]),
+            );
+        }
+    }
+    let meta = Metadata {
+        generator: "bench",
+        target: "envmap",
+        seed: 0,
+    };
+    envmap_parts(parts, Arc::new(tree)).to_blob(&meta).unwrap()
+}
