@@ -1071,7 +1071,8 @@ fn nuld_shape_pdf(local: vec2<f32>, w: vec4<f32>) -> f32 {
     return nuld_linear_pdf(x, a, b) * nuld_linear_pdf(y, c, d);
 }
 
-// Rust: `morton`: `x` on the even bits, `y` on the odd bits.
+// Rust: `quadtree::morton`: `x` on the even bits, `y` on the odd bits (16 bits
+// each here: a tree has at most 12 levels).
 fn nuld_morton(x: u32, y: u32) -> u32 {
     var a = x & 0xffffu;
     a = (a | (a << 8u)) & 0x00ff00ffu;
