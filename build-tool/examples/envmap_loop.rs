@@ -15,13 +15,11 @@
 //! Prints ns per sample, the best of three runs of 4·10^6 samples each, one
 //! thread. (`bench` times every method through one harness, where the sampler
 //! has several callers and is compiled apart from them.)
-use nuld_build_tool::lab::bench::runtime::{envmap_parts, random_parts, random_shape};
+use nuld_build_tool::lab::bench::envmap_prior::{sampler_blob, sampler_parts};
 use nuld_build_tool::pointset::AlignedBytes;
 use nuld_build_tool::sphere::envmap_tree::{prior_levels, PRIOR_GRID};
 use nuld_build_tool::sphere::{EnvmapDensity, EnvmapTree};
-use nuld_core::blob::{Domain, Metadata};
-use nuld_core::conditional::PointWarp;
-use nuld_core::network::Activation;
+use nuld_core::blob::Domain;
 use nuld_runtime::glam::Vec3;
 use std::hint::black_box;
 use std::sync::Arc;
@@ -78,23 +76,14 @@ fn bench_blob(lattice: bool) -> AlignedBytes {
     let path = std::path::Path::new("../shared/data/envmaps/courtyard.hdr");
     let map = EnvmapDensity::from_file_filtered(path, Domain::Sphere).unwrap();
     let tree = EnvmapTree::new(&map, prior_levels(&map), PRIOR_GRID).unwrap();
-    let bake = nuld_build_tool::conditional::bake::BakeConfig::default();
-    let slots = nuld_build_tool::conditional::bake::ENVMAP_INSTANCE_SLOTS;
-    let shape = random_shape(
-        64,
-        &bake.train.hidden,
-        Activation::Relu,
-        PointWarp::EnvmapTree,
-        slots,
-    )
-    .unwrap();
-    let grid = nuld_build_tool::conditional::bake::ENVMAP_GRID;
-    let mut parts = random_parts(shape, PointWarp::EnvmapTree, 64, grid, 3).unwrap();
+    let mut parts = sampler_parts(Arc::new(tree)).unwrap();
     if lattice {
-        let g = shape.lattice_generator();
+        let shape = parts.info.shape().unwrap();
+        let (n, g) = (shape.n() as usize, shape.lattice_generator());
+        let instances = parts.info.instances;
         for (at, code) in parts.table.iter_mut().enumerate() {
-            let (k, i) = ((at / 64) as u32 % 64, at as u32 % 64);
-            let l = nuld_core::network::lattice_point::<f64>(i, 64, g);
+            let (k, i) = ((at / n) as u32 % instances, (at % n) as u32);
+            let l = nuld_core::network::lattice_point::<f64>(i, n as u32, g);
             let p = nuld_core::conditional::torus_shift(l, shape.instance_offset(k));
             *code = nuld_core::conditional::pack_point(
                 nuld_core::quantize::unorm16_encode(p[0]),
@@ -102,10 +91,5 @@ fn bench_blob(lattice: bool) -> AlignedBytes {
             );
         }
     }
-    let meta = Metadata {
-        generator: "bench",
-        target: "envmap",
-        seed: 0,
-    };
-    envmap_parts(parts, Arc::new(tree)).to_blob(&meta).unwrap()
+    sampler_blob(parts).unwrap()
 }

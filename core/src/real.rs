@@ -92,8 +92,8 @@ impl Real for f64 {
     /// The sign bit cleared: libm's `fabs` bit for bit, inlined (libm's is a
     /// call, which the warps' hot paths paid several times per sample). Core's
     /// own `abs` (LLVM's `fabs`: a mask in the vector register), not the bits
-    /// moved through an integer register and back, which put about 5 % on the
-    /// environment sampler's `pdf` (docs/results/runtime-cost.md#morton).
+    /// moved through an integer register and back, which cost the environment
+    /// sampler's `pdf` 2 to 5 % (docs/results/runtime-cost.md#morton).
     #[inline]
     fn abs(self) -> Self {
         f64::abs(self)

@@ -90,18 +90,11 @@ pub struct CapTree {
     nodes: Vec<Node>,
 }
 
+/// The Morton code ([`nuld_core::quadtree::morton`]) of `p`'s cell among
+/// `2^LEVELS x 2^LEVELS` (2 LEVELS bits, so it fits a `u32`).
 fn morton(p: DVec2) -> u32 {
-    let scale = (1u32 << LEVELS) as f64;
-    let spread = |v: f64| -> u32 {
-        let mut x = ((v * scale) as u32).min((1 << LEVELS) - 1);
-        let mut out = 0;
-        for b in 0..LEVELS {
-            out |= (x & 1) << (2 * b);
-            x >>= 1;
-        }
-        out
-    };
-    spread(p.x) | (spread(p.y) << 1)
+    let cell = |v: f64| ((v * (1u32 << LEVELS) as f64) as u32).min((1 << LEVELS) - 1);
+    nuld_core::quadtree::morton(cell(p.x), cell(p.y)) as u32
 }
 
 impl CapTree {

@@ -13,6 +13,8 @@
 use super::rounds::Rounds;
 use super::runtime::{envmap_parts, random_parts, random_shape};
 use crate::baselines::EnvmapLight;
+use crate::conditional::blob::ConditionalParts;
+use crate::pointset::AlignedBytes;
 use crate::sphere::envmap_tree::{prior_levels, PRIOR_GRID};
 use crate::sphere::{DirectionDensity, EnvmapDensity, EnvmapTree};
 use anyhow::{anyhow, Result};
@@ -35,6 +37,41 @@ const N: u32 = 64;
 
 /// Levels of the shallow tree timed beside the prior's own.
 const SHALLOW_LEVELS: u32 = 5;
+
+/// The environment sampler this bench times, on `tree`: the default bake's
+/// shapes ([32, 32] ReLU, [`ENVMAP_INSTANCE_SLOTS`] slots, 64 instances on
+/// [`ENVMAP_GRID`] normals, `N` points) with random contents ([`random_parts`],
+/// seed 3): its speed does not depend on them.
+///
+/// [`ENVMAP_INSTANCE_SLOTS`]: crate::conditional::bake::ENVMAP_INSTANCE_SLOTS
+/// [`ENVMAP_GRID`]: crate::conditional::bake::ENVMAP_GRID
+pub fn sampler_parts(tree: Arc<EnvmapTree>) -> Result<ConditionalParts> {
+    let defaults = crate::conditional::bake::BakeConfig::default();
+    let shape = random_shape(
+        N,
+        &defaults.train.hidden,
+        Activation::Relu,
+        PointWarp::EnvmapTree,
+        crate::conditional::bake::ENVMAP_INSTANCE_SLOTS,
+    )?;
+    let parts = random_parts(
+        shape,
+        PointWarp::EnvmapTree,
+        64,
+        crate::conditional::bake::ENVMAP_GRID,
+        3,
+    )?;
+    Ok(envmap_parts(parts, tree))
+}
+
+/// The blob of `parts` ([`sampler_parts`]) as this bench writes it.
+pub fn sampler_blob(parts: ConditionalParts) -> Result<AlignedBytes> {
+    parts.to_blob(&Metadata {
+        generator: "bench",
+        target: "envmap",
+        seed: 0,
+    })
+}
 
 /// `(method, ns per sample)` rows, the incumbent first, over `samples` samples
 /// each, one thread, the methods taking turns over the rounds of [`Rounds`]
@@ -74,28 +111,7 @@ pub fn measure(
     // descent's own latency.
     let shallow = EnvmapTree::new(map, SHALLOW_LEVELS, grid)?;
     let shallow_core = shallow.tree();
-    // The default bake's sampler: [32, 32] ReLU, 64 slots, 64 instances on 13 x
-    // 13 normals.
-    let defaults = crate::conditional::bake::BakeConfig::default();
-    let shape = random_shape(
-        N,
-        &defaults.train.hidden,
-        Activation::Relu,
-        PointWarp::EnvmapTree,
-        crate::conditional::bake::ENVMAP_INSTANCE_SLOTS,
-    )?;
-    let parts = random_parts(
-        shape,
-        PointWarp::EnvmapTree,
-        64,
-        crate::conditional::bake::ENVMAP_GRID,
-        3,
-    )?;
-    let blob = envmap_parts(parts, Arc::new(tree.clone())).to_blob(&Metadata {
-        generator: "bench",
-        target: "envmap",
-        seed: 0,
-    })?;
+    let blob = sampler_blob(sampler_parts(Arc::new(tree.clone()))?)?;
     let env = Blob::parse(blob.as_slice())
         .map_err(|e| anyhow!("{e}"))?
         .envmap()
