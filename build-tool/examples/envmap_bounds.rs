@@ -35,129 +35,13 @@
 //! at one normal, and in a table fitted node by node, against what the bake's
 //! network reaches across all normals (docs/results/envmap.md, "bounds").
 mod check;
+mod fit;
 
+use fit::{fit, warp, Fit, Site};
 use glam::{DVec2, DVec3};
-use nuld_build_tool::descent::{epoch_schedule, local_factor, Adam};
-use nuld_build_tool::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
-use nuld_build_tool::discrepancy::GradientPath;
 use nuld_build_tool::optimize::directions::{optimize_directions, DirectionConfig};
-use nuld_build_tool::sphere::geometry::{fold, map_jacobian};
-use nuld_build_tool::sphere::{
-    CapMeasureTable, DirectionDensity, EnvmapDensity, EnvmapTree as ToolTree,
-};
-use nuld_core::blob::Domain;
-use nuld_core::envmap_tree::EnvmapTree;
-use nuld_core::network::shifted_lattice_point;
 use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
-use std::f64::consts::PI;
-
-/// The fit's settings.
-struct Fit {
-    n: usize,
-    steps: usize,
-    step: f64,
-}
-
-/// The tree's warp at the normal of octahedral point `u`, and its Jacobian: the
-/// sphere map's times the descent's exact slopes (what the trainer's
-/// `PoolCondition::direction` does); without a tree, the sphere's equal-area map
-/// alone (`p` a point of the sphere's square, the same direction at every
-/// normal).
-fn warp(tree: Option<&EnvmapTree<'_>>, u: [f64; 2], p: DVec2) -> (DVec3, DVec3, DVec3) {
-    match tree {
-        Some(tree) => ToolTree::sample_with_jacobian(tree, u, p),
-        None => {
-            let (jx, jy) = map_jacobian(Domain::Sphere, p);
-            (square_to_sphere(p), jx, jy)
-        }
-    }
-}
-
-/// What a fit reads at one normal: its octahedral point, lit map, caps and their
-/// measures on the lit map's mass rule.
-struct Site {
-    u: [f64; 2],
-    lit: EnvmapDensity,
-    caps: Vec<Cap>,
-    measures: Vec<f64>,
-}
-
-impl Site {
-    /// The normal of octahedral point `u`, its 2048 caps from `stream`.
-    fn new(map: &EnvmapDensity, u: [f64; 2], stream: u32) -> Self {
-        let (lit, _) = map
-            .cosine_weighted(square_to_sphere(DVec2::from(u)))
-            .unwrap();
-        let table = CapMeasureTable::new(&lit.mass_rule(1 << 14));
-        let caps: Vec<Cap> = (0..2048)
-            .map(|k| {
-                let s = |d| sobol_burley::sample(k, d, stream) as f64;
-                Cap::from_unit_cube(DVec3::new(s(0), s(1), s(2)))
-            })
-            .collect();
-        let measures = caps
-            .iter()
-            .map(|c| table.measure(c.center, c.cos_theta))
-            .collect();
-        Self {
-            u,
-            lit,
-            caps,
-            measures,
-        }
-    }
-}
-
-/// `start` fitted in the primary space of the normals `sites` at once (the sum
-/// of their losses; see the module docs), or without a tree in the sphere's
-/// equal-area square.
-fn fit(tree: Option<&EnvmapTree<'_>>, sites: &[Site], start: &[DVec2], how: &Fit) -> Vec<DVec2> {
-    let n = how.n;
-    let mut p = start.to_vec();
-    let mut adam = Adam::new(n);
-    adam.epsilon = 1e-12;
-    let spacing = (4.0 * PI / n as f64).sqrt();
-    let mut grad = vec![DVec3::ZERO; n];
-    for t in 0..how.steps {
-        // The trainer's schedule: sharpness 8 to 64 inverse spacings, the step's
-        // cosine decay to 3 %.
-        let (alpha, ratio) = epoch_schedule(t, how.steps, (8.0, 64.0), 0.03);
-        let mut g = vec![DVec2::ZERO; n];
-        for site in sites {
-            let w: Vec<_> = p.iter().map(|&q| warp(tree, site.u, q)).collect();
-            let dirs: Vec<DVec3> = w.iter().map(|x| x.0).collect();
-            let local: Vec<f64> = dirs
-                .iter()
-                .map(|&x| local_factor(4.0 * PI, site.lit.pdf(x)))
-                .collect();
-            let window: Vec<usize> = (0..256).map(|j| (256 * t + j) % site.caps.len()).collect();
-            let c: Vec<Cap> = window.iter().map(|&j| site.caps[j]).collect();
-            let mu: Vec<f64> = window.iter().map(|&j| site.measures[j]).collect();
-            cap_loss_and_gradient(
-                &dirs,
-                &c,
-                CapArea::Precomputed(&mu),
-                alpha / spacing,
-                Some(&local),
-                GradientPath::Fast,
-                &mut grad,
-            );
-            for i in 0..n {
-                g[i] += DVec2::new(w[i].1.dot(grad[i]), w[i].2.dot(grad[i]));
-            }
-        }
-        adam.step(&mut p, &g, how.step / (n as f64).sqrt() * ratio);
-        for q in &mut p {
-            // The primary square is clamped; the sphere's square wraps at its seam.
-            *q = match tree {
-                Some(_) => q.clamp(DVec2::ZERO, DVec2::splat(1.0 - 1e-12)),
-                None => fold(Domain::Sphere, *q),
-            };
-        }
-    }
-    p
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -166,19 +50,12 @@ fn main() {
         std::process::exit(2);
     }
     let arg = |k: usize, default: f64| args.get(k).map_or(default, |s| s.parse().unwrap());
-    let how = Fit {
-        n: arg(2, 64.0) as usize,
-        steps: arg(3, 3000.0) as usize,
-        step: arg(4, 0.02),
-    };
+    let how = Fit::from_args(&args);
     let grid = arg(5, 13.0) as usize;
     let n = how.n;
     let (shape, env) = check::load(&args[1], n as u32);
     let tree = env.tree.tree();
-    let (g, z) = (shape.lattice_generator(), shape.instance_offset::<f64>(0));
-    let lattice: Vec<DVec2> = (0..n as u32)
-        .map(|i| DVec2::from(shifted_lattice_point(i, n as u32, g, z)))
-        .collect();
+    let lattice = fit::lattice(&shape, n);
     let rows: Vec<[f64; 6]> = (0..check::NORMALS)
         .into_par_iter()
         .filter_map(|index| {
