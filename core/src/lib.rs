@@ -41,6 +41,10 @@
 #![no_std]
 #![deny(missing_docs)]
 
+// The compiler's square root ([`real::Real::sqrt`]); nothing else of std.
+#[cfg(feature = "std")]
+extern crate std;
+
 pub mod bilinear;
 pub mod blob;
 pub mod brdf;

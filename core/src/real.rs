@@ -79,7 +79,7 @@ impl Real for f64 {
     }
     #[inline]
     fn sqrt(self) -> Self {
-        libm::sqrt(self)
+        sqrt_f64(self)
     }
     #[inline]
     fn max(self, other: Self) -> Self {
@@ -165,7 +165,7 @@ impl Real for f32 {
     }
     #[inline]
     fn sqrt(self) -> Self {
-        libm::sqrtf(self)
+        sqrt_f32(self)
     }
     #[inline]
     fn max(self, other: Self) -> Self {
@@ -265,6 +265,38 @@ pub fn is_positive_finite<T: Real>(v: T) -> bool {
     v > T::ZERO && v <= T::MAX
 }
 
+/// IEEE 754's correctly rounded square root of `x`. With the `std` feature it is
+/// the compiler's (LLVM's `sqrt`, which it can schedule and vectorize: the
+/// environment tree's four children take one `sqrtps`); without it, libm's,
+/// whose inline `sqrtsd` the compiler can do neither with. Both round the exact
+/// root once: the same bits (a test).
+#[cfg(feature = "std")]
+#[inline]
+fn sqrt_f64(x: f64) -> f64 {
+    f64::sqrt(x)
+}
+
+/// [`sqrt_f64`] without std: libm's.
+#[cfg(not(feature = "std"))]
+#[inline]
+fn sqrt_f64(x: f64) -> f64 {
+    libm::sqrt(x)
+}
+
+/// [`sqrt_f64`] in `f32`: the compiler's with the `std` feature.
+#[cfg(feature = "std")]
+#[inline]
+fn sqrt_f32(x: f32) -> f32 {
+    f32::sqrt(x)
+}
+
+/// [`sqrt_f64`] in `f32` without std: libm's.
+#[cfg(not(feature = "std"))]
+#[inline]
+fn sqrt_f32(x: f32) -> f32 {
+    libm::sqrtf(x)
+}
+
 /// The floor of `x` from its truncation toward zero `t` (exact): `x` itself
 /// when it is whole (keeping -0.0), else `t`, or `t - 1` below zero.
 #[inline]
@@ -325,6 +357,37 @@ mod tests {
                 let y32 = f32::from_bits((b >> 32) as u32);
                 let want = libm::copysignf(x32, y32).to_bits();
                 assert_eq!(Real::copysign(x32, y32).to_bits(), want);
+            }
+        }
+    }
+
+    /// `sqrt` against libm's, bit for bit, in both precisions: the compiler's
+    /// square root with the `std` feature (the workspace's builds), libm's own
+    /// without. Signed zeros, subnormals, infinities, negative values and NaNs
+    /// (NaN out, compared as NaN), and pseudo-random bits.
+    #[test]
+    fn sqrt_is_libms_bit_for_bit() {
+        let mut bits = std::vec![0u64, 1, 1 << 63, (1 << 63) | 1, 0x7ff0_0000_0000_0000];
+        bits.extend([
+            0xfff0_0000_0000_0000,
+            0x7fef_ffff_ffff_ffff,
+            0x7ff8_0000_0000_0001,
+            0x3ff0_0000_0000_0000,
+            0x4000_0000_0000_0000,
+        ]);
+        bits.extend(random_bits(0x6a09_e667_f3bc_c908, 50_000));
+        for &b in &bits {
+            let x = f64::from_bits(b);
+            let (got, want) = (Real::sqrt(x), libm::sqrt(x));
+            assert!(got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan()));
+            // Positive values only, half of them: the random bits' signs fall
+            // either way.
+            let x = f64::from_bits(b & !(1 << 63));
+            assert_eq!(Real::sqrt(x).to_bits(), libm::sqrt(x).to_bits(), "{x:e}");
+            for b32 in [(b >> 32) as u32, b as u32 & 0x7fff_ffff] {
+                let x = f32::from_bits(b32);
+                let (got, want) = (Real::sqrt(x), libm::sqrtf(x));
+                assert!(got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan()));
             }
         }
     }
