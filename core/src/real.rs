@@ -32,7 +32,8 @@ pub trait Real:
     const MAX: Self;
     /// `x` rounded to the nearest value of `Self` (exact for `f64`).
     fn of(x: f64) -> Self;
-    /// The square root (NaN for negative arguments).
+    /// The correctly rounded square root (NaN for negative arguments): the
+    /// compiler's with the crate's `std` feature, libm's without, the same bits.
     fn sqrt(self) -> Self;
     /// The larger argument; the other one if either is NaN.
     fn max(self, other: Self) -> Self;
@@ -380,8 +381,8 @@ mod tests {
             let x = f64::from_bits(b);
             let (got, want) = (Real::sqrt(x), libm::sqrt(x));
             assert!(got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan()));
-            // Positive values only, half of them: the random bits' signs fall
-            // either way.
+            // The same bits made positive, compared bit for bit: every value
+            // has a root, and a NaN passes its payload through in both.
             let x = f64::from_bits(b & !(1 << 63));
             assert_eq!(Real::sqrt(x).to_bits(), libm::sqrt(x).to_bits(), "{x:e}");
             for b32 in [(b >> 32) as u32, b as u32 & 0x7fff_ffff] {
