@@ -80,7 +80,7 @@ impl Real for f64 {
     }
     #[inline]
     fn sqrt(self) -> Self {
-        sqrt_f64(self)
+        root::sqrt(self)
     }
     #[inline]
     fn max(self, other: Self) -> Self {
@@ -166,7 +166,7 @@ impl Real for f32 {
     }
     #[inline]
     fn sqrt(self) -> Self {
-        sqrt_f32(self)
+        root::sqrtf(self)
     }
     #[inline]
     fn max(self, other: Self) -> Self {
@@ -266,37 +266,28 @@ pub fn is_positive_finite<T: Real>(v: T) -> bool {
     v > T::ZERO && v <= T::MAX
 }
 
-/// IEEE 754's correctly rounded square root of `x`. With the `std` feature it is
-/// the compiler's (LLVM's `sqrt`, which it can schedule and vectorize: the
-/// environment tree's four children take one `sqrtps`); without it, libm's,
-/// whose inline `sqrtsd` the compiler can do neither with. Both round the exact
-/// root once: the same bits (a test).
+/// IEEE 754's correctly rounded square roots, named as libm names them. With the
+/// `std` feature they are the compiler's (LLVM's `sqrt`, which it can schedule and
+/// vectorize: the environment tree's four children take one `sqrtps`); without
+/// it, libm's, whose inline `sqrtss`/`sqrtsd` the compiler can do neither with.
+/// Both round the exact root once: the same bits (a test).
 #[cfg(feature = "std")]
-#[inline]
-fn sqrt_f64(x: f64) -> f64 {
-    f64::sqrt(x)
+mod root {
+    /// The square root of an `f64`.
+    #[inline]
+    pub fn sqrt(x: f64) -> f64 {
+        f64::sqrt(x)
+    }
+
+    /// The square root of an `f32`.
+    #[inline]
+    pub fn sqrtf(x: f32) -> f32 {
+        f32::sqrt(x)
+    }
 }
 
-/// [`sqrt_f64`] without std: libm's.
 #[cfg(not(feature = "std"))]
-#[inline]
-fn sqrt_f64(x: f64) -> f64 {
-    libm::sqrt(x)
-}
-
-/// [`sqrt_f64`] in `f32`: the compiler's with the `std` feature.
-#[cfg(feature = "std")]
-#[inline]
-fn sqrt_f32(x: f32) -> f32 {
-    f32::sqrt(x)
-}
-
-/// [`sqrt_f64`] in `f32` without std: libm's.
-#[cfg(not(feature = "std"))]
-#[inline]
-fn sqrt_f32(x: f32) -> f32 {
-    libm::sqrtf(x)
-}
+use libm as root;
 
 /// The floor of `x` from its truncation toward zero `t` (exact): `x` itself
 /// when it is whole (keeping -0.0), else `t`, or `t - 1` below zero.
