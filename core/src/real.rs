@@ -326,17 +326,25 @@ mod tests {
         })
     }
 
+    /// `f64` bit patterns that the bitwise tests start from: signed zeros, the
+    /// smallest subnormals of both signs, the smallest normal, 1 and 2, the largest
+    /// finite values and infinities of both signs, and NaNs of either sign; then
+    /// `count` pseudo-random ones from `seed`.
+    fn special_and_random_bits(seed: u64, count: usize) -> std::vec::Vec<u64> {
+        let mut bits = std::vec![0u64, 1, 1 << 63, (1 << 63) | 1, 0x0010_0000_0000_0000];
+        bits.extend([0x3ff0_0000_0000_0000, 0x4000_0000_0000_0000]);
+        bits.extend([0x7fef_ffff_ffff_ffff, 0xffef_ffff_ffff_ffff]);
+        bits.extend([0x7ff0_0000_0000_0000, 0xfff0_0000_0000_0000]);
+        bits.extend([0x7ff8_0000_0000_0001, 0xfff8_0000_0000_0002]);
+        bits.extend(random_bits(seed, count));
+        bits
+    }
+
     /// `abs` and `copysign` against libm's, bit for bit, on signed zeros,
     /// infinities, NaNs of either sign, subnormals and pseudo-random bits.
     #[test]
     fn abs_and_copysign_are_libms_bit_for_bit() {
-        let mut bits = std::vec![0u64, 1, 1 << 63, (1 << 63) | 1, 0x7ff0_0000_0000_0000];
-        bits.extend([
-            0xfff0_0000_0000_0000,
-            0x7ff8_0000_0000_0001,
-            0xfff8_0000_0000_0002,
-        ]);
-        bits.extend(random_bits(0x9e37_79b9_7f4a_7c15, 2000));
+        let bits = special_and_random_bits(0x9e37_79b9_7f4a_7c15, 2000);
         for &a in &bits {
             let x = f64::from_bits(a);
             assert_eq!(Real::abs(x).to_bits(), libm::fabs(x).to_bits());
@@ -359,15 +367,7 @@ mod tests {
     /// (NaN out, compared as NaN), and pseudo-random bits.
     #[test]
     fn sqrt_is_libms_bit_for_bit() {
-        let mut bits = std::vec![0u64, 1, 1 << 63, (1 << 63) | 1, 0x7ff0_0000_0000_0000];
-        bits.extend([
-            0xfff0_0000_0000_0000,
-            0x7fef_ffff_ffff_ffff,
-            0x7ff8_0000_0000_0001,
-            0x3ff0_0000_0000_0000,
-            0x4000_0000_0000_0000,
-        ]);
-        bits.extend(random_bits(0x6a09_e667_f3bc_c908, 50_000));
+        let bits = special_and_random_bits(0x6a09_e667_f3bc_c908, 50_000);
         for &b in &bits {
             let x = f64::from_bits(b);
             let (got, want) = (Real::sqrt(x), libm::sqrt(x));
@@ -390,16 +390,7 @@ mod tests {
     /// bits, in both precisions.
     #[test]
     fn positive_finite_is_the_class_test() {
-        let mut bits = std::vec![0u64, 1, 1 << 63, (1 << 63) | 1, 0x7ff0_0000_0000_0000];
-        bits.extend([
-            0xfff0_0000_0000_0000,
-            0x7fef_ffff_ffff_ffff,
-            0xffef_ffff_ffff_ffff,
-            0x7ff8_0000_0000_0001,
-            0xfff8_0000_0000_0002,
-            0x0010_0000_0000_0000,
-        ]);
-        bits.extend(random_bits(0x2545_f491_4f6c_dd1d, 20_000));
+        let bits = special_and_random_bits(0x2545_f491_4f6c_dd1d, 20_000);
         let mut f32_bits: std::vec::Vec<u32> = bits.iter().map(|&b| (b >> 32) as u32).collect();
         f32_bits.extend([
             0,
