@@ -132,14 +132,7 @@ fn main() {
                 row.push(table[..8].iter().sum::<f64>() / 8.0);
                 row.push(table.iter().sum::<f64>() / 64.0);
             }
-            let cells: Vec<String> = row.iter().map(|x| format!("{x:.3}")).collect();
-            println!(
-                "({:.2}, {:4.1}°, {:.2}): {}",
-                c[0],
-                c[1],
-                c[2],
-                cells.join(" ")
-            );
+            selection::print_row(c, &row);
             row
         })
         .collect();

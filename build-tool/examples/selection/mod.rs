@@ -38,3 +38,16 @@ pub fn scores<C: Sync>(sets: &[Vec<DVec3>], judge: &Judge<C>) -> Vec<f64> {
 pub fn mean_of(scores: &[f64], order: &[usize], count: usize) -> f64 {
     order[..count].iter().map(|&k| scores[k]).sum::<f64>() / count as f64
 }
+
+/// Prints a condition `[roughness, θo, metallic]`'s row of figures.
+#[allow(dead_code)] // the BRDF examples' (the environment ones print normals)
+pub fn print_row(c: [f64; 3], row: &[f64]) {
+    let cells: Vec<String> = row.iter().map(|x| format!("{x:.3}")).collect();
+    println!(
+        "({:.2}, {:4.1}°, {:.2}): {}",
+        c[0],
+        c[1],
+        c[2],
+        cells.join(" ")
+    );
+}
