@@ -183,7 +183,7 @@ impl Transport {
 /// in the shared square (each the prior's exact mixture of its metallic 0 and
 /// 1 nodes there), then the metal layer's nodes; `layers` 0: the shipped nodes.
 fn map_nodes(prior: &BrdfPrior, layers: u32) -> Vec<Blend<f32>> {
-    let [gr, gt, _] = PRIOR_GRID;
+    let [gr, gt, _] = prior.grid;
     let layer = gr * gt;
     if layers == 0 {
         return (0..prior.masses.len() as u32).map(Blend::single).collect();
@@ -203,7 +203,7 @@ fn map_nodes(prior: &BrdfPrior, layers: u32) -> Vec<Blend<f32>> {
 
 /// The multilinear blend at `c` of [`map_nodes`]`(layers)`.
 fn map_blend(prior: &BrdfPrior, layers: u32, c: [f32; 3]) -> Blend<f32> {
-    let [gr, gt, _] = PRIOR_GRID;
+    let [gr, gt, _] = prior.grid;
     if layers == 0 {
         // The shipped blend without its masses.
         let c = c.map(|x| x as f64);
@@ -215,7 +215,7 @@ fn map_blend(prior: &BrdfPrior, layers: u32, c: [f32; 3]) -> Blend<f32> {
         return Blend::from_pairs(&pairs);
     }
     let unit = unit_condition(c);
-    if reads_metal_layer(PRIOR_GRID, c[2]) {
+    if reads_metal_layer(prior.grid, c[2]) {
         let metal = layers * gr * gt;
         let b = Blend::multilinear(&unit[..2], &[gr, gt]);
         let pairs: Vec<(u32, f32)> = b.pairs().map(|(k, w)| (k + metal, w)).collect();
