@@ -43,9 +43,10 @@
 //! 5. with `BLOB` (a `bake --brdf` blob of N = 64): its table-mode and
 //!    network-mode primary points through both priors on `eval brdf-prior
 //!    --sets 32`'s judge, and ns per sample against the incumbent (Owen-Sobol
-//!    through the VNDF/cosine mixture warp, f32): the runtime's table-mode
-//!    sample, its primary point alone, that point through the transport prior,
-//!    and the same for network mode on decoded weights.
+//!    through the VNDF/cosine mixture warp, f32), and against the incumbent
+//!    with the weight a renderer computes after it (`f cos / pdf`): the
+//!    runtime's table-mode sample, its primary point alone, that point through
+//!    the transport prior, and the same for network mode on decoded weights.
 #[allow(dead_code)]
 mod selection;
 
@@ -61,7 +62,7 @@ use nuld_core::brdf_prior::{
     half_vector_direction, query_stretch, reads_metal_layer, unit_condition,
 };
 use nuld_core::marginal2d::{Blend, Marginal2D};
-use nuld_core::warp::brdf_mixture_real;
+use nuld_core::warp::{brdf_mixture_pdf, brdf_mixture_real};
 use nuld_runtime::ConditionalSampler;
 use rayon::prelude::*;
 use std::hint::black_box;
@@ -511,6 +512,23 @@ fn main() {
                 brdf_mixture_real(wo, a, ps, u)[0]
             },
             &|s| {
+                // The weight a renderer computes after the incumbent's
+                // sample: the mixture's pdf and the BRDF (in f64, as `bench
+                // --only runtime`'s row of it).
+                let (wo, a, ps) = incumbents[s % 64];
+                let (c, k, i) = at(s);
+                let seed = nuld_core::network::hash_u32(k);
+                let u = [
+                    sobol_burley::sample(i, 0, seed),
+                    sobol_burley::sample(i, 1, seed),
+                ];
+                let d = brdf_mixture_real(wo, a, ps, u).map(|x| x as f64);
+                let wo = wo.map(|x| x as f64);
+                let pdf = brdf_mixture_pdf(wo.into(), a as f64, ps as f64, d.into());
+                let f = gltf_metallic(wo, d, c[0] as f64, c[2] as f64);
+                (d[0] + f * d[2] / pdf) as f32
+            },
+            &|s| {
                 let ([r, t, m], k, i) = at(s);
                 let sample = cs.sample_metallic(Vec2::new(r, t), m, k, i);
                 sample.direction.x + sample.weight
@@ -538,9 +556,10 @@ fn main() {
             },
         ],
     );
-    println!("ns per sample (/ the incumbent):");
+    println!("ns per sample (/ the incumbent, / the incumbent with its weight):");
     let names = [
         "incumbent (f32)",
+        "incumbent + weight",
         "runtime table mode",
         "its primary point alone",
         "that point, transport",
@@ -548,7 +567,8 @@ fn main() {
         "its point, transport",
     ];
     for (name, t) in names.iter().zip(&figures) {
-        println!("{name:>28}: {t:.1} ({:.2}x)", t / figures[0]);
+        let ratios = (t / figures[0], t / figures[1]);
+        println!("{name:>28}: {t:.1} ({:.2}x, {:.2}x)", ratios.0, ratios.1);
     }
 }
 
