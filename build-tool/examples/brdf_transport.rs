@@ -42,11 +42,13 @@
 //!    transport prior `L = 5, G = 97, a = 0.97`;
 //! 5. with `BLOB` (a `bake --brdf` blob of N = 64): its table-mode and
 //!    network-mode primary points through both priors on `eval brdf-prior
-//!    --sets 32`'s judge, and ns per sample against the incumbent (Owen-Sobol
-//!    through the VNDF/cosine mixture warp, f32), and against the incumbent
-//!    with the weight a renderer computes after it (`f cos / pdf`): the
-//!    runtime's table-mode sample, its primary point alone, that point through
-//!    the transport prior, and the same for network mode on decoded weights.
+//!    --sets 32`'s judge, and through the maps at metallic 0 and 1 only with
+//!    the density blend between; then ns per sample against the incumbent
+//!    (Owen-Sobol through the VNDF/cosine mixture warp, f32) and against the
+//!    incumbent with the weight a renderer computes after it (`f cos / pdf`):
+//!    the runtime's table-mode sample, its primary point alone, that point
+//!    through the transport prior, and the same for network mode on decoded
+//!    weights.
 #[allow(dead_code)]
 mod selection;
 
@@ -618,6 +620,12 @@ fn judge_blob(
                     row[2 * j + 1] += judge.d(&moved) / judge.baseline() / sets as f64;
                 }
             }
+            // The maps at metallic 0 and 1 (the metal layer), the density
+            // blend between.
+            let ends = c[2] <= 0.0 || reads_metal_layer(prior.grid, c[2]);
+            let pick = usize::from(ends);
+            row.extend([row[pick], row[2 + pick]]);
+            selection::print_row(c, &row);
             row
         })
         .collect();
@@ -627,23 +635,30 @@ fn judge_blob(
         "table, transport",
         "network, density blend",
         "network, transport",
+        "table, maps at 0 and 1",
+        "network, maps at 0 and 1",
     ];
     for (j, name) in names.iter().enumerate() {
         let (mean, worst) = summary(&rows, j);
-        let by_metallic: Vec<String> = [0.0, 0.5, 1.0]
+        // Metallic 0, 0.5, 1 and the held-out conditions' uniform ones.
+        let groups: [&dyn Fn(f64) -> bool; 4] =
+            [&|m| m == 0.0, &|m| m == 0.5, &|m| m == 1.0, &|m| {
+                ![0.0, 0.5, 1.0].contains(&m)
+            }];
+        let by_metallic: Vec<String> = groups
             .iter()
-            .map(|&m| {
+            .map(|keep| {
                 let v: Vec<f64> = rows
                     .iter()
                     .zip(&conds)
-                    .filter(|(_, c)| c[2] == m)
+                    .filter(|(_, c)| keep(c[2]))
                     .map(|(r, _)| r[j])
                     .collect();
                 format!("{:.3}", v.iter().sum::<f64>() / v.len() as f64)
             })
             .collect();
         println!(
-            "{name:>28}: mean {mean:.4}, worst {worst:.3}, metallic 0 / 0.5 / 1: {}",
+            "{name:>28}: mean {mean:.4}, worst {worst:.3}, metallic 0 / 0.5 / 1 / others: {}",
             by_metallic.join(" / ")
         );
     }
