@@ -48,7 +48,7 @@
 //!    incumbent with the weight a renderer computes after it (`f cos / pdf`):
 //!    the runtime's table-mode sample, its primary point alone, that point
 //!    through the transport prior, and the same for network mode on decoded
-//!    weights.
+//!    weights; at metallic 0, 0.5 and 1 in turn, then at 0 and 1 alone.
 #[allow(dead_code)]
 mod selection;
 
@@ -486,7 +486,29 @@ fn main() {
     let blob = nuld_runtime::Blob::parse(bytes.as_slice()).unwrap();
     let cs = blob.brdf().unwrap().conditional();
     judge_blob(&prior, &warp, proposal, &cs);
+    println!("metallic 0, 0.5 and 1 in turn:");
+    blob_cost(&prior, proposal, &cs, &conds, samples);
+    let ends: Vec<[f32; 3]> = conds
+        .iter()
+        .enumerate()
+        .map(|(k, &[r, t, _])| [r, t, (k % 2) as f32])
+        .collect();
+    println!("metallic 0 and 1 in turn (where the maps would serve alone):");
+    blob_cost(&prior, proposal, &cs, &ends, samples);
+}
+
+/// ns per sample, the median of 5 turns of `samples`, at `conds` in turn:
+/// the incumbent, without and with its weight, and the blob's table and
+/// network modes through the density blend and through `map`.
+fn blob_cost(
+    prior: &BrdfPrior,
+    map: &Transport,
+    cs: &ConditionalSampler<'_>,
+    conds: &[[f32; 3]],
+    samples: usize,
+) {
     let n = cs.len();
+    let count = conds.len();
     let incumbents: Vec<([f32; 3], f32, f32)> = conds
         .iter()
         .map(|c| {
@@ -498,13 +520,13 @@ fn main() {
         .collect();
     let mut buf = vec![0.0f32; cs.decoded_network_len()];
     let decoded = cs.decode_network(&mut buf).unwrap();
-    // Instance `s / n` mod 64, index `s mod n`, condition `s mod 64`.
-    let at = |s: usize| (conds[s % 64], (s as u32 / n) % 64, s as u32 % n);
+    // Instance `s / n` mod 64, index `s mod n`, condition `s` mod their count.
+    let at = |s: usize| (conds[s % count], (s as u32 / n) % 64, s as u32 % n);
     let figures = turns(
         samples,
         &[
             &|s| {
-                let (wo, a, ps) = incumbents[s % 64];
+                let (wo, a, ps) = incumbents[s % count];
                 let (_, k, i) = at(s);
                 let seed = nuld_core::network::hash_u32(k);
                 let u = [
@@ -517,7 +539,7 @@ fn main() {
                 // The weight a renderer computes after the incumbent's
                 // sample: the mixture's pdf and the BRDF (in f64, as `bench
                 // --only runtime`'s row of it).
-                let (wo, a, ps) = incumbents[s % 64];
+                let (wo, a, ps) = incumbents[s % count];
                 let (c, k, i) = at(s);
                 let seed = nuld_core::network::hash_u32(k);
                 let u = [
@@ -542,7 +564,7 @@ fn main() {
             &|s| {
                 let (c, k, i) = at(s);
                 let p = cs.square_point_metallic(Vec2::new(c[0], c[1]), c[2], k, i);
-                let (d, _, w) = sample_weighted(&prior, proposal, c, p.to_array());
+                let (d, _, w) = sample_weighted(prior, map, c, p.to_array());
                 d[0] + w
             },
             &|s| {
@@ -553,7 +575,7 @@ fn main() {
             &|s| {
                 let (c, k, i) = at(s);
                 let p = decoded.square_point_metallic(Vec2::new(c[0], c[1]), c[2], k, i);
-                let (d, _, w) = sample_weighted(&prior, proposal, c, p.to_array());
+                let (d, _, w) = sample_weighted(prior, map, c, p.to_array());
                 d[0] + w
             },
         ],
