@@ -14,8 +14,7 @@
 //! density is exactly `1 / (∂x/∂u.x ∂y/∂u.y)`, the pdf of the points it
 //! produces, read at the same cell corners. A sample reads 6 values per node,
 //! independent of each other: no search. (The pdf of an arbitrary direction,
-//! for MIS, needs the inverse: a search over the blended map, about what a
-//! sample costs today.)
+//! for MIS, needs the inverse: a search over the blended map.)
 //!
 //! Two things make it work. The metallic axis is a *mixture* of the metallic 0
 //! and 1 targets, which no blend of their maps follows, so the maps are
@@ -37,9 +36,10 @@
 //!    maps' tabulation error apart from the blend;
 //! 3. the transport pdf against central differences of its map;
 //! 4. ns per sample (f32, 64 conditions in turn, metallic 0, 0.5 and 1, the
-//!    median of 5 turns): the warp alone and the whole prior (blend, warp,
-//!    direction, pdf and weight `f cos / pdf`), density blend against the
-//!    transport prior `L = 5, G = 97, a = 0.97`;
+//!    median of 5 turns): the warp alone, the pdf at a given square point
+//!    (the maps' after inverting their blend) and the whole prior (blend,
+//!    warp, direction, pdf and weight `f cos / pdf`), density blend against
+//!    the transport prior `L = 5, G = 97, a = 0.97`;
 //! 5. with `BLOB` (a `bake --brdf` blob of N = 64): its table-mode and
 //!    network-mode primary points through both priors on `eval brdf-prior
 //!    --sets 32`'s judge, and through the maps at metallic 0 and 1 only with
@@ -145,6 +145,53 @@ impl Transport {
             knots,
             guide,
         }
+    }
+
+    /// The primary point that the blended map takes to the square point `p`
+    /// and the density there: what `pdf(direction)` needs for MIS. Two
+    /// binary searches over the knots, each step a blended read (of one row
+    /// of `y`, then of two rows of `x`), and a linear solve in the cell.
+    fn invert(&self, p: [f32; 2], blend: &Blend<f32>) -> ([f32; 2], f32) {
+        let (g, k) = (self.g, &self.knots);
+        let total: f32 = blend.pairs().map(|(_, w)| w).sum();
+        // The last cell `[c, c + 1]` whose start `at(c)` is at most `target`.
+        let search = |target: f32, at: &dyn Fn(usize) -> f32| {
+            let (mut lo, mut hi) = (0, g - 2);
+            while lo < hi {
+                let mid = (lo + hi).div_ceil(2);
+                if at(mid) <= target {
+                    lo = mid;
+                } else {
+                    hi = mid - 1;
+                }
+            }
+            lo
+        };
+        let y_at = |j: usize| {
+            blend
+                .pairs()
+                .map(|(n, w)| w * self.y[n as usize * g + j])
+                .sum::<f32>()
+                / total
+        };
+        let j = search(p[1], &y_at);
+        let (y0, y1) = (y_at(j), y_at(j + 1));
+        let ty = ((p[1] - y0) / (y1 - y0)).clamp(0.0, 1.0);
+        let x_at = |i: usize| {
+            blend
+                .pairs()
+                .map(|(n, w)| {
+                    let at = (n as usize * g + j) * g + i;
+                    w * (self.x[at] + (self.x[at + g] - self.x[at]) * ty)
+                })
+                .sum::<f32>()
+                / total
+        };
+        let i = search(p[0], &x_at);
+        let (x0, x1) = (x_at(i), x_at(i + 1));
+        let tx = ((p[0] - x0) / (x1 - x0)).clamp(0.0, 1.0);
+        let u = [k[i] + tx * (k[i + 1] - k[i]), k[j] + ty * (k[j + 1] - k[j])];
+        (u, self.sample(u, blend).1)
     }
 
     /// The blended map at `u` and its density in the square.
@@ -473,6 +520,31 @@ fn main() {
             },
         ],
     );
+    // The pdf at a given square point (MIS): the density blend reads its
+    // cell's corners; the maps invert their blend first.
+    let points: Vec<[f32; 2]> = (0..4096)
+        .map(|s| proposal.sample(u_at(s), &map_blends[s % 64]).0)
+        .collect();
+    let worst_u = (0..4096)
+        .map(|s| {
+            let (u, _) = proposal.invert(points[s], &map_blends[s % 64]);
+            (u[0] - u_at(s)[0]).abs().max((u[1] - u_at(s)[1]).abs())
+        })
+        .fold(0.0f32, f32::max);
+    let pdfs = turns(
+        samples,
+        &[
+            &|s| warp.pdf(points[s % 4096], &density_blends[s % 64]),
+            &|s| proposal.invert(points[s % 4096], &map_blends[s % 64]).1,
+        ],
+    );
+    println!(
+        "the pdf at a square point, ns: density blend {:.1}, {} (inverting the map; \
+         |u - invert(sample(u))| at most {worst_u:.1e}) {:.1}",
+        pdfs[0],
+        PROPOSAL.name(),
+        pdfs[1]
+    );
     println!(
         "the whole prior (sample_weighted), ns per sample: density blend {:.1}, {} {:.1}",
         figures[0],
@@ -522,31 +594,29 @@ fn blob_cost(
     let decoded = cs.decode_network(&mut buf).unwrap();
     // Instance `s / n` mod 64, index `s mod n`, condition `s` mod their count.
     let at = |s: usize| (conds[s % count], (s as u32 / n) % 64, s as u32 % n);
+    // The incumbent's direction: instance `k`'s Owen-Sobol point `i` through
+    // the mixture warp.
+    let incumbent = |s: usize| {
+        let (wo, a, ps) = incumbents[s % count];
+        let (_, k, i) = at(s);
+        let seed = nuld_core::network::hash_u32(k);
+        let u = [
+            sobol_burley::sample(i, 0, seed),
+            sobol_burley::sample(i, 1, seed),
+        ];
+        brdf_mixture_real(wo, a, ps, u)
+    };
     let figures = turns(
         samples,
         &[
-            &|s| {
-                let (wo, a, ps) = incumbents[s % count];
-                let (_, k, i) = at(s);
-                let seed = nuld_core::network::hash_u32(k);
-                let u = [
-                    sobol_burley::sample(i, 0, seed),
-                    sobol_burley::sample(i, 1, seed),
-                ];
-                brdf_mixture_real(wo, a, ps, u)[0]
-            },
+            &|s| incumbent(s)[0],
             &|s| {
                 // The weight a renderer computes after the incumbent's
                 // sample: the mixture's pdf and the BRDF (in f64, as `bench
                 // --only runtime`'s row of it).
                 let (wo, a, ps) = incumbents[s % count];
-                let (c, k, i) = at(s);
-                let seed = nuld_core::network::hash_u32(k);
-                let u = [
-                    sobol_burley::sample(i, 0, seed),
-                    sobol_burley::sample(i, 1, seed),
-                ];
-                let d = brdf_mixture_real(wo, a, ps, u).map(|x| x as f64);
+                let c = at(s).0;
+                let d = incumbent(s).map(|x| x as f64);
                 let wo = wo.map(|x| x as f64);
                 let pdf = brdf_mixture_pdf(wo.into(), a as f64, ps as f64, d.into());
                 let f = gltf_metallic(wo, d, c[0] as f64, c[2] as f64);
