@@ -40,7 +40,7 @@
 //!    (the maps' after inverting their blend) and the whole prior (blend,
 //!    warp, direction, pdf and weight `f cos / pdf`), density blend against
 //!    the transport prior `L = 5, G = 97, a = 0.97`;
-//! 5. with `BLOB` (a `bake --brdf` blob of N = 64): its table-mode and
+//! 5. with `BLOB` (a `bake --brdf` blob, any N): its table-mode and
 //!    network-mode primary points through both priors on `eval brdf-prior
 //!    --sets 32`'s judge, and through the maps at metallic 0 and 1 only with
 //!    the density blend between; then ns per sample against the incumbent
@@ -675,7 +675,9 @@ fn judge_blob(
     cs: &ConditionalSampler<'_>,
 ) {
     let sets = 32;
+    // The judge's baseline is Owen-Sobol sets of the blob's own N.
     let settings = BrdfPriorSettings {
+        n: cs.len(),
         instances: sets,
         ..BrdfPriorSettings::default()
     };
