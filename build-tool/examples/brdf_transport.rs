@@ -55,6 +55,7 @@ mod selection;
 use glam::{DVec2, DVec3, Vec2};
 use nuld_build_tool::lab::eval::brdf_prior::{self, held_out, judging, BrdfPriorSettings};
 use nuld_build_tool::lab::eval::prior_judge::Judge;
+use nuld_build_tool::seeding::rng;
 use nuld_build_tool::sphere::brdf_prior::{BrdfPrior, PRIOR_GRID};
 use nuld_build_tool::sphere::{BrdfTarget, TabulatedWarp};
 use nuld_build_tool::train::lattice_generator;
@@ -66,13 +67,14 @@ use nuld_core::brdf_prior::{
 use nuld_core::marginal2d::{Blend, Marginal2D};
 use nuld_core::warp::{brdf_mixture_pdf, brdf_mixture_real};
 use nuld_runtime::ConditionalSampler;
+use rand::Rng;
 use rayon::prelude::*;
 use std::hint::black_box;
 use std::time::Instant;
 
 /// A transport prior: `layers` metallic layers (0: the shipped prior's own
 /// nodes, metallic 0 and 1), `g` knots per axis crowded by `crowd`.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, PartialEq)]
 struct Variant {
     layers: u32,
     g: usize,
@@ -150,7 +152,8 @@ impl Transport {
     /// The primary point that the blended map takes to the square point `p`
     /// and the density there: what `pdf(direction)` needs for MIS. Two
     /// binary searches over the knots, each step a blended read (of one row
-    /// of `y`, then of two rows of `x`), and a linear solve in the cell.
+    /// of `y`, then of two rows of `x`), and a linear solve in the cell, whose
+    /// ends give the density.
     fn invert(&self, p: [f32; 2], blend: &Blend<f32>) -> ([f32; 2], f32) {
         let (g, k) = (self.g, &self.knots);
         let total: f32 = blend.pairs().map(|(_, w)| w).sum();
@@ -190,8 +193,11 @@ impl Transport {
         let i = search(p[0], &x_at);
         let (x0, x1) = (x_at(i), x_at(i + 1));
         let tx = ((p[0] - x0) / (x1 - x0)).clamp(0.0, 1.0);
-        let u = [k[i] + tx * (k[i + 1] - k[i]), k[j] + ty * (k[j + 1] - k[j])];
-        (u, self.sample(u, blend).1)
+        let (wx, wy) = (k[i + 1] - k[i], k[j + 1] - k[j]);
+        let u = [k[i] + tx * wx, k[j] + ty * wy];
+        // The map is linear along `u.x` at this `u.y`, and `y` along `u.y`,
+        // within the cell: [`Self::sample`]'s Jacobian from the same reads.
+        (u, wx * wy / ((x1 - x0) * (y1 - y0)))
     }
 
     /// The blended map at `u` and its density in the square.
@@ -293,7 +299,7 @@ fn sample_weighted(
 ) -> ([f32; 3], f32, f32) {
     let wo = view_direction_real(c[1]);
     let (p, pdf) = map.sample(u, &map_blend(prior, PROPOSAL.layers, c));
-    match half_vector_direction(wo, p, query_stretch(PRIOR_GRID, c)) {
+    match half_vector_direction(wo, p, query_stretch(prior.grid, c)) {
         Some((wi, jac)) => {
             let pdf = pdf / (2.0 * std::f32::consts::PI * jac);
             (wi, pdf, gltf_metallic(wo, wi, c[0], c[2]) * wi[2] / pdf)
@@ -331,17 +337,6 @@ fn turns(samples: usize, fs: &[&dyn Fn(usize) -> f32]) -> Vec<f64> {
         .collect()
 }
 
-/// A small xorshift stream of uniform numbers in `[0, 1)`.
-fn uniforms(seed: u64) -> impl FnMut() -> f64 {
-    let mut state = seed;
-    move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 40) as f64 / (1u64 << 24) as f64
-    }
-}
-
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let k_count: u32 = args.get(1).map_or(64, |s| s.parse().unwrap());
@@ -363,7 +358,7 @@ fn main() {
         .iter()
         .map(|v| Transport::new(&warp, &map_nodes(&prior, v.layers), v.g, v.crowd))
         .collect();
-    let proposal = &maps[5];
+    let proposal = &maps[variants.iter().position(|&v| v == PROPOSAL).unwrap()];
     eprintln!("maps: {:.1} s", start.elapsed().as_secs_f64());
 
     // 1. Held-out conditions.
@@ -445,7 +440,8 @@ fn main() {
     }
 
     // 3. The pdf against central differences of the map, inside a cell.
-    let mut next = uniforms(0x2545_f491_4f6c_dd1d);
+    let mut r = rng(0, 0x7472_616e);
+    let mut next = || r.random::<f64>();
     let (mut worst, mut checked) = (0.0f64, 0);
     let knots = &proposal.knots;
     for _ in 0..2000 {
@@ -520,17 +516,26 @@ fn main() {
             },
         ],
     );
+    println!(
+        "the whole prior (sample_weighted), ns per sample: density blend {:.1}, {} {:.1}",
+        figures[0],
+        PROPOSAL.name(),
+        figures[1]
+    );
     // The pdf at a given square point (MIS): the density blend reads its
     // cell's corners; the maps invert their blend first.
     let points: Vec<[f32; 2]> = (0..4096)
         .map(|s| proposal.sample(u_at(s), &map_blends[s % 64]).0)
         .collect();
-    let worst_u = (0..4096)
+    // The round trip: the point back, and the pdf as the sample gave it.
+    let (worst_u, worst_pdf) = (0..4096)
         .map(|s| {
-            let (u, _) = proposal.invert(points[s], &map_blends[s % 64]);
-            (u[0] - u_at(s)[0]).abs().max((u[1] - u_at(s)[1]).abs())
+            let (u, pdf) = proposal.invert(points[s], &map_blends[s % 64]);
+            let want = proposal.sample(u_at(s), &map_blends[s % 64]).1;
+            let du = (u[0] - u_at(s)[0]).abs().max((u[1] - u_at(s)[1]).abs());
+            (du, (pdf / want - 1.0).abs())
         })
-        .fold(0.0f32, f32::max);
+        .fold((0.0f32, 0.0f32), |a, b| (a.0.max(b.0), a.1.max(b.1)));
     let pdfs = turns(
         samples,
         &[
@@ -540,16 +545,11 @@ fn main() {
     );
     println!(
         "the pdf at a square point, ns: density blend {:.1}, {} (inverting the map; \
-         |u - invert(sample(u))| at most {worst_u:.1e}) {:.1}",
+         |u - invert(sample(u))| at most {worst_u:.1e}, its pdf within {worst_pdf:.1e} \
+         of the sample's) {:.1}",
         pdfs[0],
         PROPOSAL.name(),
         pdfs[1]
-    );
-    println!(
-        "the whole prior (sample_weighted), ns per sample: density blend {:.1}, {} {:.1}",
-        figures[0],
-        PROPOSAL.name(),
-        figures[1]
     );
 
     // 5. A blob's points.
