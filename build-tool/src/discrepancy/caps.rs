@@ -12,7 +12,8 @@
 //! of the angle). The fast path answers each cap with a [`CapTree`]: nodes whose
 //! bounding cap lies entirely inside (or outside) the query cap, further than the
 //! sigmoid band from its rim, are counted (or skipped) without touching their
-//! points.
+//! points. A set of a few dozen points (a few hundred, under a wide band) is one
+//! leaf, every point tested: the walk would cost more than it prunes.
 
 use super::estimator::{sigmoid_slope, sum_partials, SIGMOID_BAND};
 use super::GradientPath;
@@ -63,6 +64,17 @@ impl Cap {
 
 /// Points at most this many per tree leaf.
 const LEAF: usize = 8;
+/// Up to this many points a [`CapTree`] is one leaf without a bounding cap: each
+/// query tests every point, since a few dozen dot products cost less than the
+/// walk, its square roots and its branches (a training set of 64 directions).
+const FLAT: usize = 96;
+/// Up to this many points the gradient's queries test every point too when
+/// their rim band is at least [`WIDE_BAND`] wide: few nodes lie clear of so
+/// wide a band, so the walk prunes little (a training set of 256 directions,
+/// whose sharpness ends at 32 inverse spacings).
+const FLAT_WIDE: usize = 256;
+/// The band (radians, each side of the rim) from which [`FLAT_WIDE`] applies.
+const WIDE_BAND: f64 = 0.05;
 /// Depth of the Morton code over the equal-area square.
 const LEVELS: u32 = 12;
 
@@ -100,6 +112,17 @@ fn morton(p: DVec2) -> u32 {
 impl CapTree {
     /// Builds the tree over `points` (unit vectors). O(N log N).
     pub fn new(points: &[DVec3]) -> Self {
+        Self::for_band(points, 0.0)
+    }
+
+    /// The tree for queries whose rim band is `band` radians wide each side: one
+    /// flat leaf where testing every point costs less ([`FLAT`], [`FLAT_WIDE`]).
+    /// The answers are the same either way.
+    fn for_band(points: &[DVec3], band: f64) -> Self {
+        let n = points.len();
+        if n <= FLAT || (n <= FLAT_WIDE && band >= WIDE_BAND) {
+            return Self::flat(points);
+        }
         let mut keyed: Vec<(u32, u32)> = points
             .iter()
             .enumerate()
@@ -144,6 +167,26 @@ impl CapTree {
             k += 1;
         }
         tree
+    }
+
+    /// One leaf over `points` in their order, bounded by the whole sphere so that
+    /// no query prunes it: the queries' answers are the tree's (the leaf tests
+    /// are the same), found by testing every point.
+    fn flat(points: &[DVec3]) -> Self {
+        Self {
+            points: points.to_vec(),
+            index: (0..points.len() as u32).collect(),
+            nodes: vec![Node {
+                start: 0,
+                end: points.len() as u32,
+                first_child: 0,
+                child_count: 0,
+                center: DVec3::Z,
+                radius: std::f64::consts::PI,
+                cos_radius: -1.0,
+                sin_radius: 0.0,
+            }],
+        }
     }
 
     fn make_node(&self, start: usize, end: usize) -> Node {
@@ -293,53 +336,60 @@ pub fn cap_loss_and_gradient(
     // Points with `local > 1` have narrower bands: the base band covers them all.
     let inv_n = 1.0 / n.max(1) as f64;
     let band = SIGMOID_BAND / alpha;
-    let tree = (path == GradientPath::Fast).then(|| CapTree::new(points));
+    let tree = (path == GradientPath::Fast).then(|| CapTree::for_band(points, band));
     let chunk = caps.len().div_ceil(CHUNKS).max(1);
     if let CapArea::Precomputed(mu) = area {
         assert_eq!(mu.len(), caps.len(), "one precomputed measure per cap");
     }
-    let partials: Vec<(f64, Vec<DVec3>)> = caps
-        .par_chunks(chunk)
-        .enumerate()
-        .map(|(ci, cs)| {
-            let mut g = vec![DVec3::ZERO; n];
-            let mut loss = 0.0;
-            let mut rim: Vec<(usize, DVec3)> = Vec::new();
-            for (j, cap) in cs.iter().enumerate() {
-                let mu = match area {
-                    CapArea::Exact(f) => f(cap.center, cap.cos_theta),
-                    CapArea::Precomputed(mu) => mu[ci * chunk + j],
-                    CapArea::MonteCarlo(samples) => {
-                        samples.query(cap, 0.0, |_, _| {}) as f64
-                            / samples.points.len().max(1) as f64
+    let chunk_partial = |(ci, cs): (usize, &[Cap])| {
+        let mut g = vec![DVec3::ZERO; n];
+        let mut loss = 0.0;
+        let mut rim: Vec<(usize, DVec3)> = Vec::new();
+        for (j, cap) in cs.iter().enumerate() {
+            let mu = match area {
+                CapArea::Exact(f) => f(cap.center, cap.cos_theta),
+                CapArea::Precomputed(mu) => mu[ci * chunk + j],
+                CapArea::MonteCarlo(samples) => {
+                    samples.query(cap, 0.0, |_, _| {}) as f64 / samples.points.len().max(1) as f64
+                }
+            };
+            rim.clear();
+            let count = match &tree {
+                Some(t) => t.query(cap, band, |i, x| rim.push((i, x))),
+                None => {
+                    rim.extend(points.iter().copied().enumerate());
+                    points.iter().filter(|&&x| cap.contains(x)).count() as u32
+                }
+            };
+            let r = count as f64 * inv_n - mu;
+            loss += r * r;
+            match local {
+                None => {
+                    for &(i, x) in &rim {
+                        g[i] += r * rim_gradient(cap, x, alpha);
                     }
-                };
-                rim.clear();
-                let count = match &tree {
-                    Some(t) => t.query(cap, band, |i, x| rim.push((i, x))),
-                    None => {
-                        rim.extend(points.iter().copied().enumerate());
-                        points.iter().filter(|&&x| cap.contains(x)).count() as u32
-                    }
-                };
-                let r = count as f64 * inv_n - mu;
-                loss += r * r;
-                match local {
-                    None => {
-                        for &(i, x) in &rim {
-                            g[i] += r * rim_gradient(cap, x, alpha);
-                        }
-                    }
-                    Some(l) => {
-                        for &(i, x) in &rim {
-                            g[i] += r * rim_gradient(cap, x, alpha * l[i]);
-                        }
+                }
+                Some(l) => {
+                    for &(i, x) in &rim {
+                        g[i] += r * rim_gradient(cap, x, alpha * l[i]);
                     }
                 }
             }
-            (loss, g)
-        })
-        .collect();
+        }
+        (loss, g)
+    };
+    // Called from the pool's own threads (a training step runs its conditions
+    // in parallel, each with its sets' caps), the threads are busy already and
+    // handing chunks between them costs more than it saves: the chunks run in
+    // turn, the same chunks summed in the same order.
+    let partials: Vec<(f64, Vec<DVec3>)> = if rayon::current_thread_index().is_some() {
+        caps.chunks(chunk).enumerate().map(chunk_partial).collect()
+    } else {
+        caps.par_chunks(chunk)
+            .enumerate()
+            .map(chunk_partial)
+            .collect()
+    };
     let m = caps.len().max(1) as f64;
     let loss = sum_partials(partials, grad, 2.0 / (m * n.max(1) as f64));
     loss / m
@@ -383,10 +433,22 @@ mod tests {
 
     #[test]
     fn tree_counts_equal_brute_force_and_rim_points_are_complete() {
-        let pts = random_dirs(3000, 1);
-        let tree = CapTree::new(&pts);
-        for cap in random_caps(300, 2) {
-            let band = 0.02;
+        // One flat leaf up to FLAT points (FLAT_WIDE for wide bands), a tree
+        // beyond.
+        for n in [1, 5, 64, FLAT, FLAT + 1, FLAT_WIDE, FLAT_WIDE + 1, 3000] {
+            for band in [0.0, WIDE_BAND] {
+                tree_agrees_with_brute_force(CapTree::for_band(&random_dirs(n, 1), band), n);
+            }
+        }
+    }
+
+    fn tree_agrees_with_brute_force(tree: CapTree, n: usize) {
+        let pts = random_dirs(n, 1);
+        for (cap, band) in random_caps(300, 2)
+            .into_iter()
+            .zip([0.02, 0.1].iter().cycle())
+        {
+            let band = *band;
             let mut rim = Vec::new();
             let count = tree.query(&cap, band, |i, _| rim.push(i));
             let want = pts.iter().filter(|&&x| cap.contains(x)).count() as u32;
@@ -430,7 +492,14 @@ mod tests {
     #[test]
     fn fast_gradient_equals_dense_reference() {
         let uniform = |_: DVec3, c: f64| (1.0 - c) / 2.0;
-        for (n, a) in [(100, 3.0), (1000, 12.0), (2048, 40.0)] {
+        // A training set's size (one flat leaf), a tree.
+        for (n, a) in [
+            (64, 3.0),
+            (64, 32.0),
+            (100, 3.0),
+            (1000, 12.0),
+            (2048, 40.0),
+        ] {
             let pts = random_dirs(n, n as u64);
             let caps = random_caps(200, 7);
             let alpha = a * (n as f64 / (4.0 * std::f64::consts::PI)).sqrt();
@@ -463,6 +532,43 @@ mod tests {
                     "{n} point {i}: {x:?} vs {y:?}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn chunks_in_turn_on_a_pool_thread_give_the_pools_bits() {
+        // From a pool's thread (as a training step calls it) the chunks run in
+        // turn; from outside, on the pool. The same sums in the same order.
+        let uniform = |_: DVec3, c: f64| (1.0 - c) / 2.0;
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        for n in [64, 300] {
+            let pts = random_dirs(n, 40 + n as u64);
+            let caps = random_caps(256, 41);
+            let local: Vec<f64> = pts.iter().map(|x| 1.0 + x.z.abs()).collect();
+            let run = |g: &mut [DVec3]| {
+                cap_loss_and_gradient(
+                    &pts,
+                    &caps,
+                    CapArea::Exact(&uniform),
+                    30.0,
+                    Some(&local),
+                    GradientPath::Fast,
+                    g,
+                )
+            };
+            let mut outside = vec![DVec3::ZERO; n];
+            let mut inside = vec![DVec3::ZERO; n];
+            let lo = run(&mut outside);
+            let li = pool.install(|| {
+                assert!(rayon::current_thread_index().is_some());
+                run(&mut inside)
+            });
+            assert_eq!(lo.to_bits(), li.to_bits());
+            assert!(outside.iter().any(|g| *g != DVec3::ZERO));
+            assert_eq!(outside, inside);
         }
     }
 
