@@ -16,6 +16,9 @@ use nuld_core::network::{InterleavedParams, Network, Shape, Trace, OUTPUTS};
 use rand::Rng;
 use rayon::prelude::*;
 
+/// Parameters per task when a step sums its conditions' gradients.
+const GRADIENT_CHUNK: usize = 1 << 13;
+
 /// The loss of step `step`: its batch of conditions drawn from the step's seed,
 /// the warp-fitting loss while pretraining, then the cap loss of the sets and
 /// their union; updates the pool's running losses that the tournament reads.
@@ -77,16 +80,23 @@ impl EpochLoss<f64> for BatchLoss<'_> {
                 condition_step(cfg, net, pc, instances, *start, alpha, slot)
             })
             .collect();
+        // Each parameter sums its conditions' gradients in batch order, whichever
+        // thread takes its chunk: the same bits.
+        grad.par_chunks_mut(GRADIENT_CHUNK)
+            .enumerate()
+            .for_each(|(c, chunk)| {
+                let start = c * GRADIENT_CHUNK;
+                for slot in slots.iter() {
+                    for (a, b) in chunk.iter_mut().zip(&slot.grad[start..]) {
+                        *a += b;
+                    }
+                }
+            });
         let (mut loss, mut ratio) = (0.0, 0.0);
         let inv_b = 1.0 / batch.len() as f64;
-        for (((pick, _, _), (set_loss, union_loss)), slot) in
-            batch.iter().zip(&results).zip(slots.iter())
-        {
+        for ((pick, _, _), (set_loss, union_loss)) in batch.iter().zip(&results) {
             loss += (set_loss + cfg.union_weight * union_loss) * inv_b;
             ratio += set_loss / self.pool.conditions[*pick].baseline_loss * inv_b;
-            for (a, b) in grad.iter_mut().zip(&slot.grad) {
-                *a += b;
-            }
             if pretraining {
                 continue;
             }
