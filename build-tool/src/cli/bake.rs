@@ -34,7 +34,7 @@ pub struct BakeArgs {
     #[arg(long, value_delimiter = ',')]
     pub grid: Option<Vec<u32>>,
     /// Training steps after the 300 steps of pretraining on the warp [default for
-    /// --brdf, each of its two networks (metallic below 1, and the metal): 16000
+    /// --brdf, each of its two networks (metallic below 1, and the metal): 20000
     /// at --n 64 to 127, else 12000; 3000 for --envmap].
     #[arg(long, allow_negative_numbers = true, value_parser = super::count)]
     pub steps: Option<usize>,
