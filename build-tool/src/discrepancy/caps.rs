@@ -110,8 +110,8 @@ fn morton(p: DVec2) -> u32 {
 }
 
 impl CapTree {
-    /// Builds the tree over `points` (unit vectors): one flat leaf up to
-    /// [`FLAT`] points, else O(N log N).
+    /// Builds the tree over `points` (unit vectors): one flat leaf up to 96
+    /// points, else O(N log N).
     pub fn new(points: &[DVec3]) -> Self {
         Self::for_band(points, 0.0)
     }
