@@ -2,6 +2,7 @@
 //! [`crate::lab::bench`] and prints them as tables.
 
 use crate::baselines::Baseline;
+use crate::conditional::bake::BakeConfig;
 use crate::discrepancy::GradientPath;
 use crate::lab::bench::rounds::ROUNDS;
 use crate::lab::bench::{baselines, envmap_prior, optimizer, runtime, training};
@@ -144,12 +145,17 @@ pub fn run(a: BenchArgs) -> Result<()> {
 const TRAINING_SIZES: [(u32, usize); 3] = [(64, 20), (256, 6), (2048, 2)];
 
 /// Milliseconds per training step of the conditional BRDF sampler, all threads,
-/// and the default bake's training time at that rate: its two networks (below
-/// metallic 1, and the metal), each the pretraining and the recipe's steps at
-/// that N ([`crate::train::brdf_recipe`]).
+/// and the default bake's training time at that rate: the steps of each network
+/// it trains at that N (below metallic 1, and the metal), pretraining included.
 fn run_training() -> Result<()> {
     let d = crate::train::TrainConfig::default();
-    let bake_steps = |n: u32| 2 * (d.pretrain_steps + crate::train::brdf_recipe(n).0);
+    let bake_steps = |n: u32| {
+        let bake = BakeConfig::default().with_points(n);
+        std::iter::once(bake.train.clone())
+            .chain(bake.metal_train())
+            .map(|t| t.pretrain_steps + t.steps)
+            .sum::<usize>()
+    };
     println!(
         "conditional sampler training, {} rayon threads, hidden {:?}, {} conditions x {} instances per step",
         rayon::current_num_threads(),

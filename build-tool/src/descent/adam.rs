@@ -1,13 +1,10 @@
 //! Adam (Kingma & Ba 2015) on a vector of parameters: 2D points (the optimizers)
 //! or scalars (a network's flat weights).
 
+use super::PARAMETER_CHUNK;
 use glam::DVec2;
 use rayon::prelude::*;
 use std::ops::{Add, Div, Mul, Sub};
-
-/// Parameters updated per task when a step runs on the thread pool: a network's
-/// tens of thousands of weights split; a point set of a few hundred does not.
-const PARALLEL_CHUNK: usize = 1 << 13;
 
 /// A parameter Adam updates coordinate by coordinate: `f64` or [`DVec2`].
 pub trait AdamParam:
@@ -112,16 +109,16 @@ impl<P: AdamParam> Adam<P> {
                 *x = *x - m_hat * lr_i / (v_hat.sqrt() + epsilon);
             }
         };
-        if params.len() <= PARALLEL_CHUNK {
+        if params.len() <= PARAMETER_CHUNK {
             update(0, params, &mut self.m, &mut self.v);
             return;
         }
         params
-            .par_chunks_mut(PARALLEL_CHUNK)
-            .zip(self.m.par_chunks_mut(PARALLEL_CHUNK))
-            .zip(self.v.par_chunks_mut(PARALLEL_CHUNK))
+            .par_chunks_mut(PARAMETER_CHUNK)
+            .zip(self.m.par_chunks_mut(PARAMETER_CHUNK))
+            .zip(self.v.par_chunks_mut(PARAMETER_CHUNK))
             .enumerate()
-            .for_each(|(c, ((x, m), v))| update(c * PARALLEL_CHUNK, x, m, v));
+            .for_each(|(c, ((x, m), v))| update(c * PARAMETER_CHUNK, x, m, v));
     }
 
     /// The state to checkpoint, moved out: first and second moments and the step
@@ -193,7 +190,7 @@ mod tests {
     fn a_network_sized_step_is_each_parameters_own_update_bit_for_bit() {
         // Long enough to run in chunks on the pool; every parameter against
         // Adam's formula written out for it alone, with its own scale.
-        let n = 3 * PARALLEL_CHUNK + 5;
+        let n = 3 * PARAMETER_CHUNK + 5;
         let value = |i: usize, k: usize| ((i * 7919 + k * 104_729) % 1000) as f64 / 500.0 - 1.0;
         let scale: Vec<f64> = (0..n).map(|i| 0.5 + value(i, 9).abs()).collect();
         let mut x: Vec<f64> = (0..n).map(|i| value(i, 0)).collect();

@@ -21,6 +21,11 @@ pub use schedule::{epoch_schedule, Schedule};
 
 use serde::Serialize;
 
+/// Parameters per task when a step's work parameter by parameter (Adam's
+/// update, a trainer's sum of gradients) runs on the thread pool: a network's
+/// tens of thousands of weights split, a point set of a few hundred does not.
+pub(crate) const PARAMETER_CHUNK: usize = 1 << 13;
+
 /// A loss that a [`Descent`] minimizes over parameters of type `P`.
 pub trait EpochLoss<P> {
     /// The loss at `params` in epoch `epoch`, with sigmoid sharpness `alpha` (the

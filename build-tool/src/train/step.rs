@@ -6,7 +6,7 @@
 //! reuses ([`StepScratch`]).
 
 use super::{pool, ConditionPool, PoolCondition, TrainConfig, TOURNAMENT};
-use crate::descent::EpochLoss;
+use crate::descent::{EpochLoss, PARAMETER_CHUNK};
 use crate::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
 use crate::discrepancy::GradientPath;
 use crate::network::{backward, output_gradient, Interleaved};
@@ -15,9 +15,6 @@ use glam::{DVec2, DVec3};
 use nuld_core::network::{InterleavedParams, Network, Shape, Trace, OUTPUTS};
 use rand::Rng;
 use rayon::prelude::*;
-
-/// Parameters per task when a step sums its conditions' gradients.
-const GRADIENT_CHUNK: usize = 1 << 13;
 
 /// The loss of step `step`: its batch of conditions drawn from the step's seed,
 /// the warp-fitting loss while pretraining, then the cap loss of the sets and
@@ -82,10 +79,10 @@ impl EpochLoss<f64> for BatchLoss<'_> {
             .collect();
         // Each parameter sums its conditions' gradients in batch order, whichever
         // thread takes its chunk: the same bits.
-        grad.par_chunks_mut(GRADIENT_CHUNK)
+        grad.par_chunks_mut(PARAMETER_CHUNK)
             .enumerate()
             .for_each(|(c, chunk)| {
-                let start = c * GRADIENT_CHUNK;
+                let start = c * PARAMETER_CHUNK;
                 for slot in slots.iter() {
                     for (a, b) in chunk.iter_mut().zip(&slot.grad[start..]) {
                         *a += b;
