@@ -1,10 +1,10 @@
 //! How far the BRDF sampler's sets are from what its prior's primary space
 //! allows at one condition, on `eval conditional`'s judge at its ten conditions
 //! with direct optimization: `cargo run --release -p nuld-build-tool --example
-//! brdf_bounds -- BLOB [STEPS] [STEP] [INSTANCES] [REFINE]` (about 2.5 minutes
+//! brdf_bounds -- BLOB [STEPS] [STEP] [INSTANCES] [REFINE] [SHIFTS]` (about 2.5 minutes
 //! on 2 cores at the defaults: 3000 steps, 0.02, 4 sets a method, 0.25).
 //!
-//! Besides the blob's table mode, four samplers fit each set to its one
+//! Besides the blob's table mode, samplers fit each set to its one
 //! condition in the prior's primary space, as the trainer moves a network's
 //! points: the cap loss on 2048 caps of the condition measured on the
 //! trainer's `2^14`-point rule, 256 a step; the sigmoid's sharpness in local
@@ -15,12 +15,13 @@
 //! inverse spacings and the step `STEP / sqrt(N)`; `fitted-table` from the
 //! blob's own table-mode points of instance `k` (where training left them),
 //! at the end sharpness 32 throughout and `REFINE` times the step, so that
-//! it refines them rather than starting over; `fitted-table-4deg` and
-//! `fitted-table-0.05r` refine the table's set half a cell of the point
-//! table away (4° less of view, 0.05 more roughness) and read it at the
-//! condition: how far a refined set carries. The judge, its caps, the exact
-//! baseline and the direct optimization are `eval conditional`'s at the same
-//! conditions (each seeded by its condition), `INSTANCES` sets a method.
+//! it refines them rather than starting over; `fitted-table(dr, dθ)` refines
+//! the table's set at the condition shifted by each of `SHIFTS` (default
+//! `0/-4,0.05/0`: half a cell of the point table away, 4° less of view or 0.05
+//! more roughness) and reads it at the condition: how far a refined set
+//! carries. The judge, its caps, the exact baseline and the direct
+//! optimization are `eval conditional`'s at the same conditions (each seeded
+//! by its condition), `INSTANCES` sets a method.
 use glam::{DVec2, DVec3};
 use nuld_build_tool::descent::{epoch_schedule, local_factor, Adam};
 use nuld_build_tool::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
@@ -39,7 +40,7 @@ use std::sync::Arc;
 
 /// Sets fitted to their one condition in the prior's primary space.
 struct Fitted<'a> {
-    name: &'static str,
+    name: String,
     n: usize,
     prior: Arc<BrdfPrior>,
     /// Where a fit starts: the blob's table-mode points of instance `k`, or
@@ -131,7 +132,7 @@ impl Fitted<'_> {
 
 impl ConditionalSets for Fitted<'_> {
     fn name(&self) -> &str {
-        self.name
+        &self.name
     }
 
     fn len(&self) -> usize {
@@ -154,13 +155,26 @@ impl ConditionalSets for Fitted<'_> {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    if !(2..=6).contains(&args.len()) {
-        eprintln!("usage: brdf_bounds BLOB [STEPS] [STEP] [INSTANCES] [REFINE]");
+    if !(2..=7).contains(&args.len()) {
+        eprintln!("usage: brdf_bounds BLOB [STEPS] [STEP] [INSTANCES] [REFINE] [SHIFTS]");
         std::process::exit(2);
     }
     let arg = |k: usize, default: f64| args.get(k).map_or(default, |s| s.parse().unwrap());
     let (steps, step, instances) = (arg(2, 3000.0) as usize, arg(3, 0.02), arg(4, 4.0) as usize);
     let refine = arg(5, 0.25);
+    // `dr/dθ` pairs, comma-separated: where the refined sets read at each
+    // condition are fitted. By default half a cell of the point table's grid
+    // away (10 x 12 nodes: roughness 0.1 and θo 8.1° apart), the farthest a
+    // nearest-node table of refined sets reads from.
+    let shifts: Vec<[f64; 2]> = args
+        .get(6)
+        .map_or("0/-4,0.05/0", String::as_str)
+        .split(',')
+        .map(|pair| {
+            let (r, t) = pair.split_once('/').expect("a shift is dr/dθ");
+            [r.parse().unwrap(), t.parse().unwrap()]
+        })
+        .collect();
     let bytes = std::fs::read(&args[1]).unwrap();
     let blob = nuld_runtime::Blob::parse(&bytes).unwrap();
     let cs = blob.brdf().unwrap().conditional();
@@ -171,7 +185,7 @@ fn main() {
     };
     let table = blob_sets(&bytes).unwrap().swap_remove(0);
     let lattice = Fitted {
-        name: "fitted-lattice",
+        name: "fitted-lattice".into(),
         n,
         prior: Arc::clone(&prior),
         table: None,
@@ -180,7 +194,7 @@ fn main() {
         alpha_start: 8.0,
         shift: [0.0; 2],
     };
-    let refined = |name, shift| Fitted {
+    let refined = |name: String, shift| Fitted {
         name,
         n,
         prior: Arc::clone(&prior),
@@ -190,12 +204,10 @@ fn main() {
         alpha_start: 32.0,
         shift,
     };
-    let here = refined("fitted-table", [0.0; 2]);
-    // Half a cell of the point table's grid away (10 x 12 nodes: roughness 0.1
-    // and θo 8.1° apart), the farthest a nearest-node table of refined sets
-    // reads from.
-    let view = refined("fitted-table-4deg", [0.0, -4.0]);
-    let rough = refined("fitted-table-0.05r", [0.05, 0.0]);
+    let mut fitted = vec![refined("fitted-table".into(), [0.0; 2])];
+    for &[r, t] in &shifts {
+        fitted.push(refined(format!("fitted-table({r:+}, {t:+}°)"), [r, t]));
+    }
     let full = ConditionalSettings::full(&[0.0, 1.0]);
     let settings = ConditionalSettings {
         conditions: full.direct.iter().map(|&i| full.conditions[i]).collect(),
@@ -204,7 +216,9 @@ fn main() {
         union_instances: instances.max(2),
         ..full
     };
-    let report = evaluate(&[table.as_ref(), &lattice, &here, &view, &rough], &settings).unwrap();
+    let mut samplers: Vec<&dyn ConditionalSets> = vec![table.as_ref(), &lattice];
+    samplers.extend(fitted.iter().map(|f| f as &dyn ConditionalSets));
+    let report = evaluate(&samplers, &settings).unwrap();
     println!("N = {n}, {steps} steps of {step} / sqrt(N), {instances} sets a method");
     println!("roughness, θo, metallic: cap L2 over direct optimization (over the exact warp's Owen-Sobol)");
     for c in &report.conditions {
