@@ -22,10 +22,10 @@
 //! carries. The judge, its caps, the exact baseline and the direct
 //! optimization are `eval conditional`'s at the same conditions (each seeded
 //! by its condition), `INSTANCES` sets a method.
+mod primary;
+
 use glam::{DVec2, DVec3};
 use nuld_build_tool::descent::{epoch_schedule, local_factor, Adam};
-use nuld_build_tool::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
-use nuld_build_tool::discrepancy::GradientPath;
 use nuld_build_tool::lab::eval::conditional::{
     blob_sets, evaluate, ConditionalSets, ConditionalSettings,
 };
@@ -35,6 +35,7 @@ use nuld_build_tool::train::pool::{brdf_table_direction, POOL_RULE_POINTS};
 use nuld_build_tool::train::target::{LoadedTarget, TrainTarget};
 use nuld_core::brdf::{gltf_metallic, view_direction};
 use nuld_core::network::{salted_instance_offset, shifted_lattice_point};
+use primary::step_gradient;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -79,12 +80,7 @@ impl Fitted<'_> {
         let n = self.n;
         let target = BrdfTarget::coarse(cond[0], cond[1], cond[2], POOL_RULE_POINTS).unwrap();
         let stream = 0x0b0d_0000 ^ k;
-        let caps: Vec<Cap> = (0..2048)
-            .map(|j| {
-                let s = |d| sobol_burley::sample(j, d, stream) as f64;
-                Cap::from_unit_cube(DVec3::new(s(0), s(1), s(2)))
-            })
-            .collect();
+        let caps = primary::caps(2048, stream);
         let measures: Vec<f64> = caps
             .iter()
             .map(|c| target.cap_measure(c.center, c.cos_theta))
@@ -97,30 +93,14 @@ impl Fitted<'_> {
         let mut adam = Adam::new(n);
         adam.epsilon = 1e-12;
         let spacing = (2.0 * PI / n as f64).sqrt();
-        let mut grad = vec![DVec3::ZERO; n];
         for t in 0..self.steps {
             let (alpha, ratio) = epoch_schedule(t, self.steps, (self.alpha_start, 32.0), 0.03);
             let w: Vec<_> = p
                 .iter()
                 .map(|&u| brdf_table_direction(&self.prior, cond, u))
                 .collect();
-            let dirs: Vec<DVec3> = w.iter().map(|x| x.0).collect();
-            let local: Vec<f64> = dirs.iter().map(|&x| local_factor(2.0 * PI, q(x))).collect();
-            let window: Vec<usize> = (0..256).map(|j| (256 * t + j) % caps.len()).collect();
-            let c: Vec<Cap> = window.iter().map(|&j| caps[j]).collect();
-            let mu: Vec<f64> = window.iter().map(|&j| measures[j]).collect();
-            cap_loss_and_gradient(
-                &dirs,
-                &c,
-                CapArea::Precomputed(&mu),
-                alpha / spacing,
-                Some(&local),
-                GradientPath::Fast,
-                &mut grad,
-            );
-            let g: Vec<DVec2> = (0..n)
-                .map(|i| DVec2::new(w[i].1.dot(grad[i]), w[i].2.dot(grad[i])))
-                .collect();
+            let local: Vec<f64> = w.iter().map(|x| local_factor(2.0 * PI, q(x.0))).collect();
+            let g = step_gradient(&w, &local, (&caps, &measures), t, alpha, spacing);
             adam.step(&mut p, &g, self.step / (n as f64).sqrt() * ratio);
             for u in &mut p {
                 *u = u.clamp(DVec2::ZERO, DVec2::splat(1.0 - 1e-12));

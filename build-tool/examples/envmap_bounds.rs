@@ -36,6 +36,7 @@
 //! network reaches across all normals (docs/results/envmap.md, "bounds").
 mod check;
 mod fit;
+mod primary;
 
 use fit::{fit, warp, Fit, Site};
 use glam::{DVec2, DVec3};

@@ -26,6 +26,7 @@
 //! normal itself, through the tree at the normal).
 mod check;
 mod fit;
+mod primary;
 
 use fit::{fit, warp, Fit, Site};
 use glam::{DVec2, DVec3};

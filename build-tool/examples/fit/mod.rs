@@ -1,10 +1,10 @@
 //! What `envmap_bounds` and `envmap_nearest_node` share: a set fitted to one or
 //! more normals' lit maps in the environment tree's primary space, as the
 //! trainer moves points, and the tree's warp with its Jacobian.
+use crate::primary::{self, step_gradient};
 use glam::{DVec2, DVec3};
 use nuld_build_tool::descent::{epoch_schedule, local_factor, Adam};
-use nuld_build_tool::discrepancy::caps::{cap_loss_and_gradient, Cap, CapArea};
-use nuld_build_tool::discrepancy::GradientPath;
+use nuld_build_tool::discrepancy::caps::Cap;
 use nuld_build_tool::sphere::geometry::{fold, map_jacobian};
 use nuld_build_tool::sphere::{
     CapMeasureTable, DirectionDensity, EnvmapDensity, EnvmapTree as ToolTree,
@@ -75,12 +75,7 @@ impl Site {
             .cosine_weighted(square_to_sphere(DVec2::from(u)))
             .unwrap();
         let table = CapMeasureTable::new(&lit.mass_rule(1 << 14));
-        let caps: Vec<Cap> = (0..2048)
-            .map(|k| {
-                let s = |d| sobol_burley::sample(k, d, stream) as f64;
-                Cap::from_unit_cube(DVec3::new(s(0), s(1), s(2)))
-            })
-            .collect();
+        let caps = primary::caps(2048, stream);
         let measures = caps
             .iter()
             .map(|c| table.measure(c.center, c.cos_theta))
@@ -108,7 +103,6 @@ pub fn fit(
     let mut adam = Adam::new(n);
     adam.epsilon = 1e-12;
     let spacing = (4.0 * PI / n as f64).sqrt();
-    let mut grad = vec![DVec3::ZERO; n];
     for t in 0..how.steps {
         // The trainer's schedule: sharpness 8 to 64 inverse spacings, the step's
         // cosine decay to 3 %.
@@ -116,25 +110,13 @@ pub fn fit(
         let mut g = vec![DVec2::ZERO; n];
         for site in sites {
             let w: Vec<_> = p.iter().map(|&q| warp(tree, site.u, q)).collect();
-            let dirs: Vec<DVec3> = w.iter().map(|x| x.0).collect();
-            let local: Vec<f64> = dirs
+            let local: Vec<f64> = w
                 .iter()
-                .map(|&x| local_factor(4.0 * PI, site.lit.pdf(x)))
+                .map(|x| local_factor(4.0 * PI, site.lit.pdf(x.0)))
                 .collect();
-            let window: Vec<usize> = (0..256).map(|j| (256 * t + j) % site.caps.len()).collect();
-            let c: Vec<Cap> = window.iter().map(|&j| site.caps[j]).collect();
-            let mu: Vec<f64> = window.iter().map(|&j| site.measures[j]).collect();
-            cap_loss_and_gradient(
-                &dirs,
-                &c,
-                CapArea::Precomputed(&mu),
-                alpha / spacing,
-                Some(&local),
-                GradientPath::Fast,
-                &mut grad,
-            );
-            for i in 0..n {
-                g[i] += DVec2::new(w[i].1.dot(grad[i]), w[i].2.dot(grad[i]));
+            let site_g = step_gradient(&w, &local, (&site.caps, &site.measures), t, alpha, spacing);
+            for (a, b) in g.iter_mut().zip(site_g) {
+                *a += b;
             }
         }
         adam.step(&mut p, &g, how.step / (n as f64).sqrt() * ratio);
