@@ -33,10 +33,10 @@ use nuld_build_tool::sphere::brdf_prior::BrdfPrior;
 use nuld_build_tool::sphere::{BrdfTarget, DirectionDensity};
 use nuld_build_tool::train::pool::{brdf_table_direction, POOL_RULE_POINTS};
 use nuld_build_tool::train::target::{LoadedTarget, TrainTarget};
-use nuld_core::brdf::{gltf_metallic, view_direction};
+use nuld_core::blob::Domain;
+use nuld_core::brdf::{clamp_roughness, clamp_theta_o_deg};
 use nuld_core::network::{salted_instance_offset, shifted_lattice_point};
 use primary::step_gradient;
-use std::f64::consts::PI;
 use std::sync::Arc;
 
 /// Sets fitted to their one condition in the prior's primary space.
@@ -85,21 +85,22 @@ impl Fitted<'_> {
             .iter()
             .map(|c| target.cap_measure(c.center, c.cos_theta))
             .collect();
-        let (wo, albedo) = (view_direction(cond[1]), target.albedo());
-        let q = |x: DVec3| {
-            gltf_metallic(wo.to_array(), x.to_array(), cond[0], cond[2]) * x.z.max(0.0) / albedo
-        };
+        // The target density `q = f cos / A` sets each point's local units.
+        let area = Domain::Hemisphere.area();
         let mut p = self.start(cond, k);
         let mut adam = Adam::new(n);
         adam.epsilon = 1e-12;
-        let spacing = (2.0 * PI / n as f64).sqrt();
+        let spacing = (area / n as f64).sqrt();
         for t in 0..self.steps {
             let (alpha, ratio) = epoch_schedule(t, self.steps, (self.alpha_start, 32.0), 0.03);
             let w: Vec<_> = p
                 .iter()
                 .map(|&u| brdf_table_direction(&self.prior, cond, u))
                 .collect();
-            let local: Vec<f64> = w.iter().map(|x| local_factor(2.0 * PI, q(x.0))).collect();
+            let local: Vec<f64> = w
+                .iter()
+                .map(|x| local_factor(area, target.pdf(x.0)))
+                .collect();
             let g = step_gradient(&w, &local, (&caps, &measures), t, alpha, spacing);
             adam.step(&mut p, &g, self.step / (n as f64).sqrt() * ratio);
             for u in &mut p {
@@ -121,8 +122,8 @@ impl ConditionalSets for Fitted<'_> {
 
     fn set(&self, roughness: f64, theta_o_deg: f64, metallic: f64, instance: u32) -> Vec<DVec3> {
         let at = [
-            (roughness + self.shift[0]).clamp(0.1, 1.0),
-            (theta_o_deg + self.shift[1]).clamp(0.0, 89.0),
+            clamp_roughness(roughness + self.shift[0]),
+            clamp_theta_o_deg(theta_o_deg + self.shift[1]),
             metallic,
         ];
         let cond = [roughness, theta_o_deg, metallic];
