@@ -1,7 +1,7 @@
 //! How the BRDF sampler's fixed sets integrate a real map through a lobe, beside
 //! what the cap judge says of them: `cargo run --release -p nuld-build-tool
-//! --example brdf_map_integrand -- BLOB MAP [INSTANCES] [CAPS]` (16 sets and 512
-//! caps a scale by default; seconds).
+//! --example brdf_map_integrand -- BLOB MAP [INSTANCES] [CAPS] [OPTIMIZED]` (16
+//! sets and 512 caps a scale by default; seconds).
 //!
 //! At the render scene's materials (`lab::render::scene`: the ground, dielectric
 //! 0.8, at three views; spheres' roughnesses, dielectric and metal), every method's
@@ -19,7 +19,10 @@
 //!   a courtyard's bright walls sit in that band);
 //! * **profile** (table mode and Owen-Sobol, every `N/16`-th point): where a
 //!   set's points lie along the normal, the sorted target mass between the
-//!   horizon and each point, mean over the sets, against the even `(k + 1/2) / N`.
+//!   horizon and each point, mean over the sets, against the even `(k + 1/2) / N`;
+//!   with `OPTIMIZED`, a `set.nuld` of directly optimized sets of the ground at
+//!   50° (`build-tool optimize --domain hemisphere --density brdf:0.8,50 --n N
+//!   --sets 16 --out DIR`), theirs at that condition too.
 //!
 //! Methods: the blob's table and network modes; its unbiased mode (instance `k`
 //! with seed `k`); the render's baselines, Owen-Sobol, SOT and GBN as `render`
@@ -116,13 +119,27 @@ fn profile(sets: &[Vec<DVec3>], zs: &[f64]) -> Vec<f64> {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    if !(3..=5).contains(&args.len()) {
-        eprintln!("usage: brdf_map_integrand BLOB MAP [INSTANCES] [CAPS]");
+    if !(3..=6).contains(&args.len()) {
+        eprintln!("usage: brdf_map_integrand BLOB MAP [INSTANCES] [CAPS] [OPTIMIZED]");
         std::process::exit(2);
     }
     let map = Environment::from_file(std::path::Path::new(&args[2])).unwrap();
     let instances: u32 = args.get(3).map_or(16, |s| s.parse().unwrap());
     let count: usize = args.get(4).map_or(512, |s| s.parse().unwrap());
+    let optimized_bytes = args.get(5).map(|p| std::fs::read(p).unwrap());
+    let optimized: Option<Vec<Vec<DVec3>>> = optimized_bytes.as_ref().map(|b| {
+        let sets = nuld_runtime::Blob::parse(b)
+            .unwrap()
+            .direction_set()
+            .unwrap();
+        (0..sets.set_count())
+            .map(|s| {
+                (0..sets.len())
+                    .map(|i| sets.direction(s, i).as_dvec3())
+                    .collect()
+            })
+            .collect()
+    });
     let bytes = std::fs::read(&args[1]).unwrap();
     let blob = nuld_runtime::Blob::parse(&bytes).unwrap();
     let cs = blob.brdf().unwrap().conditional();
@@ -231,11 +248,15 @@ fn main() {
         let ideal: Vec<f64> = (0..n).map(|k| (k as f64 + 0.5) / n as f64).collect();
         let mut zs: Vec<f64> = fine.iter().map(|l| l.z).collect();
         zs.sort_by(f64::total_cmp);
-        for (name, profile) in [
+        let mut profiles = vec![
             ("ideal", ideal),
             ("table", profile(&methods[1].1, &zs)),
             ("owen-sobol", profile(&methods[0].1, &zs)),
-        ] {
+        ];
+        if let Some(sets) = optimized.as_ref().filter(|_| [r, t, m] == [0.8, 50.0, 0.0]) {
+            profiles.push(("optimized", profile(sets, &zs)));
+        }
+        for (name, profile) in profiles {
             let stride = n.div_ceil(16);
             let cells: Vec<String> = profile
                 .iter()
