@@ -245,11 +245,11 @@ fn main() {
             n as f64 * fine.iter().filter(|l| l.z < RIM_COS).count() as f64 / fine.len() as f64;
 
         println!("\n({r}, {t}°, metallic {m}): beyond 60° the target holds {rim_target:.2} points");
-        let ideal: Vec<f64> = (0..n).map(|k| (k as f64 + 0.5) / n as f64).collect();
+        let even: Vec<f64> = (0..n).map(|k| (k as f64 + 0.5) / n as f64).collect();
         let mut zs: Vec<f64> = fine.iter().map(|l| l.z).collect();
         zs.sort_by(f64::total_cmp);
         let mut profiles = vec![
-            ("ideal", ideal),
+            ("even", even),
             ("table", profile(&methods[1].1, &zs)),
             ("owen-sobol", profile(&methods[0].1, &zs)),
         ];
