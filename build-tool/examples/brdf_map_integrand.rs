@@ -5,12 +5,13 @@
 //!
 //! At the render scene's materials (`lab::render::scene`: the ground, dielectric
 //! 0.8, at three views; spheres' roughnesses, dielectric and metal), every method's
-//! `INSTANCES` sets of the blob's `N` directions, scored three ways, each over
+//! `INSTANCES` sets of the blob's `N` directions, scored four ways, each over
 //! Owen-Sobol through the exact inverse CDF of the condition's `q = f cos / A`:
 //!
 //! * **cap L2** (paper Eq. 9, centre uniform) over caps whose radius is uniform in
-//!   `[0, R]`, `R` = 180° (the judge's measure), 45°, 15° and 5°; and over caps
-//!   centred on the normal (**zonal**, radii evenly spread over 0° to 90°);
+//!   `[0, R]`, `R` = 180° (the judge's measure), 45°, 15° and 5°
+//!   ([`MeasuredCaps::draw_up_to`]); and over caps centred on the normal
+//!   (**zonal**, radii evenly spread over 0° to 90°, [`MeasuredCaps::zonal`]);
 //! * **map RMSE**: the error of `(1/N) sum_i L(R_j l_i)` against `2^16` Owen-Sobol
 //!   points through the same exact warp, over the sets and 32 turns `R_j` of the
 //!   map about the normal `z` (a ground pixel's estimate of its reflected light
@@ -35,9 +36,9 @@ use nuld_build_tool::baselines::seeded_owen_sobol;
 use nuld_build_tool::lab::render::environment::Environment;
 use nuld_build_tool::lab::render::primary::{Generator, PrimaryPoints};
 use nuld_build_tool::lab::render::sampler::PixelKey;
+use nuld_build_tool::sphere::metrics::{CapRadius, MeasuredCaps};
 use nuld_build_tool::sphere::{BrdfTarget, DirectionDensity, TabulatedWarp};
 use nuld_core::blob::Domain;
-use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 use std::f64::consts::TAU;
 
@@ -50,52 +51,10 @@ const RADII_DEG: [f64; 4] = [180.0, 45.0, 15.0, 5.0];
 /// Turns of the map about the normal.
 const TURNS: usize = 32;
 
-/// `(centre, cos radius, target measure)`.
-type Cap = (DVec3, f64, f64);
-
-/// `count` caps, centre uniform on the sphere, radius uniform in `[0, max_radius]`.
-fn caps(target: &BrdfTarget, count: usize, max_radius: f64, seed: u64) -> Vec<Cap> {
-    let mut g = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
-    let drawn: Vec<(DVec3, f64)> = (0..count)
-        .map(|_| {
-            let z = 1.0 - 2.0 * g.random::<f64>();
-            let r = (1.0 - z * z).max(0.0).sqrt();
-            let phi = TAU * g.random::<f64>();
-            let w = DVec3::new(r * phi.cos(), r * phi.sin(), z);
-            (w, (max_radius * g.random::<f64>()).cos())
-        })
-        .collect();
-    drawn
-        .into_par_iter()
-        .map(|(w, t)| (w, t, target.cap_measure(w, t)))
-        .collect()
-}
-
-/// `count` caps centred on the normal `+z`, radii evenly spread over `(0°, 90°)`:
-/// what the judge's caps seldom are, a band test along the normal.
-fn zonal_caps(target: &BrdfTarget, count: usize) -> Vec<Cap> {
-    (0..count)
-        .into_par_iter()
-        .map(|k| {
-            let t = ((k as f64 + 0.5) / count as f64 * std::f64::consts::FRAC_PI_2).cos();
-            (DVec3::Z, t, target.cap_measure(DVec3::Z, t))
-        })
-        .collect()
-}
-
-/// Root mean square local discrepancy of each set over `caps`, averaged in the square.
-fn cap_l2(sets: &[Vec<DVec3>], caps: &[Cap]) -> f64 {
-    let squared = |points: &Vec<DVec3>| {
-        let n = points.len() as f64;
-        caps.iter()
-            .map(|&(w, t, mu)| {
-                let inside = points.iter().filter(|p| w.dot(**p) >= t).count() as f64;
-                (inside / n - mu).powi(2)
-            })
-            .sum::<f64>()
-            / caps.len() as f64
-    };
-    (sets.par_iter().map(squared).sum::<f64>() / sets.len() as f64).sqrt()
+/// Root mean square cap L2 of the sets over `caps` (their squares averaged).
+fn cap_l2(sets: &[Vec<DVec3>], caps: &MeasuredCaps) -> f64 {
+    let squared = |set: &Vec<DVec3>| caps.l2_squared(set, CapRadius::ThetaUniform).0;
+    (sets.iter().map(squared).sum::<f64>() / sets.len() as f64).sqrt()
 }
 
 /// Points beyond 60° from the normal: mean and standard deviation over the sets.
@@ -225,23 +184,23 @@ fn main() {
             methods.push((g.generator().name().to_string(), pixels(g, &by_exact)));
         }
 
+        let measure = |w: DVec3, t: f64| target.cap_measure(w, t);
         let l2: Vec<Vec<f64>> = RADII_DEG
             .iter()
             .enumerate()
-            .map(|(s, &rd)| {
-                let caps = caps(&target, count, rd.to_radians(), 7 + s as u64);
+            .map(|(s, &rd)| MeasuredCaps::draw_up_to(count, 7 + s as u64, rd.to_radians(), measure))
+            .chain(std::iter::once(MeasuredCaps::zonal(
+                DVec3::Z,
+                count,
+                std::f64::consts::FRAC_PI_2,
+                measure,
+            )))
+            .map(|caps| {
                 methods
                     .iter()
                     .map(|(_, sets)| cap_l2(sets, &caps))
                     .collect()
             })
-            .chain(std::iter::once({
-                let caps = zonal_caps(&target, count);
-                methods
-                    .iter()
-                    .map(|(_, sets)| cap_l2(sets, &caps))
-                    .collect()
-            }))
             .collect();
         let fine = exact.warp_all(&seeded_owen_sobol(1 << 16, 99));
         let reference: Vec<f64> = turns.par_iter().map(|j| mean_radiance(&fine, j)).collect();

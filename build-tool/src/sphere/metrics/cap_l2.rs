@@ -223,6 +223,58 @@ impl MeasuredCaps {
         radius: CapRadius,
         cap_measure: impl Fn(DVec3, f64) -> f64 + Sync,
     ) -> Self {
+        Self::draw_with(count, seed, cap_measure, |u| match radius {
+            CapRadius::CosUniform => 1.0 - 2.0 * u,
+            CapRadius::ThetaUniform => (PI * u).cos(),
+        })
+    }
+
+    /// [`MeasuredCaps::draw`]'s caps with `theta` uniform in `[0, max_theta]`
+    /// instead (radians, clamped into `[0, pi]`): the paper's measure restricted to
+    /// caps of at most that radius, a probability measure scored with
+    /// [`CapRadius::ThetaUniform`]'s scale. At `max_theta = pi`, the caps of
+    /// `draw(count, seed, CapRadius::ThetaUniform, ..)` bit for bit.
+    pub fn draw_up_to(
+        count: usize,
+        seed: u64,
+        max_theta: f64,
+        cap_measure: impl Fn(DVec3, f64) -> f64 + Sync,
+    ) -> Self {
+        let max_theta = max_theta.clamp(0.0, PI);
+        Self::draw_with(count, seed, cap_measure, |u| (max_theta * u).cos())
+    }
+
+    /// `count` caps all centred on the unit `center`, radii
+    /// `theta_k = (k + 1/2) max_theta / count` (a midpoint rule over `theta`
+    /// uniform in `[0, max_theta]`, `max_theta` clamped into `[0, pi]`): how evenly
+    /// a set fills the bands about one direction (a hemisphere's normal), which
+    /// caps with uniform centres seldom test. Scored with
+    /// [`CapRadius::ThetaUniform`]'s scale.
+    pub fn zonal(
+        center: DVec3,
+        count: usize,
+        max_theta: f64,
+        cap_measure: impl Fn(DVec3, f64) -> f64 + Sync,
+    ) -> Self {
+        let max_theta = max_theta.clamp(0.0, PI);
+        let caps = (0..count)
+            .into_par_iter()
+            .map(|k| {
+                let t = ((k as f64 + 0.5) / count as f64 * max_theta).cos();
+                (center, t, cap_measure(center, t))
+            })
+            .collect();
+        Self { caps }
+    }
+
+    /// The caps of `count` centres `w` uniform on the sphere, each with
+    /// `t = cos theta = radius(u)` for `u` uniform in `[0, 1)`, measured.
+    fn draw_with(
+        count: usize,
+        seed: u64,
+        cap_measure: impl Fn(DVec3, f64) -> f64 + Sync,
+        radius: impl Fn(f64) -> f64 + Sync,
+    ) -> Self {
         let chunks = count.div_ceil(CAP_CHUNK);
         let caps = (0..chunks)
             .into_par_iter()
@@ -232,11 +284,7 @@ impl MeasuredCaps {
                 let drawn: Vec<(DVec3, f64)> = (0..m)
                     .map(|_| {
                         let w = random_direction(&mut g);
-                        let t = match radius {
-                            CapRadius::CosUniform => 1.0 - 2.0 * g.random::<f64>(),
-                            CapRadius::ThetaUniform => (PI * g.random::<f64>()).cos(),
-                        };
-                        (w, t)
+                        (w, radius(g.random::<f64>()))
                     })
                     .collect();
                 drawn.into_iter().map(|(w, t)| (w, t, cap_measure(w, t)))

@@ -260,3 +260,53 @@ fn star_estimate_is_consistent_and_close_to_an_exhaustive_search() {
         e.lower_bound
     );
 }
+
+#[test]
+fn caps_up_to_pi_are_the_papers_caps_and_smaller_caps_stay_within_their_radius() {
+    let uniform = |_: DVec3, t: f64| (1.0 - t) / 2.0;
+    let all = MeasuredCaps::draw(600, 9, CapRadius::ThetaUniform, uniform);
+    assert_eq!(MeasuredCaps::draw_up_to(600, 9, PI, uniform).caps, all.caps);
+    let small = MeasuredCaps::draw_up_to(600, 9, 0.1, uniform);
+    assert_eq!(small.len(), 600);
+    assert!(small
+        .caps
+        .iter()
+        .all(|&(_, t, mu)| t >= 0.1f64.cos() && mu == (1.0 - t) / 2.0));
+    // The same centres: only the radii differ.
+    assert!(small.caps.iter().zip(&all.caps).all(|(a, b)| a.0 == b.0));
+}
+
+#[test]
+fn zonal_caps_see_a_sets_bands_about_their_centre() {
+    // Uniform measure: a cap of radius theta about z holds (1 - cos theta) / 2.
+    let uniform = |_: DVec3, t: f64| (1.0 - t) / 2.0;
+    let caps = MeasuredCaps::zonal(DVec3::Z, 1000, PI, uniform);
+    let n = 16;
+    // One point in each of n equal-area bands about z: every zonal cap's local
+    // discrepancy is at most 1 / (2n) (within a band the count lags or leads the
+    // measure by at most half a point)...
+    let banded: Vec<DVec3> = (0..n)
+        .map(|k| {
+            let z = 1.0 - 2.0 * (k as f64 + 0.5) / n as f64;
+            let r = (1.0 - z * z).sqrt();
+            let phi = 2.4 * k as f64;
+            DVec3::new(r * phi.cos(), r * phi.sin(), z)
+        })
+        .collect();
+    let (d2, _) = caps.l2_squared(&banded, CapRadius::ThetaUniform);
+    assert!(d2 <= (0.5 / n as f64).powi(2) + 1e-12, "{d2}");
+    // ...and its exact value is the mean over the midpoint radii of the squared
+    // distance of (1 - cos theta) / 2 to the count's step function.
+    let exact = (0..1000)
+        .map(|k| {
+            let t = ((k as f64 + 0.5) / 1000.0 * PI).cos();
+            let inside = banded.iter().filter(|p| p.z >= t).count() as f64;
+            (inside / n as f64 - (1.0 - t) / 2.0).powi(2)
+        })
+        .sum::<f64>()
+        / 1000.0;
+    assert!((d2 - exact).abs() < 1e-15);
+    // All points at the pole: caps hold every point long before their measure.
+    let pole = vec![DVec3::Z; n];
+    assert!(caps.l2_squared(&pole, CapRadius::ThetaUniform).0 > 0.2);
+}
