@@ -69,18 +69,19 @@ fn rim_counts(sets: &[Vec<DVec3>]) -> (f64, f64) {
     (mean, var.sqrt())
 }
 
-/// The sets' profile along the normal: the `k`-th smallest `F(cos θ)` of a set,
-/// mean over the sets, `F(z)` the target's mass at `cos θ <= z` (from the
-/// horizon in) read off `zs`, the sorted `cos θ` of a fine exact set. An even
-/// profile is `(k + 1/2) / N`.
+/// `F(z)`: the target's mass at `cos θ < z` (from the horizon in), read off
+/// `zs`, the sorted `cos θ` of a fine exact set.
+fn mass_below(zs: &[f64], z: f64) -> f64 {
+    zs.partition_point(|&v| v < z) as f64 / zs.len() as f64
+}
+
+/// The sets' profile along the normal: the `k`-th smallest [`mass_below`] of a
+/// set's points, mean over the sets. An even profile is `(k + 1/2) / N`.
 fn profile(sets: &[Vec<DVec3>], zs: &[f64]) -> Vec<f64> {
     let n = sets[0].len();
     let mut mean = vec![0.0; n];
     for set in sets {
-        let mut f: Vec<f64> = set
-            .iter()
-            .map(|l| zs.partition_point(|&v| v <= l.z) as f64 / zs.len() as f64)
-            .collect();
+        let mut f: Vec<f64> = set.iter().map(|l| mass_below(zs, l.z)).collect();
         f.sort_by(f64::total_cmp);
         for (m, v) in mean.iter_mut().zip(f) {
             *m += v / sets.len() as f64;
@@ -220,13 +221,12 @@ fn main() {
                 (squared / (sets.len() * TURNS) as f64).sqrt()
             })
             .collect();
-        let rim_target =
-            n as f64 * fine.iter().filter(|l| l.z < RIM_COS).count() as f64 / fine.len() as f64;
+        let mut zs: Vec<f64> = fine.iter().map(|l| l.z).collect();
+        zs.sort_by(f64::total_cmp);
+        let rim_target = n as f64 * mass_below(&zs, RIM_COS);
 
         println!("\n({r}, {t}°, metallic {m}): beyond 60° the target holds {rim_target:.2} points");
         let even: Vec<f64> = (0..n).map(|k| (k as f64 + 0.5) / n as f64).collect();
-        let mut zs: Vec<f64> = fine.iter().map(|l| l.z).collect();
-        zs.sort_by(f64::total_cmp);
         let mut profiles = vec![
             ("even", even),
             ("table", profile(&methods[1].1, &zs)),
