@@ -14,6 +14,7 @@
 
 use super::distill::distill;
 use super::quality::{evaluate, instance_directions, Quality, QualityConfig};
+use crate::network::Params;
 use crate::plot::{render_loglog, render_square_panels, Series, SquarePanel};
 use crate::progress::Progress;
 use crate::sphere::{BrdfTarget, DirectionDensity, EnvmapDensity};
@@ -96,9 +97,15 @@ pub struct BakeReport {
     pub loss_curve: Vec<f64>,
     /// Steps per entry of `loss_curve`.
     pub loss_block: usize,
-    /// Held-out quality (network mode, f16 parameters, against Owen-Sobol through
-    /// the mixture warp for the BRDF, through the lit map's inverse CDF for a map).
+    /// Held-out quality of what the blob ships (network mode, f16 parameters,
+    /// against Owen-Sobol through the mixture warp for the BRDF, through the lit
+    /// map's inverse CDF for a map).
     pub quality: Option<Quality>,
+    /// The trained networks' held-out quality where it was worse than the
+    /// unbiased mode's and the blob ships the untrained lattice instead
+    /// (`quality` is then the lattice's); absent where the trained sets ship.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub trained_quality: Option<Quality>,
 }
 
 /// Point-table grid of an environment sampler: 13 x 13 normals on the octahedral
@@ -318,12 +325,20 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     timings.train_s = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let params = trainer.params();
-    let metal_params = metal_trainer.as_ref().map(Trainer::params);
     let target = &trainer.pool.target;
+    let shipped = ship(
+        trainer.params(),
+        metal_trainer.as_ref().map(Trainer::params),
+        target,
+        config.quality_grid,
+    )?;
+    timings.quality_s = t.elapsed().as_secs_f64();
+    let (params, metal_params) = (&shipped.params, shipped.metal.as_ref());
+
+    let t = Instant::now();
     let parts = distill(
-        &params,
-        metal_params.as_ref(),
+        params,
+        metal_params,
         target,
         config.instances,
         config.grid,
@@ -336,15 +351,6 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
         seed: config.train.seed,
     })?;
     timings.distill_s = t.elapsed().as_secs_f64();
-
-    let t = Instant::now();
-    let quality = (config.quality_grid > 0)
-        .then(|| {
-            let held_out = QualityConfig::held_out(target, config.quality_grid, 0x9a11);
-            evaluate(&params, metal_params.as_ref(), target, &held_out)
-        })
-        .transpose()?;
-    timings.quality_s = t.elapsed().as_secs_f64();
 
     let losses = &trainer.state.losses;
     let loss_block = losses.len().div_ceil(200).max(1);
@@ -369,8 +375,8 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
         (800, 500),
     )?;
     match target {
-        LoadedTarget::GltfBrdf(_) => render_sets(&out.join("sets.png"), &params)?,
-        LoadedTarget::Envmap(env) => render_envmap_sets(&out.join("sets.png"), &params, env)?,
+        LoadedTarget::GltfBrdf(_) => render_sets(&out.join("sets.png"), params)?,
+        LoadedTarget::Envmap(env) => render_envmap_sets(&out.join("sets.png"), params, env)?,
     }
     crate::output::write_atomic(&out.join(config.blob_name()), blob.as_slice())?;
     timings.total_s = started.elapsed().as_secs_f64();
@@ -382,15 +388,73 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
         timings,
         loss_curve,
         loss_block,
-        quality,
+        quality: shipped.quality,
+        trained_quality: shipped.trained_quality,
     };
     let json = serde_json::to_vec_pretty(&report).context("cannot encode report")?;
     crate::output::write_atomic(&out.join("report.json"), &json)?;
     Ok(report)
 }
 
+/// What a bake ships: the trained networks, or their untrained lattice
+/// ([`Params::without_residual`]) where the trained sets check worse than it.
+struct Shipped {
+    params: Params,
+    metal: Option<Params>,
+    /// The held-out check of what ships.
+    quality: Option<Quality>,
+    /// The trained networks' check, where the lattice ships instead.
+    trained_quality: Option<Quality>,
+}
+
+/// The networks a bake ships, and their held-out check on a `grid x grid` grid
+/// of conditions (none at 0). Where the trained sets check worse than the
+/// unbiased mode, the prior's shifted lattice with a random shift per instance
+/// ([`Quality::training_helps`]), training has hurt this target (a map whose
+/// sun holds most of its light: docs/results/envmap.md#clear-skies): the
+/// learned residual is dropped, so that table and network mode serve the
+/// untrained lattice at each instance's offset, which is checked again.
+fn ship(
+    params: Params,
+    metal: Option<Params>,
+    target: &LoadedTarget,
+    grid: usize,
+) -> Result<Shipped> {
+    if grid == 0 {
+        return Ok(Shipped {
+            params,
+            metal,
+            quality: None,
+            trained_quality: None,
+        });
+    }
+    let held_out = QualityConfig::held_out(target, grid, 0x9a11);
+    let trained = evaluate(&params, metal.as_ref(), target, &held_out)?;
+    let lattice = metal
+        .as_ref()
+        .map(Params::without_residual)
+        .map_or(Some(None), |m| m.map(Some));
+    match (trained.training_helps(), params.without_residual(), lattice) {
+        (false, Some(params), Some(metal)) => {
+            let quality = evaluate(&params, metal.as_ref(), target, &held_out)?;
+            Ok(Shipped {
+                params,
+                metal,
+                quality: Some(quality),
+                trained_quality: Some(trained),
+            })
+        }
+        _ => Ok(Shipped {
+            params,
+            metal,
+            quality: Some(trained),
+            trained_quality: None,
+        }),
+    }
+}
+
 /// Instance 0 at four conditions, each over its target in the equal-area square.
-fn render_sets(path: &Path, params: &crate::network::Params) -> Result<()> {
+fn render_sets(path: &Path, params: &Params) -> Result<()> {
     let shipped = params.rounded_to_f16();
     let conds = [[0.15, 20.0], [0.15, 75.0], [0.5, 45.0], [0.9, 80.0]];
     // Only the density and the lobe probability are read: no cap-measure table
@@ -424,11 +488,7 @@ fn render_sets(path: &Path, params: &crate::network::Params) -> Result<()> {
 
 /// Instance 0 at four normals, each over its target `L max(0, n.l)` in the
 /// sphere's equal-area square.
-fn render_envmap_sets(
-    path: &Path,
-    params: &crate::network::Params,
-    env: &EnvmapTarget,
-) -> Result<()> {
+fn render_envmap_sets(path: &Path, params: &Params, env: &EnvmapTarget) -> Result<()> {
     // The pool's copy: a 450-pixel panel does not see its blocks, and lighting
     // an 8192 x 4096 map whole four times took 29 s.
     let map = env.coarse_map();
@@ -567,6 +627,35 @@ mod tests {
             std::fs::read(dir.join("brdf.nuld")).unwrap(),
             bytes.to_vec()
         );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Sets that check worse than the unbiased mode do not ship: untrained
+    /// weights (a random residual over the lattice) on a constant sky give way
+    /// to the lattice itself, whose check is what the report keeps.
+    #[test]
+    fn sets_worse_than_the_lattice_ship_as_the_lattice() {
+        let dir = std::env::temp_dir().join(format!("nuld-bake-ship-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let map = dir.join("grey.hdr");
+        let img = image::Rgb32FImage::from_pixel(64, 32, image::Rgb([0.5f32; 3]));
+        image::DynamicImage::ImageRgb32F(img).save(&map).unwrap();
+        let config = tiny().with_envmap(TrainTarget::envmap(&map).unwrap());
+        let target = config.train.target.load().unwrap();
+        let random = Params::init(config.train.shape().unwrap(), 11);
+        let shipped = ship(random.clone(), None, &target, 2).unwrap();
+        let trained = shipped.trained_quality.expect("a random residual is worse");
+        assert!(!trained.training_helps());
+        assert_eq!(shipped.params, random.without_residual().unwrap());
+        assert!(shipped.metal.is_none());
+        let lattice = shipped.quality.unwrap();
+        assert!(lattice.mean_ratio < trained.mean_ratio);
+        // The same lattice at fixed offsets and at random shifts: alike.
+        assert!((lattice.mean_ratio - lattice.mean_randomized_ratio).abs() < 0.25);
+        // Without a check nothing is judged and the trained weights ship.
+        let unchecked = ship(random.clone(), None, &target, 0).unwrap();
+        assert_eq!(unchecked.params, random);
+        assert!(unchecked.quality.is_none() && unchecked.trained_quality.is_none());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

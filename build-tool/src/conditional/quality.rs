@@ -133,7 +133,7 @@ pub struct Quality {
 impl Quality {
     /// Whether the trained sets check at least as well as the unbiased mode, the
     /// prior's shifted lattice that no training touched: where they do not, the
-    /// learned part did not help this target (`bake` says so).
+    /// learned part did not help this target (`bake` then ships the lattice).
     pub fn training_helps(&self) -> bool {
         self.mean_ratio <= self.mean_randomized_ratio
     }

@@ -65,6 +65,26 @@ impl Params {
         self.network().square_point_at(c, m, k, i)
     }
 
+    /// These parameters with the output layer's weights and biases set to 0, or
+    /// `None` for a shape without [`Shape::lattice_residual`]. A residual network
+    /// adds its output to the shifted lattice point's logit
+    /// ([`nuld_core::network::lattice_logit`]), so this one returns every
+    /// instance's shifted lattice point unchanged (to the logit's clamp at
+    /// `2^-20` of the square's edges): the prior's untrained lattice, which
+    /// `bake` ships where training did not beat it.
+    pub fn without_residual(&self) -> Option<Self> {
+        if !self.shape.lattice_residual() {
+            return None;
+        }
+        let output = self.shape.layers().last()?;
+        let mut values = self.values.clone();
+        values[output.weights..].fill(0.0);
+        Some(Self {
+            shape: self.shape,
+            values,
+        })
+    }
+
     /// The parameters as f16 bits (round to nearest even through `f32`).
     pub fn to_f16_bits(&self) -> Vec<u16> {
         self.values.iter().map(|&x| f16_encode(x as f32)).collect()
@@ -127,6 +147,41 @@ impl Interleaved {
 mod tests {
     use super::*;
     use nuld_core::network::{Activation, INPUTS};
+
+    #[test]
+    fn without_residual_serves_the_shifted_lattice() {
+        let lattice = Shape::new(16, &[8, 8], Activation::Relu, 5)
+            .unwrap()
+            .with_lattice_residual(true);
+        let trained = Params::init(lattice, 7);
+        let bare = trained.without_residual().unwrap();
+        // Only the output layer (the parameters' tail) changed.
+        let output = lattice.layers().last().unwrap();
+        assert_eq!(
+            output.weights + (output.fan_in + 1) * output.width,
+            trained.values.len()
+        );
+        assert_eq!(
+            bare.values[..output.weights],
+            trained.values[..output.weights]
+        );
+        for (k, i, c) in [(0, 0, [0.2, 0.9]), (3, 7, [0.5, 0.5]), (40, 15, [1.0, 0.0])] {
+            let z = lattice.instance_offset::<f64>(k);
+            let want = nuld_core::network::shifted_lattice_point(i, 16, 5, z);
+            let got = bare.square_point(c, 0.0, k, i);
+            for a in 0..2 {
+                assert!(
+                    (got[a] - want[a]).abs() < 1e-12,
+                    "{k} {i}: {got:?} {want:?}"
+                );
+            }
+            // The trained network's own residual moves the point.
+            assert_ne!(trained.square_point(c, 0.0, k, i), got);
+        }
+        // A network that is not a residual over the lattice has no such copy.
+        let plain = Shape::new(16, &[8, 8], Activation::Relu, 5).unwrap();
+        assert!(Params::init(plain, 7).without_residual().is_none());
+    }
 
     #[test]
     fn init_is_deterministic_sized_and_bounded() {
