@@ -5,7 +5,10 @@ the light), lowsun.hdr (a 3x3-pixel sun 4 degrees above the horizon holding 80 %
 lamps.hdr (a dark room with four 2x1-pixel lamps of 15 % each), pixel.hdr (one lit
 pixel, 30 degrees above the horizon, the rest black: half the normals see no light),
 sky.hdr (a sky brightening towards the horizon with a 3x3-pixel sun 30 degrees up
-holding 5/7 of the light, above a black ground); and lamps-4k.hdr, a 4096x2048 map
+holding 5/7 of the light, above a black ground); sun45.hdr and sun20.hdr (clear
+skies as most outdoor HDRIs are: a sky brightening towards the horizon above a
+ground of 0.3 and 0.2, and a 2x2-pixel sun, 0.7 degrees, 45 and 20 degrees up,
+holding 80 % and 90 % of the light); and lamps-4k.hdr, a 4096x2048 map
 of lamps.hdr's room whose four lamps are 2x1 pixels of that map (0.09 degrees), for
 the bake of a large map (docs/results/envmap.md#large-maps).
 Usage: scripts/synthetic-maps.py OUT_DIR"""
@@ -55,7 +58,17 @@ srows=[170,171,172]; scols=[500,501,502]
 skym=sum(omega(r)*(1+r/256) for r in range(256))*W
 Ls5=2.5*skym/(sum(omega(r) for r in srows)*3)
 write(os.path.join(out,'sky.hdr'), lambda c,r: Ls5 if (r in srows and c in scols) else ((1+r/256) if r<256 else 0.0))
-# 6. lamps at 4096 x 2048: the dark room, four 2x1-pixel lamps of ~15 % each, rows
+# 6. clear skies: a 2x2-pixel sun `elev` degrees up holding `share` of the light,
+# a sky from 0.5 at the zenith to 1 at the horizon, a uniform ground
+def sunmap(path,elev,share,ground):
+    rs=int((90-elev)/180*H); rows=[rs,rs+1]; cols=[300,301]
+    sky=lambda r: 0.5+0.5*r/256 if r<256 else ground
+    rest=sum(omega(r)*sky(r) for r in range(H))*W
+    Ls=share/(1-share)*rest/(sum(omega(r) for r in rows)*2)
+    write(os.path.join(out,path), lambda c,r: Ls if (r in rows and c in cols) else sky(r))
+sunmap('sun45.hdr',45,0.8,0.3)
+sunmap('sun20.hdr',20,0.9,0.2)
+# 7. lamps at 4096 x 2048: the dark room, four 2x1-pixel lamps of ~15 % each, rows
 # written whole (the other maps' per-pixel function would take minutes here)
 W4,H4=4096,2048
 def omega4(r): return (2*math.pi/W4)*(math.cos(math.pi*r/H4)-math.cos(math.pi*(r+1)/H4))
