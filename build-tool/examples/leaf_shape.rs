@@ -13,12 +13,18 @@
 //! exact inverse CDF of the filtered map's half pixels: what renderers ship, blind
 //! to the cosine). What is left for the tree is the leaves' probabilities'
 //! distance from `L cos`, and the bilinear shape's from `L`; for the luminance
-//! warp, the cosine and the samples below the normal's horizon.
+//! warp, the cosine and the samples below the normal's horizon. A fourth line
+//! gives the tree whose leaves would follow their light exactly inside them
+//! (`pdf = P(leaf) L / M(leaf)`, the estimate `cos M(leaf) / (E P(leaf))` with
+//! the cosine read at the shaped sample, which is in the leaf): the bound of
+//! pixel-exact leaves, which no blob holds.
 //! Results: docs/results/rendering.md#fixed-instance-weight, docs/results/envmap.md#clear-skies.
 use glam::{DVec2, DVec3};
 use nuld_build_tool::sphere::envmap_tree::{prior_levels, PRIOR_GRID};
 use nuld_build_tool::sphere::{DirectionDensity, EnvmapDensity, EnvmapTree};
 use nuld_core::blob::Domain;
+use nuld_core::envmap_tree::node_index;
+use nuld_core::quadtree::descend;
 use nuld_core::sphere::square_to_sphere;
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
@@ -39,7 +45,7 @@ fn main() {
     // No corners: the uniform leaves, bit for bit.
     let uniform = shaped.with_corners(&[]).unwrap();
     let l = |d: DVec3| map.pdf(d) * map.integral();
-    let rows: Vec<[f64; 6]> = (0..64)
+    let rows: Vec<[f64; 8]> = (0..64)
         .into_par_iter()
         .map(|k| {
             let z = 1.0 - (k as f64 + 0.5) / 64.0 * 1.6;
@@ -50,7 +56,8 @@ fn main() {
             let q = nuld_core::sphere::sphere_to_square(n).to_array();
             let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(k);
             let m = 200_000;
-            let mut acc = [0.0; 6];
+            let mut acc = [0.0; 8];
+            let lit = shaped.lit_square(q);
             for _ in 0..m {
                 let u = [rng.random::<f64>(), rng.random::<f64>()];
                 for (j, t) in [(0, &uniform), (2, &shaped)] {
@@ -70,6 +77,18 @@ fn main() {
                 let ratio = n.dot(d).max(0.0) * map.integral() / e;
                 acc[4] += ratio;
                 acc[5] += ratio * ratio;
+                // Leaves that followed their light exactly inside them (what
+                // pixel-exact leaves would reach): `pdf = P(leaf) L / M(leaf)`, so
+                // `L cos / (E pdf) = cos M(leaf) / (E P(leaf))`, the cosine read at a
+                // point of the leaf (it hardly varies across one).
+                let leaf = descend(&lit, u);
+                let record = shaped.nodes()[node_index(levels, leaf.leaf[0], leaf.leaf[1])];
+                let (p, _, _) = shaped.sample_square_with_slopes(q, u);
+                let d = square_to_sphere(DVec2::from(p));
+                let mass = record.mass() as f64 * map.integral();
+                let ratio = n.dot(d).max(0.0) * mass / (e * leaf.share);
+                acc[6] += ratio;
+                acc[7] += ratio * ratio;
             }
             acc.map(|a| a / m as f64)
         })
@@ -101,5 +120,15 @@ fn main() {
         "median variance: shaped {:.4}, luminance {:.4}; the luminance warp's is the lower at {lower} of 64 normals",
         median(2),
         median(4)
+    );
+    let exact_lower = rows
+        .iter()
+        .filter(|r| r[5] - r[4] * r[4] < r[7] - r[6] * r[6])
+        .count();
+    println!(
+        "leaves exact inside: mean {:.4}, variance {:.4}, median {:.4}; the luminance warp's is the lower at {exact_lower} of 64 normals",
+        mean(6),
+        var(6),
+        median(6)
     );
 }
