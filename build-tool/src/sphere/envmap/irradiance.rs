@@ -2,7 +2,7 @@
 //! map lit through the cosine about `n`, `q(l | n) ∝ L(l) max(0, n.l)` (the
 //! target of `bake --envmap`).
 
-use super::EnvmapDensity;
+use super::{z_edge, EnvmapDensity};
 use crate::density::image::LuminanceImage;
 use crate::sphere::DirectionSpecError;
 use glam::DVec3;
@@ -45,42 +45,85 @@ impl EnvmapDensity {
 
     /// The density `q(l | n) ∝ L(l) max(0, n.l)` of the map lit through a cosine
     /// about the unit normal `n`, on the sphere: every pixel's luminance times
-    /// `max(0, n.c_p)` at its centre `c_p` (piecewise constant like the map), and
-    /// the irradiance `E(n)` it integrates to (the lit map's
-    /// [`integral`](Self::integral), [`Self::irradiance`]'s sum). If no light
-    /// reaches `n` (the map is black above its horizon), the plain cosine lobe
-    /// about `n` and `E(n) = 0`: any set serves there, since the estimator's
-    /// weight is 0.
+    /// `max(0, n.c)` at the centre `c` of each of its `k x k` equal-angle sub-cells
+    /// (piecewise constant like the map; `k` = [`lit_subdivision`], 1 for maps of
+    /// [`MIN_LIT_ROWS`] rows or more), and the irradiance `E(n)` it integrates to
+    /// (the lit map's [`integral`](Self::integral); at `k = 1`
+    /// [`Self::irradiance`]'s sum). If no light reaches `n` (the map is black
+    /// above its horizon), the plain cosine lobe about `n` and `E(n) = 0`: any set
+    /// serves there, since the estimator's weight is 0.
     pub fn cosine_weighted(&self, n: DVec3) -> Result<(Self, f64), DirectionSpecError> {
         let (w, h) = (self.width, self.height);
+        let k = lit_subdivision(h);
+        let (lw, lh) = (w * k, h * k);
+        // A coarse map's sub-cells: their centres on the finer equal-angle grid.
+        let fine_rows: Vec<[f64; 2]>;
+        let fine_cols: Vec<[f64; 2]>;
+        let (rows, cols) = if k == 1 {
+            (&self.row_trig, &self.col_trig)
+        } else {
+            fine_rows = (0..lh)
+                .map(|r| {
+                    let z = 0.5 * (z_edge(r, lh) + z_edge(r + 1, lh));
+                    [z, (1.0 - z * z).max(0.0).sqrt()]
+                })
+                .collect();
+            fine_cols = (0..lw)
+                .map(|c| {
+                    let phi = TAU * (c as f64 + 0.5) / lw as f64;
+                    [phi.cos(), phi.sin()]
+                })
+                .collect();
+            (&fine_rows, &fine_cols)
+        };
+        let centre = |c: usize, r: usize| {
+            let [z, s] = rows[r];
+            let [cos_phi, sin_phi] = cols[c];
+            DVec3::new(s * cos_phi, s * sin_phi, z)
+        };
         let dphi = TAU / w as f64;
         // Row by row into one allocation: a bake builds this for every pool
         // normal, on the filtered map's four cells a pixel.
-        let mut values = vec![0.0f64; w * h];
-        for (r, row) in values.chunks_exact_mut(w).enumerate() {
-            let omega = dphi * (self.z_hi[r] - self.z_lo[r]);
+        let mut values = vec![0.0f64; lw * lh];
+        for (r, row) in values.chunks_exact_mut(lw).enumerate() {
+            let cell_row = r / k;
+            let omega = dphi * (self.z_hi[cell_row] - self.z_lo[cell_row]);
             for (c, v) in row.iter_mut().enumerate() {
-                let lum = self.luminance_of(self.mass[r * w + c], omega);
-                *v = lum * n.dot(self.pixel_center(c, r)).max(0.0);
+                let lum = self.luminance_of(self.mass[cell_row * w + c / k], omega);
+                *v = lum * n.dot(centre(c, r)).max(0.0);
             }
         }
         let dark = !values.iter().any(|&v| v > 0.0);
         if dark {
-            for (r, row) in values.chunks_exact_mut(w).enumerate() {
+            for (r, row) in values.chunks_exact_mut(lw).enumerate() {
                 for (c, v) in row.iter_mut().enumerate() {
-                    *v = n.dot(self.pixel_center(c, r)).max(0.0);
+                    *v = n.dot(centre(c, r)).max(0.0);
                 }
             }
         }
         let img = LuminanceImage {
-            width: w,
-            height: h,
+            width: lw,
+            height: lh,
             values,
         };
         let lit = Self::from_owned_luminance(img, Domain::Sphere, &self.name)?;
         let irradiance = if dark { 0.0 } else { lit.integral };
         Ok((lit, irradiance))
     }
+}
+
+/// Rows of cells that a lit map ([`EnvmapDensity::cosine_weighted`]) has at
+/// least: the cosine is read once per cell, and on a map of a few pixels (a 1 x 1
+/// map's four cells span 90° each) that reading is far from `max(0, n.l)`,
+/// which the bake's check and training would then take as the target. At 256
+/// rows a cell spans 0.7°, as a 256 x 128 map's half pixels do.
+pub const MIN_LIT_ROWS: usize = 256;
+
+/// The `k` of [`EnvmapDensity::cosine_weighted`]: each cell of a map of `h` rows
+/// cut into `k x k` for the cosine, `ceil(MIN_LIT_ROWS / h)` (1 from
+/// [`MIN_LIT_ROWS`] rows on, so those maps' lit maps are what they were).
+pub fn lit_subdivision(h: usize) -> usize {
+    MIN_LIT_ROWS.div_ceil(h.max(1))
 }
 
 /// Cells per side of an [`IrradianceBlocks`] block: 16 x 16 cells of a

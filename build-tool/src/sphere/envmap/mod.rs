@@ -47,6 +47,7 @@ pub(crate) mod test_support;
 mod tests;
 
 pub use box_filter::COARSE_CELLS;
+pub use irradiance::{lit_subdivision, MIN_LIT_ROWS};
 
 use super::cap_table::profile_of_rule;
 use super::equirect::pixel_coords;

@@ -358,3 +358,47 @@ fn tiny_negative_pixels_of_lossy_maps_are_set_to_zero_and_reported() {
     let e = EnvmapDensity::from_luminance(&image(8, 4, |_, _| -1.0), Domain::Sphere, "z");
     assert!(e.unwrap_err().to_string().contains("zero mass"));
 }
+
+/// A constant map of one pixel, lit about a normal, is the cosine lobe: its caps
+/// about the normal hold `sin^2 theta` (the closed form), its irradiance is `pi
+/// L`, and its samples' mean `n.l` is 2/3. Read at the centres of the map's own
+/// cells (a 1 x 1 map's four cells span 90° each) the cosine was far from that;
+/// the lit map cuts each cell into `k x k` first.
+#[test]
+fn a_tiny_constant_map_lit_about_a_normal_is_the_cosine_lobe() {
+    assert_eq!(lit_subdivision(1), MIN_LIT_ROWS);
+    assert_eq!(lit_subdivision(200), 2);
+    assert_eq!(lit_subdivision(MIN_LIT_ROWS), 1);
+    let lum = 2.0;
+    let map =
+        EnvmapDensity::from_luminance(&image(1, 1, |_, _| lum), Domain::Sphere, "one").unwrap();
+    for n in [
+        DVec3::Z,
+        DVec3::new(0.6, -0.48, 0.64),
+        DVec3::new(-0.3, 0.1, -0.9).normalize(),
+    ] {
+        let (lit, irradiance) = map.cosine_weighted(n).unwrap();
+        assert!(lit.height() >= MIN_LIT_ROWS);
+        let pi_l = std::f64::consts::PI * lum;
+        assert!((irradiance / pi_l - 1.0).abs() < 1e-3, "{n}: {irradiance}");
+        for t in [0.95, 0.8, 0.5, 0.2, 0.0] {
+            let got = lit.cap_measure(n, t);
+            let want = 1.0 - t * t;
+            assert!(
+                (got - want).abs() < 2e-3,
+                "{n}, cos {t}: {got} against {want}"
+            );
+        }
+        let mut g = rng(5, 0);
+        let m = 20_000;
+        let mean: f64 = (0..m)
+            .map(|_| n.dot(lit.sample(DVec2::new(g.random(), g.random()))))
+            .sum::<f64>()
+            / m as f64;
+        // The lobe's `n.l` has variance 1/18: 4 standard errors at 20 000 samples.
+        assert!(
+            (mean - 2.0 / 3.0).abs() < 4.0 * (1.0 / 18.0 / m as f64).sqrt(),
+            "{n}: {mean}"
+        );
+    }
+}
