@@ -8,6 +8,7 @@ use crate::sphere::DirectionSpecError;
 use glam::DVec3;
 use nuld_core::blob::Domain;
 use rayon::prelude::*;
+use std::borrow::Cow;
 use std::f64::consts::TAU;
 
 impl EnvmapDensity {
@@ -33,7 +34,24 @@ impl EnvmapDensity {
     /// rounding: the blocks kept whole have every cell about `1e-3` or more
     /// above the horizon (in `n . c_p`), so no term is small against the
     /// rounding of the others. `O(blocks + horizon cells)` a normal.
+    ///
+    /// A map of fewer than [`MIN_LIT_ROWS`] rows sums the lit map's own
+    /// sub-cells instead ([`Self::cosine_weighted`]), in the order the lit map
+    /// sums them: its integral to the last bit.
     pub fn irradiances(&self, normals: &[DVec3]) -> Vec<f64> {
+        if lit_subdivision(self.height) > 1 {
+            return normals
+                .par_iter()
+                .map(|&n| {
+                    let lit = self.lit_cells(n);
+                    lit.values
+                        .iter()
+                        .enumerate()
+                        .map(|(j, v)| v * lit.dphi * lit.dz(j / lit.width))
+                        .sum()
+                })
+                .collect();
+        }
         let blocks = self
             .irradiance_blocks
             .get_or_init(|| IrradianceBlocks::new(self));
@@ -53,62 +71,116 @@ impl EnvmapDensity {
     /// above its horizon), the plain cosine lobe about `n` and `E(n) = 0`: any set
     /// serves there, since the estimator's weight is 0.
     pub fn cosine_weighted(&self, n: DVec3) -> Result<(Self, f64), DirectionSpecError> {
+        let LitCells {
+            mut values,
+            width,
+            height,
+            ..
+        } = self.lit_cells(n);
+        let dark = !values.iter().any(|&v| v > 0.0);
+        if dark {
+            let centres = self.centres(lit_subdivision(self.height));
+            for (r, row) in values.chunks_exact_mut(width).enumerate() {
+                for (c, v) in row.iter_mut().enumerate() {
+                    *v = n.dot(centres.at(c, r)).max(0.0);
+                }
+            }
+        }
+        let img = LuminanceImage {
+            width,
+            height,
+            values,
+        };
+        let lit = Self::from_owned_luminance(img, Domain::Sphere, &self.name)?;
+        let irradiance = if dark { 0.0 } else { lit.integral };
+        Ok((lit, irradiance))
+    }
+
+    /// The lit map's values before normalization: each (sub-)cell's luminance
+    /// times `max(0, n.c)` at its centre ([`Self::cosine_weighted`]).
+    fn lit_cells(&self, n: DVec3) -> LitCells {
         let (w, h) = (self.width, self.height);
         let k = lit_subdivision(h);
-        let (lw, lh) = (w * k, h * k);
-        // A coarse map's sub-cells: their centres on the finer equal-angle grid.
-        let fine_rows: Vec<[f64; 2]>;
-        let fine_cols: Vec<[f64; 2]>;
-        let (rows, cols) = if k == 1 {
-            (&self.row_trig, &self.col_trig)
-        } else {
-            fine_rows = (0..lh)
-                .map(|r| {
-                    let z = 0.5 * (z_edge(r, lh) + z_edge(r + 1, lh));
-                    [z, (1.0 - z * z).max(0.0).sqrt()]
-                })
-                .collect();
-            fine_cols = (0..lw)
-                .map(|c| {
-                    let phi = TAU * (c as f64 + 0.5) / lw as f64;
-                    [phi.cos(), phi.sin()]
-                })
-                .collect();
-            (&fine_rows, &fine_cols)
-        };
-        let centre = |c: usize, r: usize| {
-            let [z, s] = rows[r];
-            let [cos_phi, sin_phi] = cols[c];
-            DVec3::new(s * cos_phi, s * sin_phi, z)
-        };
+        let centres = self.centres(k);
         let dphi = TAU / w as f64;
         // Row by row into one allocation: a bake builds this for every pool
         // normal, on the filtered map's four cells a pixel.
+        let (lw, lh) = (w * k, h * k);
         let mut values = vec![0.0f64; lw * lh];
         for (r, row) in values.chunks_exact_mut(lw).enumerate() {
             let cell_row = r / k;
             let omega = dphi * (self.z_hi[cell_row] - self.z_lo[cell_row]);
             for (c, v) in row.iter_mut().enumerate() {
                 let lum = self.luminance_of(self.mass[cell_row * w + c / k], omega);
-                *v = lum * n.dot(centre(c, r)).max(0.0);
+                *v = lum * n.dot(centres.at(c, r)).max(0.0);
             }
         }
-        let dark = !values.iter().any(|&v| v > 0.0);
-        if dark {
-            for (r, row) in values.chunks_exact_mut(lw).enumerate() {
-                for (c, v) in row.iter_mut().enumerate() {
-                    *v = n.dot(centre(c, r)).max(0.0);
-                }
-            }
-        }
-        let img = LuminanceImage {
+        LitCells {
+            values,
             width: lw,
             height: lh,
-            values,
-        };
-        let lit = Self::from_owned_luminance(img, Domain::Sphere, &self.name)?;
-        let irradiance = if dark { 0.0 } else { lit.integral };
-        Ok((lit, irradiance))
+            dphi: TAU / lw as f64,
+        }
+    }
+
+    /// The centres of the lit map's cells: this map's own at `k = 1`, else those
+    /// of the `k`-times finer equal-angle grid.
+    fn centres(&self, k: usize) -> Centres<'_> {
+        if k == 1 {
+            return Centres {
+                rows: Cow::Borrowed(&self.row_trig),
+                cols: Cow::Borrowed(&self.col_trig),
+            };
+        }
+        let (lw, lh) = (self.width * k, self.height * k);
+        let rows = (0..lh)
+            .map(|r| {
+                let z = 0.5 * (z_edge(r, lh) + z_edge(r + 1, lh));
+                [z, (1.0 - z * z).max(0.0).sqrt()]
+            })
+            .collect();
+        let cols = (0..lw)
+            .map(|c| {
+                let phi = TAU * (c as f64 + 0.5) / lw as f64;
+                [phi.cos(), phi.sin()]
+            })
+            .collect();
+        Centres {
+            rows: Cow::Owned(rows),
+            cols: Cow::Owned(cols),
+        }
+    }
+}
+
+/// [`EnvmapDensity::lit_cells`]: a lit map's values, row-major, on its cells.
+struct LitCells {
+    values: Vec<f64>,
+    width: usize,
+    height: usize,
+    /// Each cell's width in `phi`.
+    dphi: f64,
+}
+
+impl LitCells {
+    /// The `z` extent of row `r` (on the sphere, as the lit map measures it).
+    fn dz(&self, r: usize) -> f64 {
+        (z_edge(r, self.height) - z_edge(r + 1, self.height)).max(0.0)
+    }
+}
+
+/// `[z, sqrt(1 - z^2)]` per row and `[cos phi, sin phi]` per column of a grid's
+/// cell centres.
+struct Centres<'a> {
+    rows: Cow<'a, [[f64; 2]]>,
+    cols: Cow<'a, [[f64; 2]]>,
+}
+
+impl Centres<'_> {
+    /// The direction of cell `(c, r)`'s centre.
+    fn at(&self, c: usize, r: usize) -> DVec3 {
+        let [z, s] = self.rows[r];
+        let [cos_phi, sin_phi] = self.cols[c];
+        DVec3::new(s * cos_phi, s * sin_phi, z)
     }
 }
 

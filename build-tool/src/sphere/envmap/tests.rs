@@ -86,15 +86,17 @@ fn filtered_map_integrates_the_bilinear_luminance() {
 }
 
 /// Irradiances, taken block by block (a block above the horizon by its first
-/// moment), are each normal's own sum over the pixel centres written out here
-/// with their sines and cosines, to rounding: on maps whose size fills no block
+/// moment) or, below MIN_LIT_ROWS rows, over the lit map's sub-cells, are each
+/// normal's own sum over the cell centres (each cell cut into `k x k` below
+/// MIN_LIT_ROWS rows) written out here with their sines and cosines, to
+/// rounding: on maps whose size fills no block
 /// exactly, at normals whose horizon crosses the light (and grazes it, where a
 /// block's cells sit just above it), and at a normal that no light reaches. A
 /// normal's value is the same alone as among others (any thread count).
 #[test]
 fn irradiances_are_each_normals_pixel_sum() {
     let maps = [
-        // One row lit all round the equator: the block's centres sum to about 0.
+        // One row, the whole sphere lit: its cells' centres lie on the equator.
         image(4, 1, |_, _| 1.0),
         image(
             40,
@@ -108,6 +110,19 @@ fn irradiances_are_each_normals_pixel_sum() {
                 0.0
             };
             if r < 50 {
+                0.2 + ((c * 13 + r * 7) % 17) as f64 + bright
+            } else {
+                0.0
+            }
+        }),
+        // From MIN_LIT_ROWS rows on: the blocks, kept whole above a horizon.
+        image(96, 300, |c, r| {
+            let bright = if (c / 7 + r / 5) % 11 == 0 {
+                500.0
+            } else {
+                0.0
+            };
+            if r < 150 {
                 0.2 + ((c * 13 + r * 7) % 17) as f64 + bright
             } else {
                 0.0
@@ -130,16 +145,21 @@ fn irradiances_are_each_normals_pixel_sum() {
         all.extend((0..8).map(|k| DVec3::new((k as f64).cos(), (k as f64).sin(), 1e-4 * k as f64)));
         all.push(DVec3::NEG_Z);
         let got = d.irradiances(&all);
+        // Each cell cut into k x k for the cosine (k = 1 from MIN_LIT_ROWS rows).
+        let k = lit_subdivision(d.height());
+        let (w, h) = (d.width() * k, d.height() * k);
         for (n, got) in all.iter().zip(&got) {
             let mut sum = 0.0;
-            for r in 0..d.height() {
-                let (lo, hi) = d.row_z_range(r);
+            for r in 0..h {
+                let (lo, hi) = (z_edge(r + 1, h), z_edge(r, h));
                 let z = 0.5 * (lo + hi);
                 let s = (1.0 - z * z).max(0.0).sqrt();
-                for c in 0..d.width() {
-                    let phi = TAU * (c as f64 + 0.5) / d.width() as f64;
+                let (cell_lo, cell_hi) = d.row_z_range(r / k);
+                let share = (hi - lo) / (k as f64 * (cell_hi - cell_lo));
+                for c in 0..w {
+                    let phi = TAU * (c as f64 + 0.5) / w as f64;
                     let center = DVec3::new(s * phi.cos(), s * phi.sin(), z);
-                    sum += d.pixel_mass(c, r) * n.dot(center).max(0.0);
+                    sum += d.pixel_mass(c / k, r / k) * share * n.dot(center).max(0.0);
                 }
             }
             let want = d.integral() * sum;
@@ -150,7 +170,13 @@ fn irradiances_are_each_normals_pixel_sum() {
             );
             assert_eq!(got.to_bits(), d.irradiance(*n).to_bits(), "{n}");
         }
-        assert_eq!(d.irradiance(DVec3::NEG_Z), 0.0);
+        if img.height == 1 {
+            // One row is the whole sphere: a constant map, whose irradiance is
+            // pi L at every normal (its cells' centres on the equator gave 0).
+            assert!((d.irradiance(DVec3::NEG_Z) / PI - 1.0).abs() < 1e-3);
+        } else {
+            assert_eq!(d.irradiance(DVec3::NEG_Z), 0.0);
+        }
     }
 }
 
