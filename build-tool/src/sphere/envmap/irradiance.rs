@@ -2,7 +2,7 @@
 //! map lit through the cosine about `n`, `q(l | n) ∝ L(l) max(0, n.l)` (the
 //! target of `bake --envmap`).
 
-use super::{z_edge, EnvmapDensity};
+use super::{column_centres, row_centres, z_edge, EnvmapDensity};
 use crate::density::image::LuminanceImage;
 use crate::sphere::DirectionSpecError;
 use glam::DVec3;
@@ -133,21 +133,11 @@ impl EnvmapDensity {
             };
         }
         let (lw, lh) = (self.width * k, self.height * k);
-        let rows = (0..lh)
-            .map(|r| {
-                let z = 0.5 * (z_edge(r, lh) + z_edge(r + 1, lh));
-                [z, (1.0 - z * z).max(0.0).sqrt()]
-            })
-            .collect();
-        let cols = (0..lw)
-            .map(|c| {
-                let phi = TAU * (c as f64 + 0.5) / lw as f64;
-                [phi.cos(), phi.sin()]
-            })
-            .collect();
         Centres {
-            rows: Cow::Owned(rows),
-            cols: Cow::Owned(cols),
+            rows: Cow::Owned(row_centres(
+                (0..lh).map(|r| (z_edge(r + 1, lh), z_edge(r, lh))),
+            )),
+            cols: Cow::Owned(column_centres(lw)),
         }
     }
 }

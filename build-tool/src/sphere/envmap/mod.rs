@@ -163,6 +163,26 @@ pub fn shape_warning(path: &Path) -> Option<String> {
     })
 }
 
+/// `[cos phi, sin phi]` at the centre of each of `w` columns.
+fn column_centres(w: usize) -> Vec<[f64; 2]> {
+    (0..w)
+        .map(|c| {
+            let phi = TAU * (c as f64 + 0.5) / w as f64;
+            [phi.cos(), phi.sin()]
+        })
+        .collect()
+}
+
+/// `[z, sqrt(1 - z^2)]` at the middle of each row's `z` range `(lo, hi)`.
+fn row_centres(ranges: impl Iterator<Item = (f64, f64)>) -> Vec<[f64; 2]> {
+    ranges
+        .map(|(lo, hi)| {
+            let z = 0.5 * (lo + hi);
+            [z, (1.0 - z * z).max(0.0).sqrt()]
+        })
+        .collect()
+}
+
 /// `z = cos(pi r / H)` written as `sin(pi (H - 2r) / (2H))`, exact 0 at the equator.
 fn z_edge(r: usize, h: usize) -> f64 {
     (PI * (h as f64 - 2.0 * r as f64) / (2.0 * h as f64)).sin()
@@ -250,18 +270,8 @@ impl EnvmapDensity {
                 (0..w).filter(|&c| row[c] > floor).collect()
             })
             .collect();
-        let col_trig = (0..w)
-            .map(|c| {
-                let phi = TAU * (c as f64 + 0.5) / w as f64;
-                [phi.cos(), phi.sin()]
-            })
-            .collect();
-        let row_trig = (0..h)
-            .map(|r| {
-                let z = 0.5 * (z_lo[r] + z_hi[r]);
-                [z, (1.0 - z * z).max(0.0).sqrt()]
-            })
-            .collect();
+        let col_trig = column_centres(w);
+        let row_trig = row_centres((0..h).map(|r| (z_lo[r], z_hi[r])));
         Ok(Self {
             name: name.to_string(),
             width: w,

@@ -95,6 +95,21 @@ fn filtered_map_integrates_the_bilinear_luminance() {
 /// normal's value is the same alone as among others (any thread count).
 #[test]
 fn irradiances_are_each_normals_pixel_sum() {
+    // Patchy light with bright spots in the top `lit` rows, black below.
+    let patchy = |lit: usize| {
+        move |c: usize, r: usize| {
+            let bright = if (c / 7 + r / 5).is_multiple_of(11) {
+                500.0
+            } else {
+                0.0
+            };
+            if r < lit {
+                0.2 + ((c * 13 + r * 7) % 17) as f64 + bright
+            } else {
+                0.0
+            }
+        }
+    };
     let maps = [
         // One row, the whole sphere lit: its cells' centres lie on the equator.
         image(4, 1, |_, _| 1.0),
@@ -103,31 +118,9 @@ fn irradiances_are_each_normals_pixel_sum() {
             20,
             |c, r| if r < 8 { 1.0 + (c * r) as f64 } else { 0.0 },
         ),
-        image(203, 101, |c, r| {
-            let bright = if (c / 7 + r / 5) % 11 == 0 {
-                500.0
-            } else {
-                0.0
-            };
-            if r < 50 {
-                0.2 + ((c * 13 + r * 7) % 17) as f64 + bright
-            } else {
-                0.0
-            }
-        }),
+        image(203, 101, patchy(50)),
         // From MIN_LIT_ROWS rows on: the blocks, kept whole above a horizon.
-        image(96, 300, |c, r| {
-            let bright = if (c / 7 + r / 5) % 11 == 0 {
-                500.0
-            } else {
-                0.0
-            };
-            if r < 150 {
-                0.2 + ((c * 13 + r * 7) % 17) as f64 + bright
-            } else {
-                0.0
-            }
-        }),
+        image(96, 300, patchy(150)),
     ];
     for img in &maps {
         let d = EnvmapDensity::from_luminance(img, Domain::Sphere, "t").unwrap();
