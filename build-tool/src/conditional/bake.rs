@@ -430,10 +430,11 @@ fn ship(
     }
     let held_out = QualityConfig::held_out(target, grid, 0x9a11);
     let trained = evaluate(&params, metal.as_ref(), target, &held_out)?;
-    let lattice = metal
-        .as_ref()
-        .map(Params::without_residual)
-        .map_or(Some(None), |m| m.map(Some));
+    // The metal network's lattice too, where there is one (`None`: no copy).
+    let lattice = match &metal {
+        None => Some(None),
+        Some(m) => m.without_residual().map(Some),
+    };
     match (trained.training_helps(), params.without_residual(), lattice) {
         (false, Some(params), Some(metal)) => {
             let quality = evaluate(&params, metal.as_ref(), target, &held_out)?;

@@ -47,7 +47,7 @@ impl EnvmapDensity {
                     lit.values
                         .iter()
                         .enumerate()
-                        .map(|(j, v)| v * lit.dphi * lit.dz(j / lit.width))
+                        .map(|(j, v)| v * lit.dphi() * lit.dz(j / lit.width))
                         .sum()
                 })
                 .collect();
@@ -75,7 +75,6 @@ impl EnvmapDensity {
             mut values,
             width,
             height,
-            ..
         } = self.lit_cells(n);
         let dark = !values.iter().any(|&v| v > 0.0);
         if dark {
@@ -119,7 +118,6 @@ impl EnvmapDensity {
             values,
             width: lw,
             height: lh,
-            dphi: TAU / lw as f64,
         }
     }
 
@@ -147,11 +145,14 @@ struct LitCells {
     values: Vec<f64>,
     width: usize,
     height: usize,
-    /// Each cell's width in `phi`.
-    dphi: f64,
 }
 
 impl LitCells {
+    /// Each cell's width in `phi`.
+    fn dphi(&self) -> f64 {
+        TAU / self.width as f64
+    }
+
     /// The `z` extent of row `r` (on the sphere, as the lit map measures it).
     fn dz(&self, r: usize) -> f64 {
         (z_edge(r, self.height) - z_edge(r + 1, self.height)).max(0.0)
