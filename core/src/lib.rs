@@ -49,6 +49,7 @@ pub mod bilinear;
 pub mod blob;
 pub mod brdf;
 pub mod brdf_prior;
+pub mod cell_table;
 pub mod conditional;
 pub mod domain;
 pub mod envmap_tree;
