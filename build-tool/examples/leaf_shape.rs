@@ -4,20 +4,22 @@
 //!
 //! The prior's tree (the one the bake builds, or one of `LEVELS` levels) draws a
 //! point inside its leaf by the bilinear warp of the leaf's four corner values
-//! (`nuld_core::bilinear`; the map's `L` at the corners, floored), where uniform
-//! leaves would leave the point where the descent put it. At 64 normals spread
-//! over the sphere (`z` from 1 down to -0.6), 200 000 random primary samples
-//! each, prints the relative variance of `L cos / (E pdf)` (the single-sample
-//! irradiance estimate over `E`, of mean one) for the tree with uniform leaves,
-//! for the tree as baked, and for the map's own luminance warp (`pdf ∝ L`, the
-//! exact inverse CDF of the filtered map's half pixels: what renderers ship, blind
-//! to the cosine). What is left for the tree is the leaves' probabilities'
-//! distance from `L cos`, and the bilinear shape's from `L`; for the luminance
-//! warp, the cosine and the samples below the normal's horizon. A fourth line
-//! gives the tree whose leaves would follow their light exactly inside them
-//! (`pdf = P(leaf) L / M(leaf)`, the estimate `cos M(leaf) / (E P(leaf))` with
-//! the cosine read at the shaped sample, which is in the leaf): the bound of
-//! pixel-exact leaves, which no blob holds.
+//! (`nuld_core::bilinear`; the map's `L` at the corners, floored), and inside
+//! the sharp leaves (around lamps and the sun) by the piecewise-constant warp of
+//! the leaf's light on 16 x 16 cells (`nuld_core::cell_table`, the detail). At
+//! 64 normals spread over the sphere (`z` from 1 down to -0.6), 200 000 random
+//! primary samples each, prints the number of detailed leaves and the state's
+//! size, then the relative variance of `L cos / (E pdf)` (the single-sample
+//! irradiance estimate over `E`, of mean one) for the tree with the corners
+//! alone (no detail), for the tree as baked, and for the map's own luminance
+//! warp (`pdf ∝ L`, the exact inverse CDF of the filtered map's half pixels:
+//! what renderers ship, blind to the cosine). What is left for the tree is the
+//! leaves' probabilities' distance from `L cos`, and the shapes' from `L`; for
+//! the luminance warp, the cosine and the samples below the normal's horizon.
+//! A last line gives the tree whose leaves would follow their light exactly
+//! inside them (`pdf = P(leaf) L / M(leaf)`, the estimate `cos M(leaf) / (E
+//! P(leaf))` with the cosine read at the shaped sample, which is in the leaf):
+//! the bound of pixel-exact leaves.
 //! Results: docs/results/rendering.md#fixed-instance-weight, docs/results/envmap.md#clear-skies.
 use glam::{DVec2, DVec3};
 use nuld_build_tool::sphere::envmap_tree::{prior_levels, PRIOR_GRID};
@@ -41,9 +43,15 @@ fn main() {
         s.parse().expect("LEVELS: an integer")
     });
     let tree = EnvmapTree::new(&map, levels, PRIOR_GRID).unwrap();
+    println!(
+        "{} detailed leaves of {} ({:.1} MB of state)",
+        tree.detail.len() / nuld_core::envmap_tree::DETAIL_LEN,
+        1usize << (2 * levels),
+        tree.state_bytes() as f64 / 1e6
+    );
     let shaped = tree.tree();
-    // No corners: the uniform leaves, bit for bit.
-    let uniform = shaped.with_corners(&[]).unwrap();
+    // No detail: the corners' bilinear shape in every leaf, bit for bit.
+    let corners_only = shaped.with_detail(&[], &[]).unwrap();
     let l = |d: DVec3| map.pdf(d) * map.integral();
     let rows: Vec<[f64; 8]> = (0..64)
         .into_par_iter()
@@ -60,7 +68,7 @@ fn main() {
             let lit = shaped.lit_square(q);
             for _ in 0..m {
                 let u = [rng.random::<f64>(), rng.random::<f64>()];
-                for (j, t) in [(0, &uniform), (2, &shaped)] {
+                for (j, t) in [(0, &corners_only), (2, &shaped)] {
                     // `L cos / (E pdf)` at the sample, pdf per unit square area.
                     let (p, pdf_sq, _) = t.sample_square_with_slopes(q, u);
                     let d = square_to_sphere(DVec2::from(p));
@@ -100,7 +108,7 @@ fn main() {
     // The normals where the luminance warp's (4) estimate is the less variable.
     let luminance_lower = |j: usize| rows.iter().filter(|r| var_at(r, 4) < var_at(r, j)).count();
     println!(
-        "{path}, {levels} levels: uniform leaves: mean {:.4}, variance of L cos/(E pdf) {:.4}; shaped (as baked): mean {:.4}, variance {:.4}; the luminance warp: mean {:.4}, variance {:.4}",
+        "{path}, {levels} levels: corners only: mean {:.4}, variance of L cos/(E pdf) {:.4}; as baked (detail in sharp leaves): mean {:.4}, variance {:.4}; the luminance warp: mean {:.4}, variance {:.4}",
         mean(0),
         var(0),
         mean(2),

@@ -60,7 +60,8 @@ pub fn sample_linear<T: Real>(u: T, a: T, b: T) -> T {
 #[inline]
 pub fn linear_pdf<T: Real>(x: T, a: T, b: T) -> T {
     if a + b > T::ZERO {
-        T::of(2.0) * lerp(clamp_unit(x), a, b) / (a + b)
+        // Divided first: corners near the float range still give a finite density.
+        T::of(2.0) * (lerp(clamp_unit(x), a, b) / (a + b))
     } else {
         T::ONE
     }

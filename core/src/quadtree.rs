@@ -52,6 +52,12 @@ pub enum QuadtreeError {
     /// A leaf-corner value ([`crate::envmap_tree`]'s leaf shape) is negative,
     /// NaN or infinite (index into the corners).
     BadCorner(u64),
+    /// A detail-index entry ([`crate::envmap_tree::EnvmapTree::with_detail`])
+    /// names a table past the tables (index into the index).
+    BadDetailIndex(u64),
+    /// A detail-table value is negative, NaN or infinite (index into the
+    /// tables).
+    BadDetail(u64),
 }
 
 impl core::fmt::Display for QuadtreeError {
@@ -67,6 +73,10 @@ impl core::fmt::Display for QuadtreeError {
                 write!(f, "top-level weight {i} is negative or not finite")
             }
             Self::BadCorner(i) => write!(f, "leaf corner {i} is negative or not finite"),
+            Self::BadDetailIndex(i) => {
+                write!(f, "detail index entry {i} names a table past the tables")
+            }
+            Self::BadDetail(i) => write!(f, "detail value {i} is negative or not finite"),
         }
     }
 }

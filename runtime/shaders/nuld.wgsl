@@ -63,6 +63,8 @@ const NULD_TAG_ENVMAP_TREE_INFO: u32 = 7u;
 const NULD_TAG_ENVMAP_TREE_NODES: u32 = 8u;
 const NULD_TAG_ENVMAP_TREE_TOP: u32 = 9u;
 const NULD_TAG_ENVMAP_TREE_CORNERS: u32 = 19u;
+const NULD_TAG_ENVMAP_TREE_DETAIL_INDEX: u32 = 20u;
+const NULD_TAG_ENVMAP_TREE_DETAIL: u32 = 21u;
 const NULD_TAG_BRDF_PRIOR_INFO: u32 = 15u;
 const NULD_TAG_BRDF_PRIOR_DATA: u32 = 11u;
 const NULD_TAG_BRDF_PRIOR_MARGINAL: u32 = 12u;
@@ -122,6 +124,9 @@ const NULD_TREE_INFO_GRID: u32 = 4u;
 const NULD_TREE_TOP_LEVELS: u32 = 3u;
 const NULD_TREE_TOP_NODES: u32 = 84u;
 const NULD_TREE_MAX_LEVELS: u32 = 24u;
+// `DETAIL_SIDE`, `DETAIL_LEN` (core/src/envmap_tree.rs).
+const NULD_TREE_DETAIL_SIDE: u32 = 16u;
+const NULD_TREE_DETAIL_LEN: u32 = 272u;
 // `BrdfPriorInfo` fields (core/src/brdf_prior.rs).
 const NULD_PRIOR_INFO_GRID: u32 = 0u;
 const NULD_PRIOR_INFO_SIZE: u32 = 12u;
@@ -985,6 +990,11 @@ struct NuldTree {
     grid: u32,
     // The leaf shape's corner values (tag 19); 0 without them (uniform leaves).
     corners: u32,
+    // The detail index (tag 20) and tables (tag 21); 0 without them.
+    detail_index: u32,
+    detail: u32,
+    // Whole tables in tag 21.
+    detail_tables: u32,
 }
 
 // Rust: `ConditionalSampler::tree`: the blob's environment prior.
@@ -996,7 +1006,99 @@ fn nuld_tree() -> NuldTree {
         min(nuld_u32(info + NULD_TREE_INFO_LEVELS), NULD_TREE_MAX_LEVELS),
         max(nuld_u32(info + NULD_TREE_INFO_GRID), 2u),
         nuld_section(NULD_TAG_ENVMAP_TREE_CORNERS),
+        nuld_section(NULD_TAG_ENVMAP_TREE_DETAIL_INDEX),
+        nuld_section(NULD_TAG_ENVMAP_TREE_DETAIL),
+        nuld_section_len(NULD_TAG_ENVMAP_TREE_DETAIL) / (4u * NULD_TREE_DETAIL_LEN),
     );
+}
+
+// Rust: `EnvmapTree::shape_of`'s detail lookup: the byte offset of leaf
+// `(x, y)`'s detail table, or 0 where it has none (entry 0, or past the tables).
+fn nuld_leaf_detail(t: NuldTree, x: u32, y: u32) -> u32 {
+    if t.detail_index == 0u || t.detail == 0u {
+        return 0u;
+    }
+    let e = nuld_u32(t.detail_index + 4u * ((y << t.levels) + x));
+    if e == 0u || e > t.detail_tables {
+        return 0u;
+    }
+    return t.detail + 4u * (e - 1u) * NULD_TREE_DETAIL_LEN;
+}
+
+// Rust: `cell_table::value`: value `i` of the table at byte `table`, as `positive`.
+fn nuld_cell_value(table: u32, i: u32) -> f32 {
+    return nuld_positive(nuld_f32(table + 4u * i));
+}
+
+// Rust: `cell_table::interval`: the interval of `u` among the `k` weights at
+// value `first` of the table (of sum `total > 0`), as `(index, place)`.
+fn nuld_cell_interval(u: f32, table: u32, first: u32, total: f32) -> vec2<f32> {
+    let goal = nuld_clamp01(u) * total;
+    var below = 0.0;
+    var last = 0u;
+    for (var i = 0u; i < NULD_TREE_DETAIL_SIDE; i++) {
+        let w = nuld_cell_value(table, first + i);
+        if w > 0.0 {
+            last = i;
+            if goal < below + w {
+                return vec2<f32>(f32(i), nuld_clamp01((goal - below) / w));
+            }
+            below = below + w;
+        }
+    }
+    return vec2<f32>(f32(last), 1.0);
+}
+
+// Rust: `cell_table::sum` of the `k` values from value `first`, in order.
+fn nuld_cell_sum(table: u32, first: u32, n: u32) -> f32 {
+    var s = 0.0;
+    for (var i = 0u; i < n; i++) {
+        s = s + nuld_cell_value(table, first + i);
+    }
+    return s;
+}
+
+// Rust: `cell_table::sample_table` (its point and density): the detail of step
+// 9 at `local` for the table at byte `table`, as `(x, y, density)`.
+fn nuld_cell_sample(local: vec2<f32>, table: u32) -> vec3<f32> {
+    let u = vec2<f32>(nuld_clamp01(local.x), nuld_clamp01(local.y));
+    let k = NULD_TREE_DETAIL_SIDE;
+    let total = nuld_cell_sum(table, 0u, k);
+    if !(total > 0.0 && nuld_is_finite(total)) {
+        return vec3<f32>(u, 1.0);
+    }
+    let kf = f32(k);
+    let ix = nuld_cell_interval(u.x, table, 0u, total);
+    let a = u32(ix.x);
+    let x = nuld_clamp01((ix.x + ix.y) / kf);
+    let px = kf * (nuld_cell_value(table, a) / total);
+    let column = k + a * k;
+    let s = nuld_cell_sum(table, column, k);
+    if !(s > 0.0 && nuld_is_finite(s)) {
+        return vec3<f32>(x, u.y, px);
+    }
+    let iy = nuld_cell_interval(u.y, table, column, s);
+    let y = nuld_clamp01((iy.x + iy.y) / kf);
+    return vec3<f32>(x, y, px * (kf * (nuld_cell_value(table, column + u32(iy.x)) / s)));
+}
+
+// Rust: `cell_table::table_pdf`: the detail's density at `local`.
+fn nuld_cell_pdf(local: vec2<f32>, table: u32) -> f32 {
+    let k = NULD_TREE_DETAIL_SIDE;
+    let total = nuld_cell_sum(table, 0u, k);
+    if !(total > 0.0 && nuld_is_finite(total)) {
+        return 1.0;
+    }
+    let kf = f32(k);
+    let a = min(u32(floor(nuld_clamp01(local.x) * kf)), k - 1u);
+    let b = min(u32(floor(nuld_clamp01(local.y) * kf)), k - 1u);
+    let px = kf * (nuld_cell_value(table, a) / total);
+    let column = k + a * k;
+    let s = nuld_cell_sum(table, column, k);
+    if !(s > 0.0 && nuld_is_finite(s)) {
+        return px;
+    }
+    return px * (kf * (nuld_cell_value(table, column + b) / s));
 }
 
 // Rust: `positive` (core/src/bilinear.rs): `v` if positive and finite, else 0.
@@ -1033,7 +1135,7 @@ fn nuld_sample_linear(u0: f32, a: f32, b: f32) -> f32 {
 // Rust: `bilinear::linear_pdf`.
 fn nuld_linear_pdf(x: f32, a: f32, b: f32) -> f32 {
     if a + b > 0.0 {
-        return 2.0 * (a + (b - a) * nuld_clamp01(x)) / (a + b);
+        return 2.0 * ((a + (b - a) * nuld_clamp01(x)) / (a + b));
     }
     return 1.0;
 }
@@ -1211,8 +1313,14 @@ fn nuld_tree_sample_square(t: NuldTree, q: vec2<f32>, u: vec2<f32>) -> NuldTreeS
         y = 2u * y + cy.side;
     }
     let side = f32(1u << t.levels);
-    if t.corners != 0u {
-        let shaped = nuld_shape(vec2<f32>(ux, uy), nuld_leaf_corners(t, x, y));
+    let detail = nuld_leaf_detail(t, x, y);
+    if detail != 0u || t.corners != 0u {
+        var shaped: vec3<f32>;
+        if detail != 0u {
+            shaped = nuld_cell_sample(vec2<f32>(ux, uy), detail);
+        } else {
+            shaped = nuld_shape(vec2<f32>(ux, uy), nuld_leaf_corners(t, x, y));
+        }
         let point = vec2<f32>(
             min((f32(x) + shaped.x) / side, 1.0),
             min((f32(y) + shaped.y) / side, 1.0),
@@ -1245,11 +1353,15 @@ fn nuld_tree_pdf_square(t: NuldTree, q: vec2<f32>, d: vec3<f32>) -> f32 {
         prob = prob * (w[k] / ((w.x + w.y) + (w.z + w.w)));
     }
     let s = f32(side);
-    if t.corners != 0u {
+    let detail = nuld_leaf_detail(t, lx, ly);
+    if detail != 0u || t.corners != 0u {
         let local = vec2<f32>(
             nuld_clamp01(nuld_clamp01(sq.x) * s - f32(lx)),
             nuld_clamp01(nuld_clamp01(sq.y) * s - f32(ly)),
         );
+        if detail != 0u {
+            return prob * s * s * nuld_cell_pdf(local, detail) / (4.0 * NULD_PI);
+        }
         return prob * s * s * nuld_shape_pdf(local, nuld_leaf_corners(t, lx, ly)) / (4.0 * NULD_PI);
     }
     return prob * s * s / (4.0 * NULD_PI);

@@ -119,8 +119,9 @@ pub fn distilled_parts(
 pub use nuld_build_tool::lab::bench::runtime::with_random_metallic_axis as with_metallic_axis;
 
 /// A tree of 4 levels (top weights on 3 x 3 normals) over a closed-form light, a
-/// sky brighter towards `+z` and a small sun: the prior of the environment
-/// fixtures (built once per test binary).
+/// sky brighter towards `+z` and a small sun, the leaves around the sun
+/// detailed (tags 20 and 21): the prior of the environment fixtures (built once
+/// per test binary).
 pub fn fixture_tree() -> std::sync::Arc<nuld_build_tool::sphere::EnvmapTree> {
     static TREE: std::sync::OnceLock<std::sync::Arc<nuld_build_tool::sphere::EnvmapTree>> =
         std::sync::OnceLock::new();
@@ -129,9 +130,11 @@ pub fn fixture_tree() -> std::sync::Arc<nuld_build_tool::sphere::EnvmapTree> {
         let light = move |d: nuld_runtime::glam::DVec3| {
             0.2 + d.z.max(0.0) + 20.0 * (-(1.0 - d.dot(sun)) * 300.0).exp()
         };
-        std::sync::Arc::new(
-            nuld_build_tool::sphere::EnvmapTree::from_light(light, 4, 3).expect("a lit fixture"),
-        )
+        let tree =
+            nuld_build_tool::sphere::EnvmapTree::from_light(light, 4, 3).expect("a lit fixture");
+        // The conformance and shader tests read the detail through it.
+        assert!(!tree.detail.is_empty(), "the fixture's sun is detailed");
+        std::sync::Arc::new(tree)
     });
     std::sync::Arc::clone(tree)
 }

@@ -903,7 +903,9 @@ fn metal_semantics_hold(layout: &Layout<'_>, warp: u32, params: usize, table: us
 /// with levels 3 to 12, a grid of 2 to 1024 normals and
 /// zero reserved words; `(4^(L+1) - 4) / 3` records of four finite `f32` with a
 /// spread >= 0 and some level-1 record with mass; `84 G^2` finite top weights >= 0;
-/// and, if there is a leaf shape (tag 19), `(2^L + 1)^2` finite values >= 0.
+/// and, if there is a leaf shape (tag 19), `(2^L + 1)^2` finite values >= 0; and
+/// if there is detail (tags 20, 21), both sections, an entry per leaf naming a
+/// table or none, whole tables of finite values >= 0.
 fn tree_semantics_hold(layout: &Layout<'_>) -> bool {
     let section = |tag| layout.section(tag).ok();
     let (Some((_, info)), Some((ne, nodes)), Some((oe, top))) = (
@@ -953,7 +955,27 @@ fn tree_semantics_hold(layout: &Layout<'_>) -> bool {
             ce.elem_size == 4 && c.len() as u128 == 4 * side * side && finite_non_negative(c)
         }
     };
-    sound && lit && finite_non_negative(top) && corners
+    // The optional detail (tags 20 and 21, both or neither): `4^L` index
+    // entries of `u32`, each at most the tables' count; tables of 272 finite
+    // values >= 0.
+    let detail = match (
+        section(SectionTag::EnvmapTreeDetailIndex),
+        section(SectionTag::EnvmapTreeDetail),
+    ) {
+        (None, None) => true,
+        (Some((ie, index)), Some((te, tables))) => {
+            let table = 4 * (16 + 16 * 16);
+            let count = (tables.len() / table) as u32;
+            ie.elem_size == 4
+                && te.elem_size == 4
+                && index.len() as u128 == 4 * (1u128 << (2 * levels))
+                && tables.len() % table == 0
+                && index.chunks_exact(4).all(|e| word(e, 0) <= count)
+                && finite_non_negative(tables)
+        }
+        _ => false,
+    };
+    sound && lit && finite_non_negative(top) && corners && detail
 }
 
 /// 100k mutations of a conditional BRDF blob: byte changes and truncations (the

@@ -14,7 +14,9 @@ use nuld_core::blob::{
 use nuld_core::brdf::{F0, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
 use nuld_core::brdf_prior::BrdfPriorInfo;
 use nuld_core::conditional::{ConditionalInfo, PointWarp, MAX_METALLIC_NODES, RANDOMIZE_SALTS};
-use nuld_core::envmap_tree::{node_count, TreeInfo, TOP_FLOOR, TOP_LEVELS};
+use nuld_core::envmap_tree::{
+    node_count, TreeInfo, DETAIL_LEN, DETAIL_SIDE, TOP_FLOOR, TOP_LEVELS,
+};
 use nuld_core::marginal2d::MAX_BLEND;
 use nuld_core::network::{
     Activation, OffsetHash, DOT_LANES, INPUTS, LATTICE_LOGIT_EPS, MAX_HIDDEN_LAYERS, MAX_WIDTH,
@@ -159,6 +161,14 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
             "NULD_TAG_ENVMAP_TREE_CORNERS",
             SectionTag::EnvmapTreeCorners as u64,
         ),
+        (
+            "NULD_TAG_ENVMAP_TREE_DETAIL_INDEX",
+            SectionTag::EnvmapTreeDetailIndex as u64,
+        ),
+        (
+            "NULD_TAG_ENVMAP_TREE_DETAIL",
+            SectionTag::EnvmapTreeDetail as u64,
+        ),
         ("NULD_TAG_BRDF_PRIOR_INFO", SectionTag::BrdfPriorInfo as u64),
         ("NULD_TAG_BRDF_PRIOR_DATA", SectionTag::BrdfPriorData as u64),
         (
@@ -193,6 +203,8 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_TREE_TOP_LEVELS", TOP_LEVELS as u64),
         ("NULD_TREE_TOP_NODES", node_count(TOP_LEVELS) as u64),
         ("NULD_TREE_MAX_LEVELS", MAX_LEVELS as u64),
+        ("NULD_TREE_DETAIL_SIDE", DETAIL_SIDE as u64),
+        ("NULD_TREE_DETAIL_LEN", DETAIL_LEN as u64),
         ("NULD_TREE_TOP_FLOOR", f(TOP_FLOOR as f32)),
         ("NULD_TREE_UNIT_MIN", f(1e-20f64 as f32)),
         ("NULD_RANDOMIZE_SALT_A", RANDOMIZE_SALTS[0] as u64),

@@ -18,8 +18,8 @@ use bytemuck::Zeroable;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::{Domain, SectionSpec};
 use nuld_core::envmap_tree::{
-    build, node_count, top_len, top_normal, top_row, EnvmapTree as CoreTree, NodeRecord, TreeInfo,
-    MAX_TREE_LEVELS, TOP_LEVELS,
+    build, detail_index_len, node_count, top_len, top_normal, top_row, EnvmapTree as CoreTree,
+    NodeRecord, TreeInfo, DETAIL_LEN, DETAIL_SIDE, MAX_TREE_LEVELS, TOP_LEVELS,
 };
 use nuld_core::quadtree::QuadtreeError;
 use nuld_core::sphere::{sphere_to_square, square_to_sphere};
@@ -196,6 +196,104 @@ fn sharp_leaves(map: &EnvmapDensity, levels: u32) -> Vec<bool> {
     sharp
 }
 
+/// Points per detail cell and axis with which a detailed leaf's table is
+/// measured (a midpoint rule of `4 x 4` points a cell, `32 x 32` a leaf).
+const DETAIL_SUPERSAMPLING: usize = 4;
+
+/// A detail cell's floor, as a share of its leaf's mean density: keeps the
+/// table's density positive wherever the leaf has light (a sliver of a bright
+/// pixel that no point of a cell caught), at the cost of that share of the
+/// samples in the leaf's dark cells.
+const DETAIL_FLOOR: f64 = 1.0 / 64.0;
+
+/// Leaf `(x, y)`'s detail table ([`nuld_core::envmap_tree::EnvmapTree::with_detail`]):
+/// `light`'s mass over each of its `DETAIL_SIDE x DETAIL_SIDE` cells by
+/// [`DETAIL_SUPERSAMPLING`] points a cell and axis, each raised to
+/// [`DETAIL_FLOOR`] times the cells' mean, stored as [`nuld_core::cell_table`]
+/// reads it (the column sums, then the cells column by column). The cells have
+/// equal solid angle (the square's map is equal-area), so masses are densities
+/// up to a constant.
+fn detail_table(
+    light: &(impl Fn(DVec3) -> f64 + Sync),
+    levels: u32,
+    (x, y): (usize, usize),
+) -> Vec<f32> {
+    let side = (1usize << levels) as f64;
+    let (k, n) = (DETAIL_SUPERSAMPLING, DETAIL_SIDE);
+    let points = (n * k) as f64;
+    // Column-major: cell `(a, b)` at `a n + b`.
+    let cells: Vec<f64> = (0..n * n)
+        .map(|c| {
+            let (a, b) = (c / n, c % n);
+            let mut sum = 0.0;
+            for j in 0..k {
+                for i in 0..k {
+                    let p = DVec2::new(
+                        (x as f64 + ((a * k + i) as f64 + 0.5) / points) / side,
+                        (y as f64 + ((b * k + j) as f64 + 0.5) / points) / side,
+                    );
+                    sum += light(square_to_sphere(p));
+                }
+            }
+            sum
+        })
+        .collect();
+    let floor = DETAIL_FLOOR * cells.iter().sum::<f64>() / (n * n) as f64;
+    let cells: Vec<f32> = cells.iter().map(|v| v.max(floor) as f32).collect();
+    let mut table: Vec<f32> = cells
+        .chunks(n)
+        .map(|column| column.iter().map(|&v| v as f64).sum::<f64>() as f32)
+        .collect();
+    table.extend(cells);
+    debug_assert_eq!(table.len(), DETAIL_LEN);
+    table
+}
+
+/// The leaves (row-major) whose light `light` varies by more than
+/// [`REFINE_CONTRAST`] times its mean over the sphere (`mean`) between the
+/// leaf's corners and centre: where a light with no map behind it
+/// ([`EnvmapTree::from_light`]) is sharp.
+fn contrast_leaves(light: &(impl Fn(DVec3) -> f64 + Sync), levels: u32, mean: f64) -> Vec<bool> {
+    let side = 1usize << levels;
+    (0..side * side)
+        .into_par_iter()
+        .map(|leaf| {
+            let (x, y) = ((leaf % side) as f64, (leaf / side) as f64);
+            let values = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0], [0.5, 0.5]].map(|f| {
+                let p = DVec2::new((x + f[0]) / side as f64, (y + f[1]) / side as f64);
+                light(square_to_sphere(p))
+            });
+            let hi = values.iter().copied().fold(f64::MIN, f64::max);
+            let lo = values.iter().copied().fold(f64::MAX, f64::min);
+            hi - lo > REFINE_CONTRAST * mean
+        })
+        .collect()
+}
+
+/// The detail index and tables of the leaves marked in `detail` (row-major).
+fn detail_tables(
+    light: &(impl Fn(DVec3) -> f64 + Sync),
+    levels: u32,
+    detail: &[bool],
+) -> (Vec<u32>, Vec<f32>) {
+    let side = 1usize << levels;
+    let marked: Vec<usize> = (0..side * side)
+        .filter(|&l| detail.get(l).copied().unwrap_or(false))
+        .collect();
+    if marked.is_empty() {
+        return (Vec::new(), Vec::new());
+    }
+    let tables: Vec<f32> = marked
+        .par_iter()
+        .flat_map_iter(|&l| detail_table(light, levels, (l % side, l / side)))
+        .collect();
+    let mut index = vec![0u32; detail_index_len(levels)];
+    for (t, &l) in marked.iter().enumerate() {
+        index[l] = t as u32 + 1;
+    }
+    (index, tables)
+}
+
 /// [`QuadtreeError::Levels`] unless `levels` is in [`TOP_LEVELS`]`..=`[`MAX_TREE_LEVELS`].
 fn check_levels(levels: u32) -> Result<(), QuadtreeError> {
     if (TOP_LEVELS..=MAX_TREE_LEVELS).contains(&levels) {
@@ -222,6 +320,13 @@ pub struct EnvmapTree {
     /// lattice points, each raised to a quarter of the mean density of the
     /// brightest leaf it touches.
     pub corners: Vec<f32>,
+    /// The detail index: per leaf (row-major) 0, or `1 + t` for a leaf drawn
+    /// by table `t` ([`nuld_core::envmap_tree::EnvmapTree::with_detail`]);
+    /// empty without detailed leaves.
+    pub detail_index: Vec<u32>,
+    /// The detailed leaves' tables: the light's mass over `8 x 8` cells of
+    /// each, floored at a sixteenth of their mean.
+    pub detail: Vec<f32>,
 }
 
 impl EnvmapTree {
@@ -239,14 +344,22 @@ impl EnvmapTree {
     }
 
     /// The tree of any light on the sphere, `light(direction)` its radiance (a
-    /// map's pdf, or a closed form for tests and fixtures); as [`Self::new`].
+    /// map's pdf, or a closed form for tests and fixtures); as [`Self::new`],
+    /// the leaves whose corners and centre differ by more than 4 times the
+    /// light's mean detailed.
     pub fn from_light(
         light: impl Fn(DVec3) -> f64 + Sync,
         levels: u32,
         grid: u32,
     ) -> Result<Self, QuadtreeError> {
         check_levels(levels)?;
-        Self::measured(light, levels, grid, &[])
+        let mut tree = Self::measured(&light, levels, grid, &[])?;
+        // The leaves hold the light's integral; its mean is that over 4 pi.
+        let total: f64 = tree.nodes[..4].iter().map(|r| r.mass() as f64).sum();
+        let sharp = contrast_leaves(&light, levels, total / (4.0 * PI));
+        (tree.detail_index, tree.detail) = detail_tables(&light, levels, &sharp);
+        tree.tree().check_values()?;
+        Ok(tree)
     }
 
     /// The tree of `light` with the leaves marked in `sharp` (row-major; missing
@@ -285,10 +398,12 @@ impl EnvmapTree {
             top_row(levels, &nodes, top_normal(grid, j), row);
         });
         let corners = leaf_corners(&light, levels, &leaves);
+        let (detail_index, detail) = detail_tables(&light, levels, sharp);
         // Refuses a map without light, as the runtime would (every value,
-        // corners included, read once).
+        // corners and detail included, read once).
         CoreTree::view(levels, &nodes, grid, &top)?
             .with_corners(&corners)?
+            .with_detail(&detail_index, &detail)?
             .check_values()?;
         Ok(Self {
             levels,
@@ -296,6 +411,8 @@ impl EnvmapTree {
             grid,
             top,
             corners,
+            detail_index,
+            detail,
         })
     }
 
@@ -303,6 +420,7 @@ impl EnvmapTree {
     pub fn tree(&self) -> CoreTree<'_> {
         CoreTree::view(self.levels, &self.nodes, self.grid, &self.top)
             .and_then(|t| t.with_corners(&self.corners))
+            .and_then(|t| t.with_detail(&self.detail_index, &self.detail))
             .expect("checked when built")
     }
 
@@ -320,6 +438,12 @@ impl EnvmapTree {
     pub fn sections<'s>(&'s self, info: &'s TreeInfo) -> Vec<SectionSpec<'s>> {
         let mut sections = nuld_core::envmap_tree::sections(info, &self.nodes, &self.top).to_vec();
         sections.push(nuld_core::envmap_tree::corner_section(&self.corners));
+        if !self.detail_index.is_empty() {
+            sections.extend(nuld_core::envmap_tree::detail_sections(
+                &self.detail_index,
+                &self.detail,
+            ));
+        }
         sections
     }
 
@@ -351,9 +475,13 @@ impl EnvmapTree {
         tree.pdf(n.to_array(), d.to_array())
     }
 
-    /// Bytes of the records and the top table.
+    /// Bytes of the records, the top table, the corners and the detail.
     pub fn state_bytes(&self) -> usize {
-        std::mem::size_of_val(self.nodes.as_slice()) + std::mem::size_of_val(self.top.as_slice())
+        std::mem::size_of_val(self.nodes.as_slice())
+            + std::mem::size_of_val(self.top.as_slice())
+            + std::mem::size_of_val(self.corners.as_slice())
+            + std::mem::size_of_val(self.detail_index.as_slice())
+            + std::mem::size_of_val(self.detail.as_slice())
     }
 }
 
@@ -467,7 +595,12 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("nuld-tree-{}", std::process::id()));
         let map = EnvmapDensity::from_file_filtered(tiny_map(&dir), Domain::Sphere).unwrap();
         let tree = EnvmapTree::new(&map, 6, 9).unwrap();
-        assert_eq!(tree.state_bytes(), 16 * node_count(6) + 4 * 81 * 84);
+        // The records, the top table, the corners and the detail.
+        let detail = 4 * (tree.detail_index.len() + tree.detail.len());
+        assert_eq!(
+            tree.state_bytes(),
+            16 * node_count(6) + 4 * 81 * 84 + 4 * 65 * 65 + detail
+        );
         let total: f32 = tree.nodes[..4].iter().map(|r| r.mass()).sum();
         assert!((total - 1.0).abs() < 1e-3, "{total}");
         let core = tree.tree();

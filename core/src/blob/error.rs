@@ -508,6 +508,11 @@ pub enum ConditionalError {
     TreeTopElementSize(u32),
     /// The [`SectionTag::EnvmapTreeCorners`] elements are not 4 bytes (f32).
     TreeCornerElementSize(u32),
+    /// The [`SectionTag::EnvmapTreeDetailIndex`] or [`SectionTag::EnvmapTreeDetail`]
+    /// elements are not 4 bytes (u32, f32).
+    TreeDetailElementSize(u32),
+    /// One of the two detail sections without the other.
+    TreeDetailAlone,
     /// The tree's levels, counts or values are refused
     /// ([`crate::envmap_tree::EnvmapTree::new`]).
     Tree(crate::quadtree::QuadtreeError),
@@ -674,6 +679,13 @@ impl core::fmt::Display for ConditionalError {
             Self::TreeCornerElementSize(e) => {
                 write!(f, "blob environment tree leaf corners are {e} bytes each, not 4")
             }
+            Self::TreeDetailElementSize(e) => {
+                write!(f, "blob environment tree detail entries are {e} bytes each, not 4")
+            }
+            Self::TreeDetailAlone => write!(
+                f,
+                "blob environment tree has one of its two detail sections (tags 20, 21) without the other"
+            ),
             Self::Tree(e) => write!(f, "blob environment tree: {e}"),
             Self::BrdfPriorUnstretched => write!(
                 f,

@@ -179,6 +179,17 @@ pub enum SectionTag {
     /// ([`crate::envmap_tree::EnvmapTree::with_corners`]). Optional: without it
     /// the leaves are uniform.
     EnvmapTreeCorners = 19,
+    /// The environment prior's detail index, `u32` (`elem_size` 4): one entry
+    /// per leaf, row-major over the octahedral square, 0 or `1 + t` for detail
+    /// table `t` ([`crate::envmap_tree::EnvmapTree::with_detail`]). Optional,
+    /// with [`Self::EnvmapTreeDetail`].
+    EnvmapTreeDetailIndex = 20,
+    /// The environment prior's detail tables, `f32` (`elem_size` 4),
+    /// [`crate::envmap_tree::DETAIL_LEN`] values each: a detailed leaf's light
+    /// on a `16 x 16` grid of cells, its column masses first, then the cells
+    /// column by column ([`crate::cell_table`]).
+    /// Optional, with [`Self::EnvmapTreeDetailIndex`].
+    EnvmapTreeDetail = 21,
 }
 
 /// Contents of the [`SectionTag::PointSetInfo`] section.

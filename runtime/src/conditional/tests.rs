@@ -7,7 +7,8 @@ use nuld_core::blob::{encoded_len, write, BlobKind};
 use nuld_core::blob::{BlobError, ConditionalError, SectionTag};
 use nuld_core::conditional::{randomization_shift, sections, torus_shift};
 use nuld_core::envmap_tree::{
-    build, node_count, top_len, top_normal, top_row, EnvmapTree, NodeRecord, TreeInfo,
+    build, detail_index_len, node_count, top_len, top_normal, top_row, EnvmapTree, NodeRecord,
+    TreeInfo, DETAIL_LEN, DETAIL_SIDE,
 };
 use nuld_core::network::{instance_offset, interleaved_index, lattice_point, Activation};
 use nuld_core::quadtree::QuadtreeError;
@@ -23,7 +24,12 @@ struct Parts {
     weights: Vec<f32>,
     /// An environment prior.
     tree: Option<TreeParts>,
+    /// Its detail index and tables (empty: none).
+    detail: DetailParts,
 }
+
+/// An environment prior's detail, owned: index, tables.
+type DetailParts = (Vec<u32>, Vec<f32>);
 
 /// An environment prior's sections, owned: info, records, top weights.
 type TreeParts = (TreeInfo, Vec<NodeRecord>, Vec<f32>);
@@ -82,6 +88,7 @@ fn parts() -> Parts {
         table,
         weights,
         tree: None,
+        detail: (Vec::new(), Vec::new()),
     }
 }
 
@@ -93,6 +100,13 @@ fn encode(p: &Parts) -> Bytes {
     let mut sections = sections(&p.info, &p.params, &p.table, &p.weights).to_vec();
     if let Some((info, nodes, top)) = &p.tree {
         sections.extend(nuld_core::envmap_tree::sections(info, nodes, top));
+    }
+    let (index, tables) = &p.detail;
+    if !index.is_empty() {
+        sections.push(nuld_core::envmap_tree::detail_sections(index, tables)[0]);
+    }
+    if !tables.is_empty() {
+        sections.push(nuld_core::envmap_tree::detail_sections(index, tables)[1]);
     }
     let meta = [0u8, 0, 0];
     let len = encoded_len(&meta, &sections);
@@ -230,6 +244,31 @@ fn test_tree() -> TreeParts {
     (info, nodes, top)
 }
 
+/// Detail for [`test_tree`]: every third leaf (86 of 256) drawn by its own table, each a
+/// dim noise with one bright cell (a sun inside the leaf), stored as
+/// `cell_table` reads it (column sums, then the cells column by column).
+fn test_detail() -> DetailParts {
+    let mut index = std::vec![0u32; detail_index_len(4)];
+    let mut tables = Vec::new();
+    for leaf in (0..index.len()).step_by(3) {
+        let t = (tables.len() / DETAIL_LEN) as u32;
+        index[leaf] = t + 1;
+        let bright = noise(t, 7) as usize % (DETAIL_SIDE * DETAIL_SIDE);
+        let cells: Vec<f32> = (0..DETAIL_SIDE * DETAIL_SIDE)
+            .map(|c| {
+                if c == bright {
+                    40.0
+                } else {
+                    0.05 + (noise(t, c as u32) % 1000) as f32 / 1000.0
+                }
+            })
+            .collect();
+        tables.extend(cells.chunks(DETAIL_SIDE).map(|c| c.iter().sum::<f32>()));
+        tables.extend(cells);
+    }
+    (index, tables)
+}
+
 /// An environment sampler's parts: `parts()` on the sphere, conditions the
 /// octahedral square, the tree prior.
 fn envmap_parts() -> Parts {
@@ -240,6 +279,7 @@ fn envmap_parts() -> Parts {
     p.info.cond_max = [1.0; 2];
     p.info.warp = PointWarp::EnvmapTree as u32;
     p.tree = Some(test_tree());
+    p.detail = test_detail();
     p
 }
 
@@ -256,7 +296,9 @@ fn envmap_tables_interpolate_primary_points_and_warp_them_through_the_tree() {
     let cs = Blob::parse(bytes.get()).unwrap().conditional().unwrap();
     assert_eq!(cs.target(), ConditionalTarget::EnvmapNormal);
     let (ti, nodes, top) = p.tree.clone().unwrap();
-    let tree = EnvmapTree::new(ti.levels, &nodes, ti.grid, &top).unwrap();
+    let tree = EnvmapTree::new(ti.levels, &nodes, ti.grid, &top)
+        .and_then(|t| t.with_detail(&p.detail.0, &p.detail.1))
+        .unwrap();
     let info = p.info;
     let stored = |node: u32, k: u32, i: u32| {
         let q = unpack_point(p.table[info.point_table_index(node as usize, k, i)]);
@@ -441,6 +483,50 @@ fn environment_blobs_without_a_sound_prior_are_refused() {
         change(p.tree.as_mut().unwrap());
         assert_eq!(parse(&p), tree_err(want));
     }
+    type DetailMutation = fn(&mut DetailParts);
+    let cases: [(DetailMutation, ConditionalError); 5] = [
+        (|d| d.1.clear(), ConditionalError::TreeDetailAlone),
+        (|d| d.0.clear(), ConditionalError::TreeDetailAlone),
+        (
+            |d| {
+                d.0.pop();
+            },
+            ConditionalError::Tree(QuadtreeError::Length {
+                expected: 256,
+                got: 255,
+            }),
+        ),
+        (
+            |d| {
+                d.1.pop();
+            },
+            ConditionalError::Tree(QuadtreeError::Length {
+                expected: 85 * DETAIL_LEN as u64,
+                got: 86 * DETAIL_LEN as u64 - 1,
+            }),
+        ),
+        (
+            |d| d.0[7] = 87,
+            ConditionalError::Tree(QuadtreeError::BadDetailIndex(7)),
+        ),
+    ];
+    for (change, want) in cases {
+        let mut p = envmap_parts();
+        change(&mut p.detail);
+        assert_eq!(parse(&p), tree_err(want));
+    }
+    let mut p = envmap_parts();
+    p.detail.1[DETAIL_LEN + 20] = -1.0;
+    assert_eq!(
+        parse(&p),
+        tree_err(ConditionalError::Tree(QuadtreeError::BadDetail(
+            DETAIL_LEN as u64 + 20
+        )))
+    );
+    // The last table named and every value sound: it parses.
+    let mut p = envmap_parts();
+    p.detail.0[7] = 86;
+    assert!(parse(&p).is_ok());
 }
 
 #[test]

@@ -9,7 +9,8 @@ use nuld_core::conditional::{
     check_metallic_nodes, ConditionalInfo, ConditionalTarget, MetallicNodesError, PointWarp,
 };
 use nuld_core::envmap_tree::{
-    corner_len, node_count, top_len, EnvmapTree, NodeRecord, TreeInfo, MAX_TREE_LEVELS, TOP_LEVELS,
+    corner_len, detail_index_len, node_count, top_len, EnvmapTree, NodeRecord, TreeInfo,
+    DETAIL_LEN, MAX_TREE_LEVELS, TOP_LEVELS,
 };
 use nuld_core::marginal2d::Marginal2DError;
 use nuld_core::network::{Activation, OffsetHash};
@@ -299,7 +300,7 @@ fn tree_length(expected: u64, got: u64) -> ConditionalError {
     ConditionalError::Tree(QuadtreeError::Length { expected, got })
 }
 
-/// The environment prior's sections (three, and the optional leaf shape), their counts checked against the
+/// The environment prior's sections (three, the optional leaf shape and detail), their counts checked against the
 /// info (`O(1)`; [`EnvmapTree::check_values`] reads every value once, in
 /// [`ConditionalSampler::validate`]).
 fn tree_view<'a>(layout: &Layout<'a>) -> Result<EnvmapTree<'a>, BlobError> {
@@ -344,8 +345,37 @@ fn tree_view<'a>(layout: &Layout<'a>) -> Result<EnvmapTree<'a>, BlobError> {
     } else {
         &[]
     };
+    // Detailed leaves are optional too: both sections or neither.
+    let tags = [
+        SectionTag::EnvmapTreeDetailIndex,
+        SectionTag::EnvmapTreeDetail,
+    ];
+    let (index, tables): (&[u32], &[f32]) = match tags.map(|t| layout.section(t).is_ok()) {
+        [false, false] => (&[], &[]),
+        [true, true] => {
+            let index = typed_section(
+                layout,
+                tags[0],
+                ConditionalError::TreeDetailElementSize,
+                || Ok(detail_index_len(info.levels) as u64),
+                tree_length,
+            )?;
+            // Whole tables: the length rounded down to one, refused if it differs.
+            let values = layout.section(tags[1])?.1.len() / 4;
+            let tables = typed_section(
+                layout,
+                tags[1],
+                ConditionalError::TreeDetailElementSize,
+                || Ok((values / DETAIL_LEN * DETAIL_LEN) as u64),
+                tree_length,
+            )?;
+            (index, tables)
+        }
+        _ => return fail(ConditionalError::TreeDetailAlone),
+    };
     EnvmapTree::view(info.levels, nodes, info.grid, top)
         .and_then(|t| t.with_corners(corners))
+        .and_then(|t| t.with_detail(index, tables))
         .map_err(|e| ConditionalError::Tree(e).into())
 }
 
