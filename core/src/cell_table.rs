@@ -21,9 +21,10 @@
 //!
 //! The density is 0 in a cell of value 0: a caller that needs it positive
 //! wherever its own function is raises the values to a floor first. Values that
-//! are negative, NaN or infinite count as 0 (a missing value too); if no column
-//! mass is positive, or their sum is not finite, the warp is the identity with
-//! density 1, and a chosen column without positive values is uniform along `y`.
+//! are negative, NaN or infinite count as 0; if no column mass is positive, or
+//! their sum is not finite, or the table is short of `K + K²` values, the warp
+//! is the identity with density 1, and a chosen column without positive values
+//! is uniform along `y`.
 //! Work is `O(K)`, bounded; everything is generic over [`Real`], allocates
 //! nothing and never panics.
 
@@ -34,46 +35,58 @@ pub const fn table_len(k: usize) -> usize {
     k + k * k
 }
 
-/// Value `i` of `v` as the warp reads it ([`positive`]; a missing one 0).
+/// A value as the warp reads it ([`positive`]).
 #[inline]
-fn value<T: Real>(v: &[f32], i: usize) -> T {
-    positive(T::of(v.get(i).copied().unwrap_or(0.0) as f64))
+fn read<T: Real>(v: f32) -> T {
+    positive(T::of(v as f64))
 }
 
-/// Cell `(a, b)`'s value.
+/// The column masses of `v`, or `None` for a table shorter than
+/// [`table_len`]`(K)` (which the warp reads as no table: the identity).
 #[inline]
-fn cell<T: Real, const K: usize>(v: &[f32], a: usize, b: usize) -> T {
-    value(v, K + a * K + b)
+fn masses<const K: usize>(v: &[f32]) -> Option<&[f32; K]> {
+    if v.len() < table_len(K) {
+        return None;
+    }
+    v.get(..K)?.try_into().ok()
 }
 
-/// The sum of `n` weights `w(0..n)`, in order.
+/// Column `a`'s `K` cells (`None` only past a short table).
 #[inline]
-fn sum<T: Real>(n: usize, w: impl Fn(usize) -> T) -> T {
+fn column<const K: usize>(v: &[f32], a: usize) -> Option<&[f32; K]> {
+    let start = K + a * K;
+    v.get(start..start + K)?.try_into().ok()
+}
+
+/// The sum of `w`'s values as read, in order.
+#[inline]
+fn sum<T: Real>(w: &[f32]) -> T {
     let mut s = T::ZERO;
-    for i in 0..n {
-        s = s + w(i);
+    for &x in w {
+        s = s + read(x);
     }
     s
 }
 
-/// The sum of the column masses, or `None` where it is not positive and finite
-/// (the identity).
+/// The column masses and their sum, or `None` where the table is short or the
+/// sum is not positive and finite (the identity).
 #[inline]
-fn total<T: Real, const K: usize>(v: &[f32]) -> Option<T> {
-    let t = sum(K, |a| value::<T>(v, a));
-    is_positive_finite(t).then_some(t)
+fn total<T: Real, const K: usize>(v: &[f32]) -> Option<(&[f32; K], T)> {
+    let m = masses::<K>(v)?;
+    let t = sum(m);
+    is_positive_finite(t).then_some((m, t))
 }
 
-/// The interval of `u` (clamped into `[0, 1]`) among `k` weights `w` of sum
-/// `total > 0`: the first `i` whose cumulative sum passes `u total` (stepping
-/// over weights of 0), and `u`'s place in it, `(u total - W_i) / w_i` clamped
-/// into `[0, 1]`.
+/// The interval of `u` (clamped into `[0, 1]`) among the weights `w` (as
+/// read) of sum `total > 0`: the first `i` whose cumulative sum passes `u
+/// total` (stepping over weights of 0), and `u`'s place in it, `(u total -
+/// W_i) / w_i` clamped into `[0, 1]`.
 #[inline]
-fn interval<T: Real>(u: T, w: impl Fn(usize) -> T, k: usize, total: T) -> (usize, T) {
+fn interval<T: Real>(u: T, w: &[f32], total: T) -> (usize, T) {
     let target = clamp_unit(u) * total;
     let (mut below, mut last) = (T::ZERO, 0);
-    for i in 0..k {
-        let wi = w(i);
+    for (i, &x) in w.iter().enumerate() {
+        let wi: T = read(x);
         if wi > T::ZERO {
             last = i;
             if target < below + wi {
@@ -96,12 +109,13 @@ fn locate<T: Real>(x: T, k: usize) -> (usize, T) {
     (i, clamp_unit(s - T::of(i as f64)))
 }
 
-/// Column `a`'s share of the row density: `v_ab / s_a`, or `None` where the
-/// column's sum is not positive and finite (uniform along `y`).
+/// Column `a`'s cells and their sum, or `None` where the sum is not positive
+/// and finite (uniform along `y`).
 #[inline]
-fn column_sum<T: Real, const K: usize>(v: &[f32], a: usize) -> Option<T> {
-    let s = sum(K, |b| cell::<T, K>(v, a, b));
-    is_positive_finite(s).then_some(s)
+fn column_sum<T: Real, const K: usize>(v: &[f32], a: usize) -> Option<(&[f32; K], T)> {
+    let c = column::<K>(v, a)?;
+    let s = sum(c);
+    is_positive_finite(s).then_some((c, s))
 }
 
 /// The point of the square at `u` under the density of the table `v` (module
@@ -112,19 +126,19 @@ fn column_sum<T: Real, const K: usize>(v: &[f32], a: usize) -> Option<T> {
 #[inline]
 pub fn sample_table<T: Real, const K: usize>(u: [T; 2], v: &[f32]) -> ([T; 2], T, [T; 3]) {
     let u = u.map(clamp_unit);
-    let Some(total) = total::<T, K>(v) else {
+    let Some((m, total)) = total::<T, K>(v) else {
         return (u, T::ONE, [T::ONE, T::ZERO, T::ONE]);
     };
     let k = T::of(K as f64);
-    let (a, tx) = interval(u[0], |i| value::<T>(v, i), K, total);
+    let (a, tx) = interval(u[0], m, total);
     let x = clamp_unit((T::of(a as f64) + tx) / k);
-    let px = k * (value::<T>(v, a) / total);
+    let px = k * (read::<T>(m[a]) / total);
     let (y, py) = match column_sum::<T, K>(v, a) {
-        Some(s) => {
-            let (b, ty) = interval(u[1], |j| cell::<T, K>(v, a, j), K, s);
+        Some((c, s)) => {
+            let (b, ty) = interval(u[1], c, s);
             (
                 clamp_unit((T::of(b as f64) + ty) / k),
-                k * (cell::<T, K>(v, a, b) / s),
+                k * (read::<T>(c[b]) / s),
             )
         }
         None => (u[1], T::ONE),
@@ -136,15 +150,15 @@ pub fn sample_table<T: Real, const K: usize>(u: [T; 2], v: &[f32]) -> ([T; 2], T
 /// the square): `K c_a / Σ c` times `K v_ab / s_a` of `p`'s cell (module docs).
 #[inline]
 pub fn table_pdf<T: Real, const K: usize>(p: [T; 2], v: &[f32]) -> T {
-    let Some(total) = total::<T, K>(v) else {
+    let Some((m, total)) = total::<T, K>(v) else {
         return T::ONE;
     };
     let (a, _) = locate(p[0], K);
     let (b, _) = locate(p[1], K);
     let k = T::of(K as f64);
-    let px = k * (value::<T>(v, a) / total);
+    let px = k * (read::<T>(m[a]) / total);
     match column_sum::<T, K>(v, a) {
-        Some(s) => px * (k * (cell::<T, K>(v, a, b) / s)),
+        Some((c, s)) => px * (k * (read::<T>(c[b]) / s)),
         None => px,
     }
 }
@@ -154,17 +168,17 @@ pub fn table_pdf<T: Real, const K: usize>(p: [T; 2], v: &[f32]) -> T {
 #[inline]
 pub fn invert_table<T: Real, const K: usize>(p: [T; 2], v: &[f32]) -> [T; 2] {
     let p = p.map(clamp_unit);
-    let Some(total) = total::<T, K>(v) else {
+    let Some((m, total)) = total::<T, K>(v) else {
         return p;
     };
     let (a, tx) = locate(p[0], K);
     let (b, ty) = locate(p[1], K);
-    let below = sum(a, |i| value::<T>(v, i));
-    let ux = clamp_unit((below + tx * value::<T>(v, a)) / total);
+    let below: T = sum(&m[..a]);
+    let ux = clamp_unit((below + tx * read::<T>(m[a])) / total);
     let uy = match column_sum::<T, K>(v, a) {
-        Some(s) => {
-            let below = sum(b, |j| cell::<T, K>(v, a, j));
-            clamp_unit((below + ty * cell::<T, K>(v, a, b)) / s)
+        Some((c, s)) => {
+            let below: T = sum(&c[..b]);
+            clamp_unit((below + ty * read::<T>(c[b])) / s)
         }
         None => p[1],
     };
