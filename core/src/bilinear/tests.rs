@@ -1,8 +1,8 @@
 extern crate std;
 
 use super::*;
-use crate::test_rng::Rng;
-use std::vec;
+use crate::test_rng::{assert_chi_square, Rng};
+use std::format;
 
 /// Corner sets the tests run over: equal, one corner dark, a diagonal, steep,
 /// one corner alone.
@@ -52,50 +52,24 @@ fn the_pdf_is_the_bilinear_density_and_integrates_to_one() {
 #[test]
 fn samples_follow_the_pdf_chi_square() {
     for (t, w) in CORNERS.into_iter().enumerate() {
-        let (bins, samples) = (16usize, 1_000_000u32);
-        let mut counts = vec![0u32; bins * bins];
+        let bins = 16;
         let mut r = Rng(11 + t as u64);
-        for _ in 0..samples {
+        let draw = || {
             let (p, pdf, _) = sample_bilinear([r.next(), r.next()], w);
             assert!((pdf - bilinear_pdf(p, w)).abs() <= 1e-9 * (1.0 + pdf));
-            let i = ((p[0] * bins as f64) as usize).min(bins - 1);
-            let j = ((p[1] * bins as f64) as usize).min(bins - 1);
-            counts[j * bins + i] += 1;
-        }
-        let (mut chi2, mut dof, mut uniform) = (0.0, 0, 0.0);
-        for j in 0..bins {
-            for i in 0..bins {
-                let at = |a: usize, b: usize| {
-                    direct(
-                        [(i + a) as f64 / bins as f64, (j + b) as f64 / bins as f64],
-                        w,
-                    )
-                };
-                // The mean of a bilinear function over a cell is its corners' mean.
-                let mean = (at(0, 0) + at(1, 0) + at(0, 1) + at(1, 1)) / 4.0;
-                let expected = samples as f64 * mean / (bins * bins) as f64;
-                let c = counts[j * bins + i] as f64;
-                let flat = samples as f64 / (bins * bins) as f64;
-                uniform += (c - flat).powi(2) / flat;
-                if expected > 0.0 {
-                    chi2 += (c - expected).powi(2) / expected;
-                    dof += 1;
-                } else {
-                    assert_eq!(c, 0.0);
-                }
-            }
-        }
-        let sd = (2.0 * dof as f64).sqrt();
-        assert!(
-            chi2 < dof as f64 + 5.0 * sd,
-            "{w:?}: chi-square {chi2} over {dof}"
-        );
-        if t > 0 {
-            assert!(
-                uniform > 10.0 * (dof as f64 + 5.0 * sd),
-                "{w:?}: uniform passes"
-            );
-        }
+            p
+        };
+        // The mean of a bilinear function over a cell is its corners' mean.
+        let mean = |i: usize, j: usize| {
+            let at = |a: usize, b: usize| {
+                direct(
+                    [(i + a) as f64 / bins as f64, (j + b) as f64 / bins as f64],
+                    w,
+                )
+            };
+            (at(0, 0) + at(1, 0) + at(0, 1) + at(1, 1)) / 4.0
+        };
+        assert_chi_square(&format!("{w:?}"), 1_000_000, bins, draw, mean, t > 0);
     }
 }
 

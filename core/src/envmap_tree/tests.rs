@@ -331,13 +331,19 @@ fn irradiance_estimate(tree: &EnvmapTree<'_>, n: [f64; 3], seed: u64) -> (f64, f
 /// `(1/M) Σ L cos / pdf` over the tree's samples is the irradiance by an
 /// independent quadrature (a fine midpoint rule on the square, `L` the light
 /// itself, not the tree's leaves), for normals facing the sun, the sky and the
-/// ground.
+/// ground; with uniform leaves, and with the leaves shaped and detailed.
 #[test]
 fn the_estimate_with_the_pdf_is_the_irradiance() {
     let levels = 7;
     let nodes = tree_nodes(levels);
     let top = top_table(levels, &nodes);
-    let tree = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let flat = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let corners = corner_values(levels);
+    let (index, tables) = detail_values(levels);
+    let detailed = flat
+        .with_corners(&corners)
+        .and_then(|t| t.with_detail(&index, &tables))
+        .unwrap();
     let m = 1024;
     for (t, n) in normals().into_iter().enumerate() {
         let nv = DVec3::from_array(n).normalize();
@@ -349,7 +355,13 @@ fn the_estimate_with_the_pdf_is_the_irradiance() {
             ));
             exact += light(d) * nv.dot(d).max(0.0) * 4.0 * core::f64::consts::PI / (m * m) as f64;
         }
-        let (mean, se) = irradiance_estimate(&tree, n, 40 + t as u64);
+        // Uniform leaves, and leaves shaped and detailed: each pdf is exact.
+        let (d_mean, d_se) = irradiance_estimate(&detailed, n, 60 + t as u64);
+        assert!(
+            (d_mean - exact).abs() < 4.0 * d_se + 1e-4 * exact,
+            "detailed {n:?}: {d_mean} vs {exact} (se {d_se})"
+        );
+        let (mean, se) = irradiance_estimate(&flat, n, 40 + t as u64);
         assert!(
             (mean - exact).abs() < 4.0 * se + 1e-4 * exact,
             "{n:?}: {mean} vs {exact} (se {se})"
