@@ -44,8 +44,10 @@ fn main() {
     });
     let tree = EnvmapTree::new(&map, levels, PRIOR_GRID).unwrap();
     println!(
-        "{} detailed leaves of {} ({:.1} MB of state)",
-        tree.detail.len() / nuld_core::envmap_tree::DETAIL_LEN,
+        "{} detailed leaves ({} of them fine) of {} ({:.1} MB of state)",
+        tree.detail.len() / nuld_core::envmap_tree::DETAIL_LEN
+            + tree.fine.len() / nuld_core::envmap_tree::FINE_LEN,
+        tree.fine.len() / nuld_core::envmap_tree::FINE_LEN,
         1usize << (2 * levels),
         tree.state_bytes() as f64 / 1e6
     );

@@ -53,11 +53,14 @@ pub enum QuadtreeError {
     /// NaN or infinite (index into the corners).
     BadCorner(u64),
     /// A detail-index entry ([`crate::envmap_tree::EnvmapTree::with_detail`])
-    /// names a table past the tables (index into the index).
+    /// names a table past the tables, or fine table 0 (index into the index).
     BadDetailIndex(u64),
     /// A detail-table value is negative, NaN or infinite (index into the
     /// tables).
     BadDetail(u64),
+    /// A fine-table value is negative, NaN or infinite (index into the fine
+    /// tables).
+    BadFineDetail(u64),
 }
 
 impl core::fmt::Display for QuadtreeError {
@@ -77,6 +80,9 @@ impl core::fmt::Display for QuadtreeError {
                 write!(f, "detail index entry {i} names a table past the tables")
             }
             Self::BadDetail(i) => write!(f, "detail value {i} is negative or not finite"),
+            Self::BadFineDetail(i) => {
+                write!(f, "fine detail value {i} is negative or not finite")
+            }
         }
     }
 }

@@ -65,6 +65,7 @@ const NULD_TAG_ENVMAP_TREE_TOP: u32 = 9u;
 const NULD_TAG_ENVMAP_TREE_CORNERS: u32 = 19u;
 const NULD_TAG_ENVMAP_TREE_DETAIL_INDEX: u32 = 20u;
 const NULD_TAG_ENVMAP_TREE_DETAIL: u32 = 21u;
+const NULD_TAG_ENVMAP_TREE_FINE_DETAIL: u32 = 22u;
 const NULD_TAG_BRDF_PRIOR_INFO: u32 = 15u;
 const NULD_TAG_BRDF_PRIOR_DATA: u32 = 11u;
 const NULD_TAG_BRDF_PRIOR_MARGINAL: u32 = 12u;
@@ -127,6 +128,10 @@ const NULD_TREE_MAX_LEVELS: u32 = 24u;
 // `DETAIL_SIDE`, `DETAIL_LEN` (core/src/envmap_tree.rs).
 const NULD_TREE_DETAIL_SIDE: u32 = 16u;
 const NULD_TREE_DETAIL_LEN: u32 = 272u;
+// `FINE_SIDE`, `FINE_LEN`, `FINE_BIT` (core/src/envmap_tree.rs).
+const NULD_TREE_FINE_SIDE: u32 = 64u;
+const NULD_TREE_FINE_LEN: u32 = 4160u;
+const NULD_TREE_FINE_BIT: u32 = 0x80000000u;
 // `BrdfPriorInfo` fields (core/src/brdf_prior.rs).
 const NULD_PRIOR_INFO_GRID: u32 = 0u;
 const NULD_PRIOR_INFO_SIZE: u32 = 12u;
@@ -995,6 +1000,9 @@ struct NuldTree {
     detail: u32,
     // Whole tables in tag 21.
     detail_tables: u32,
+    // The fine tables (tag 22; 0 without them) and how many.
+    fine: u32,
+    fine_tables: u32,
 }
 
 // Rust: `ConditionalSampler::tree`: the blob's environment prior.
@@ -1009,20 +1017,30 @@ fn nuld_tree() -> NuldTree {
         nuld_section(NULD_TAG_ENVMAP_TREE_DETAIL_INDEX),
         nuld_section(NULD_TAG_ENVMAP_TREE_DETAIL),
         nuld_section_len(NULD_TAG_ENVMAP_TREE_DETAIL) / (4u * NULD_TREE_DETAIL_LEN),
+        nuld_section(NULD_TAG_ENVMAP_TREE_FINE_DETAIL),
+        nuld_section_len(NULD_TAG_ENVMAP_TREE_FINE_DETAIL) / (4u * NULD_TREE_FINE_LEN),
     );
 }
 
 // Rust: `EnvmapTree::shape_of`'s detail lookup: the byte offset of leaf
-// `(x, y)`'s detail table, or 0 where it has none (entry 0, or past the tables).
-fn nuld_leaf_detail(t: NuldTree, x: u32, y: u32) -> u32 {
+// `(x, y)`'s table and its cells per axis, `(0, 0)` where it has none (entry
+// 0, or past the tables).
+fn nuld_leaf_detail(t: NuldTree, x: u32, y: u32) -> vec2<u32> {
     if t.detail_index == 0u || t.detail == 0u {
-        return 0u;
+        return vec2<u32>(0u, 0u);
     }
     let e = nuld_u32(t.detail_index + 4u * ((y << t.levels) + x));
-    if e == 0u || e > t.detail_tables {
-        return 0u;
+    let n = e & ~NULD_TREE_FINE_BIT;
+    if (e & NULD_TREE_FINE_BIT) != 0u {
+        if n == 0u || n > t.fine_tables || t.fine == 0u {
+            return vec2<u32>(0u, 0u);
+        }
+        return vec2<u32>(t.fine + 4u * (n - 1u) * NULD_TREE_FINE_LEN, NULD_TREE_FINE_SIDE);
     }
-    return t.detail + 4u * (e - 1u) * NULD_TREE_DETAIL_LEN;
+    if n == 0u || n > t.detail_tables {
+        return vec2<u32>(0u, 0u);
+    }
+    return vec2<u32>(t.detail + 4u * (n - 1u) * NULD_TREE_DETAIL_LEN, NULD_TREE_DETAIL_SIDE);
 }
 
 // Rust: `cell_table::value`: value `i` of the table at byte `table`, as `positive`.
@@ -1032,11 +1050,11 @@ fn nuld_cell_value(table: u32, i: u32) -> f32 {
 
 // Rust: `cell_table::interval`: the interval of `u` among the `k` weights at
 // value `first` of the table (of sum `total > 0`), as `(index, place)`.
-fn nuld_cell_interval(u: f32, table: u32, first: u32, total: f32) -> vec2<f32> {
+fn nuld_cell_interval(u: f32, table: u32, first: u32, k: u32, total: f32) -> vec2<f32> {
     let goal = nuld_clamp01(u) * total;
     var below = 0.0;
     var last = 0u;
-    for (var i = 0u; i < NULD_TREE_DETAIL_SIDE; i++) {
+    for (var i = 0u; i < k; i++) {
         let w = nuld_cell_value(table, first + i);
         if w > 0.0 {
             last = i;
@@ -1059,16 +1077,16 @@ fn nuld_cell_sum(table: u32, first: u32, n: u32) -> f32 {
 }
 
 // Rust: `cell_table::sample_table` (its point and density): the detail of step
-// 9 at `local` for the table at byte `table`, as `(x, y, density)`.
-fn nuld_cell_sample(local: vec2<f32>, table: u32) -> vec3<f32> {
+// 9 at `local` for the table of `k x k` cells at byte `table`, as `(x, y,
+// density)`.
+fn nuld_cell_sample(local: vec2<f32>, table: u32, k: u32) -> vec3<f32> {
     let u = vec2<f32>(nuld_clamp01(local.x), nuld_clamp01(local.y));
-    let k = NULD_TREE_DETAIL_SIDE;
     let total = nuld_cell_sum(table, 0u, k);
     if !(total > 0.0 && nuld_is_finite(total)) {
         return vec3<f32>(u, 1.0);
     }
     let kf = f32(k);
-    let ix = nuld_cell_interval(u.x, table, 0u, total);
+    let ix = nuld_cell_interval(u.x, table, 0u, k, total);
     let a = u32(ix.x);
     let x = nuld_clamp01((ix.x + ix.y) / kf);
     let px = kf * (nuld_cell_value(table, a) / total);
@@ -1077,14 +1095,14 @@ fn nuld_cell_sample(local: vec2<f32>, table: u32) -> vec3<f32> {
     if !(s > 0.0 && nuld_is_finite(s)) {
         return vec3<f32>(x, u.y, px);
     }
-    let iy = nuld_cell_interval(u.y, table, column, s);
+    let iy = nuld_cell_interval(u.y, table, column, k, s);
     let y = nuld_clamp01((iy.x + iy.y) / kf);
     return vec3<f32>(x, y, px * (kf * (nuld_cell_value(table, column + u32(iy.x)) / s)));
 }
 
-// Rust: `cell_table::table_pdf`: the detail's density at `local`.
-fn nuld_cell_pdf(local: vec2<f32>, table: u32) -> f32 {
-    let k = NULD_TREE_DETAIL_SIDE;
+// Rust: `cell_table::table_pdf`: the density at `local` of the table of `k x k`
+// cells at byte `table`.
+fn nuld_cell_pdf(local: vec2<f32>, table: u32, k: u32) -> f32 {
     let total = nuld_cell_sum(table, 0u, k);
     if !(total > 0.0 && nuld_is_finite(total)) {
         return 1.0;
@@ -1314,10 +1332,10 @@ fn nuld_tree_sample_square(t: NuldTree, q: vec2<f32>, u: vec2<f32>) -> NuldTreeS
     }
     let side = f32(1u << t.levels);
     let detail = nuld_leaf_detail(t, x, y);
-    if detail != 0u || t.corners != 0u {
+    if detail.y != 0u || t.corners != 0u {
         var shaped: vec3<f32>;
-        if detail != 0u {
-            shaped = nuld_cell_sample(vec2<f32>(ux, uy), detail);
+        if detail.y != 0u {
+            shaped = nuld_cell_sample(vec2<f32>(ux, uy), detail.x, detail.y);
         } else {
             shaped = nuld_shape(vec2<f32>(ux, uy), nuld_leaf_corners(t, x, y));
         }
@@ -1354,13 +1372,13 @@ fn nuld_tree_pdf_square(t: NuldTree, q: vec2<f32>, d: vec3<f32>) -> f32 {
     }
     let s = f32(side);
     let detail = nuld_leaf_detail(t, lx, ly);
-    if detail != 0u || t.corners != 0u {
+    if detail.y != 0u || t.corners != 0u {
         let local = vec2<f32>(
             nuld_clamp01(nuld_clamp01(sq.x) * s - f32(lx)),
             nuld_clamp01(nuld_clamp01(sq.y) * s - f32(ly)),
         );
-        if detail != 0u {
-            return prob * s * s * nuld_cell_pdf(local, detail) / (4.0 * NULD_PI);
+        if detail.y != 0u {
+            return prob * s * s * nuld_cell_pdf(local, detail.x, detail.y) / (4.0 * NULD_PI);
         }
         return prob * s * s * nuld_shape_pdf(local, nuld_leaf_corners(t, lx, ly)) / (4.0 * NULD_PI);
     }

@@ -119,21 +119,30 @@ pub fn distilled_parts(
 pub use nuld_build_tool::lab::bench::runtime::with_random_metallic_axis as with_metallic_axis;
 
 /// A tree of 4 levels (top weights on 3 x 3 normals) over a closed-form light, a
-/// sky brighter towards `+z` and a small sun, the leaves around the sun
-/// detailed (tags 20 and 21): the prior of the environment fixtures (built once
-/// per test binary).
+/// sky brighter towards `+z`, a small sun and a dim lamp 2° across: the sun's
+/// leaves drawn by fine tables (tag 22), the lamp's by a detail table (tags 20
+/// and 21): the prior of the environment fixtures (built once per test binary).
 pub fn fixture_tree() -> std::sync::Arc<nuld_build_tool::sphere::EnvmapTree> {
     static TREE: std::sync::OnceLock<std::sync::Arc<nuld_build_tool::sphere::EnvmapTree>> =
         std::sync::OnceLock::new();
     let tree = TREE.get_or_init(|| {
-        let sun = nuld_runtime::glam::DVec3::new(0.6, -0.3, 0.5).normalize();
-        let light = move |d: nuld_runtime::glam::DVec3| {
-            0.2 + d.z.max(0.0) + 20.0 * (-(1.0 - d.dot(sun)) * 300.0).exp()
+        use nuld_runtime::glam::{DVec2, DVec3};
+        let sun = DVec3::new(0.6, -0.3, 0.5).normalize();
+        // At a leaf's centre, so that the tree's contrast test sees it; 0.3 %
+        // of the light, under the share that earns a fine table.
+        let lamp = nuld_core::sphere::square_to_sphere(DVec2::new(3.5 / 16.0, 12.5 / 16.0));
+        let lamp_edge = 2f64.to_radians().cos();
+        let light = move |d: DVec3| {
+            let lamp = if d.dot(lamp) > lamp_edge { 3.0 } else { 0.0 };
+            0.2 + d.z.max(0.0) + 20.0 * (-(1.0 - d.dot(sun)) * 300.0).exp() + lamp
         };
         let tree =
             nuld_build_tool::sphere::EnvmapTree::from_light(light, 4, 3).expect("a lit fixture");
         // The conformance and shader tests read the detail through it.
-        assert!(!tree.detail.is_empty(), "the fixture's sun is detailed");
+        assert!(
+            !tree.detail.is_empty() && !tree.fine.is_empty(),
+            "the fixture's sun has fine tables, its lamp a detail table"
+        );
         std::sync::Arc::new(tree)
     });
     std::sync::Arc::clone(tree)

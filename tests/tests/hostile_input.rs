@@ -904,8 +904,9 @@ fn metal_semantics_hold(layout: &Layout<'_>, warp: u32, params: usize, table: us
 /// zero reserved words; `(4^(L+1) - 4) / 3` records of four finite `f32` with a
 /// spread >= 0 and some level-1 record with mass; `84 G^2` finite top weights >= 0;
 /// and, if there is a leaf shape (tag 19), `(2^L + 1)^2` finite values >= 0; and
-/// if there is detail (tags 20, 21), both sections, an entry per leaf naming a
-/// table or none, whole tables of finite values >= 0.
+/// if there is detail (tags 20, 21, and the fine tables, 22), both sections, an
+/// entry per leaf naming a table, a fine table or none, whole tables of finite
+/// values >= 0.
 fn tree_semantics_hold(layout: &Layout<'_>) -> bool {
     let section = |tag| layout.section(tag).ok();
     let (Some((_, info)), Some((ne, nodes)), Some((oe, top))) = (
@@ -955,23 +956,37 @@ fn tree_semantics_hold(layout: &Layout<'_>) -> bool {
             ce.elem_size == 4 && c.len() as u128 == 4 * side * side && finite_non_negative(c)
         }
     };
-    // The optional detail (tags 20 and 21, both or neither): `4^L` index
-    // entries of `u32`, each at most the tables' count; tables of 272 finite
-    // values >= 0.
+    // The optional detail (tags 20 and 21, both or neither, and tag 22 only
+    // with them): `4^L` index entries of `u32`, each 0, a table (1 to their
+    // count) or, with the high bit, a fine table (1 to theirs); tables of 272,
+    // fine tables of 4160 finite values >= 0.
+    let fine_section = section(SectionTag::EnvmapTreeFineDetail);
     let detail = match (
         section(SectionTag::EnvmapTreeDetailIndex),
         section(SectionTag::EnvmapTreeDetail),
     ) {
-        (None, None) => true,
+        (None, None) => fine_section.is_none(),
         (Some((ie, index)), Some((te, tables))) => {
-            let table = 4 * (16 + 16 * 16);
+            let (table, fine_table) = (4 * (16 + 16 * 16), 4 * (64 + 64 * 64));
+            let (fe, fine) = fine_section.map_or((4, &[][..]), |(e, f)| (e.elem_size, f));
             let count = (tables.len() / table) as u32;
+            let fine_count = (fine.len() / fine_table) as u32;
+            let named = |e: u32| {
+                if e & 1 << 31 == 0 {
+                    e <= count
+                } else {
+                    (1..=fine_count).contains(&(e & !(1 << 31)))
+                }
+            };
             ie.elem_size == 4
                 && te.elem_size == 4
+                && fe == 4
                 && index.len() as u128 == 4 * (1u128 << (2 * levels))
                 && tables.len() % table == 0
-                && index.chunks_exact(4).all(|e| word(e, 0) <= count)
+                && fine.len() % fine_table == 0
+                && index.chunks_exact(4).all(|e| named(word(e, 0)))
                 && finite_non_negative(tables)
+                && finite_non_negative(fine)
         }
         _ => false,
     };

@@ -15,7 +15,8 @@ use nuld_core::brdf::{F0, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
 use nuld_core::brdf_prior::BrdfPriorInfo;
 use nuld_core::conditional::{ConditionalInfo, PointWarp, MAX_METALLIC_NODES, RANDOMIZE_SALTS};
 use nuld_core::envmap_tree::{
-    node_count, TreeInfo, DETAIL_LEN, DETAIL_SIDE, TOP_FLOOR, TOP_LEVELS,
+    node_count, TreeInfo, DETAIL_LEN, DETAIL_SIDE, FINE_BIT, FINE_LEN, FINE_SIDE, TOP_FLOOR,
+    TOP_LEVELS,
 };
 use nuld_core::marginal2d::MAX_BLEND;
 use nuld_core::network::{
@@ -169,6 +170,10 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
             "NULD_TAG_ENVMAP_TREE_DETAIL",
             SectionTag::EnvmapTreeDetail as u64,
         ),
+        (
+            "NULD_TAG_ENVMAP_TREE_FINE_DETAIL",
+            SectionTag::EnvmapTreeFineDetail as u64,
+        ),
         ("NULD_TAG_BRDF_PRIOR_INFO", SectionTag::BrdfPriorInfo as u64),
         ("NULD_TAG_BRDF_PRIOR_DATA", SectionTag::BrdfPriorData as u64),
         (
@@ -205,6 +210,9 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_TREE_MAX_LEVELS", MAX_LEVELS as u64),
         ("NULD_TREE_DETAIL_SIDE", DETAIL_SIDE as u64),
         ("NULD_TREE_DETAIL_LEN", DETAIL_LEN as u64),
+        ("NULD_TREE_FINE_SIDE", FINE_SIDE as u64),
+        ("NULD_TREE_FINE_LEN", FINE_LEN as u64),
+        ("NULD_TREE_FINE_BIT", FINE_BIT as u64),
         ("NULD_TREE_TOP_FLOOR", f(TOP_FLOOR as f32)),
         ("NULD_TREE_UNIT_MIN", f(1e-20f64 as f32)),
         ("NULD_RANDOMIZE_SALT_A", RANDOMIZE_SALTS[0] as u64),

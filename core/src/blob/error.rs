@@ -508,10 +508,11 @@ pub enum ConditionalError {
     TreeTopElementSize(u32),
     /// The [`SectionTag::EnvmapTreeCorners`] elements are not 4 bytes (f32).
     TreeCornerElementSize(u32),
-    /// The [`SectionTag::EnvmapTreeDetailIndex`] or [`SectionTag::EnvmapTreeDetail`]
-    /// elements are not 4 bytes (u32, f32).
+    /// The [`SectionTag::EnvmapTreeDetailIndex`], [`SectionTag::EnvmapTreeDetail`]
+    /// or [`SectionTag::EnvmapTreeFineDetail`] elements are not 4 bytes (u32, f32).
     TreeDetailElementSize(u32),
-    /// One of the two detail sections without the other.
+    /// One of the two detail sections without the other, or the fine tables
+    /// without them.
     TreeDetailAlone,
     /// The tree's levels, counts or values are refused
     /// ([`crate::envmap_tree::EnvmapTree::new`]).
@@ -684,7 +685,7 @@ impl core::fmt::Display for ConditionalError {
             }
             Self::TreeDetailAlone => write!(
                 f,
-                "blob environment tree has one of its two detail sections (tags 20, 21) without the other"
+                "blob environment tree has one of its detail sections (tags 20, 21) without the other, or fine tables (tag 22) without them"
             ),
             Self::Tree(e) => write!(f, "blob environment tree: {e}"),
             Self::BrdfPriorUnstretched => write!(

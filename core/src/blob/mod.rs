@@ -190,6 +190,11 @@ pub enum SectionTag {
     /// column by column ([`crate::cell_table`]).
     /// Optional, with [`Self::EnvmapTreeDetailIndex`].
     EnvmapTreeDetail = 21,
+    /// The environment prior's fine tables, `f32` (`elem_size` 4),
+    /// [`crate::envmap_tree::FINE_LEN`] values each (`64 x 64` cells, laid out
+    /// as [`Self::EnvmapTreeDetail`]'s), named by the detail-index entries with
+    /// [`crate::envmap_tree::FINE_BIT`] set. Optional, with the detail sections.
+    EnvmapTreeFineDetail = 22,
 }
 
 /// Contents of the [`SectionTag::PointSetInfo`] section.

@@ -339,10 +339,11 @@ fn the_estimate_with_the_pdf_is_the_irradiance() {
     let top = top_table(levels, &nodes);
     let flat = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
     let corners = corner_values(levels);
-    let (index, tables) = detail_values(levels);
+    let (index, tables, fine) = detail_values(levels);
     let detailed = flat
         .with_corners(&corners)
         .and_then(|t| t.with_detail(&index, &tables))
+        .and_then(|t| t.with_fine_detail(&fine))
         .unwrap();
     let m = 1024;
     for (t, n) in normals().into_iter().enumerate() {
@@ -591,19 +592,26 @@ fn a_leaf_shape_keeps_the_pdf_exact() {
 }
 
 /// Detail for a tree of `levels` levels: the light's mass over each detail cell
-/// (a midpoint of it), column sums first, in the leaves on a checkerboard and in
-/// every leaf whose centre the sun lights; the index and the tables.
-fn detail_values(levels: u32) -> (Vec<u32>, Vec<f32>) {
+/// (a midpoint of it), column sums first, in the leaves on a checkerboard
+/// (16 x 16 cells) and in every leaf whose centre the sun lights (fine, 64 x 64
+/// cells); the index, the tables and the fine tables.
+fn detail_values(levels: u32) -> (Vec<u32>, Vec<f32>, Vec<f32>) {
     let side = 1usize << levels;
-    let (mut index, mut tables) = (vec![0u32; detail_index_len(levels)], Vec::new());
+    let mut index = vec![0u32; detail_index_len(levels)];
+    let (mut tables, mut fine) = (Vec::new(), Vec::new());
     let at = |x: f64, y: f64| light(square_to_sphere(DVec2::new(x, y) / side as f64));
     for (leaf, entry) in index.iter_mut().enumerate() {
         let (x, y) = ((leaf % side) as f64, (leaf / side) as f64);
-        if (leaf % side + leaf / side) % 2 == 1 && at(x + 0.5, y + 0.5) < 5.0 {
+        let sun = at(x + 0.5, y + 0.5) >= 5.0;
+        if (leaf % side + leaf / side) % 2 == 1 && !sun {
             continue;
         }
-        *entry = (tables.len() / DETAIL_LEN) as u32 + 1;
-        let n = DETAIL_SIDE;
+        let (n, out, bit, len) = if sun {
+            (FINE_SIDE, &mut fine, FINE_BIT, FINE_LEN)
+        } else {
+            (DETAIL_SIDE, &mut tables, 0, DETAIL_LEN)
+        };
+        *entry = bit | ((out.len() / len) as u32 + 1);
         // Column-major: cell `(a, b)` at `a n + b`.
         let cells: Vec<f32> = (0..n * n)
             .map(|c| {
@@ -611,10 +619,10 @@ fn detail_values(levels: u32) -> (Vec<u32>, Vec<f32>) {
                 at(x + (a + 0.5) / n as f64, y + (b + 0.5) / n as f64) as f32
             })
             .collect();
-        tables.extend(cells.chunks(n).map(|c| c.iter().sum::<f32>()));
-        tables.extend(cells);
+        out.extend(cells.chunks(n).map(|c| c.iter().sum::<f32>()));
+        out.extend(cells);
     }
-    (index, tables)
+    (index, tables, fine)
 }
 
 /// With detailed leaves beside shaped ones: the pdf integrates to 1 (a midpoint
@@ -629,15 +637,20 @@ fn detailed_leaves_keep_the_pdf_exact() {
     let nodes = tree_nodes(levels);
     let top = top_table(levels, &nodes);
     let corners = corner_values(levels);
-    let (index, tables) = detail_values(levels);
+    let (index, tables, fine) = detail_values(levels);
+    assert!(!fine.is_empty() && index.iter().any(|&e| e != 0 && e & FINE_BIT == 0));
     let shaped = EnvmapTree::new(levels, &nodes, GRID, &top)
         .unwrap()
         .with_corners(&corners)
         .unwrap();
-    let tree = shaped.with_detail(&index, &tables).unwrap();
+    let tree = shaped
+        .with_detail(&index, &tables)
+        .and_then(|t| t.with_fine_detail(&fine))
+        .unwrap();
     tree.check_values().unwrap();
     let n = [0.6, -0.3, 0.1];
-    let m = 64 * DETAIL_SIDE;
+    // A midpoint per fine cell: exact for both tables and the bilinear shape.
+    let m = 64 * FINE_SIDE;
     let sum: f64 = (0..m * m)
         .map(|k| {
             let c = square_to_sphere(DVec2::new(
@@ -651,16 +664,17 @@ fn detailed_leaves_keep_the_pdf_exact() {
 
     let bins = 128;
     check_samples(&tree, n, 8, 1e-8, bins, |i, j| {
-        // A bin is 8 x 8 detail cells: the mean of their midpoints is exact for
-        // the table and for the bilinear shape.
+        // A bin is 32 x 32 fine cells (8 x 8 detail cells): the mean of their
+        // midpoints is exact for the tables and for the bilinear shape.
+        let k = FINE_SIDE / 2;
         let mut pdf = 0.0;
-        for b in 0..8 {
-            for a in 0..8 {
+        for b in 0..k {
+            for a in 0..k {
                 let c = square_to_sphere(DVec2::new(
-                    (i as f64 + (a as f64 + 0.5) / 8.0) / bins as f64,
-                    (j as f64 + (b as f64 + 0.5) / 8.0) / bins as f64,
+                    (i as f64 + (a as f64 + 0.5) / k as f64) / bins as f64,
+                    (j as f64 + (b as f64 + 0.5) / k as f64) / bins as f64,
                 ));
-                pdf += tree.pdf(n, c.to_array()) / 64.0;
+                pdf += tree.pdf(n, c.to_array()) / (k * k) as f64;
             }
         }
         pdf
@@ -670,19 +684,21 @@ fn detailed_leaves_keep_the_pdf_exact() {
     // derivatives, and their product the inverse density.
     let q = crate::sphere::sphere_to_square(DVec3::from_array(n).normalize()).to_array();
     let mut r = Rng(31);
-    let (h, mut compared) = (1e-8, 0);
+    let (h, mut compared, mut fine_compared) = (1e-8, 0, 0);
     for _ in 0..5000 {
         let u = [r.next() * 0.98 + 0.01, r.next() * 0.98 + 0.01];
         let (p, pdf, [dx, cross, dy]) = tree.sample_square_with_slopes(q, u);
         assert!((pdf * dx * dy - 1.0).abs() < 1e-9, "{pdf} {dx} {dy}");
-        let cell = |x: [f64; 2]| x.map(|c| (c * (64 * DETAIL_SIDE) as f64).floor());
+        // The fine cells nest in the detail cells.
+        let cell = |x: [f64; 2]| x.map(|c| (c * (64 * FINE_SIDE) as f64).floor());
         let at = |du: [f64; 2]| {
             tree.sample_square_with_slopes(q, [u[0] + du[0], u[1] + du[1]])
                 .0
         };
         let (xl, xh, yl, yh) = (at([-h, 0.0]), at([h, 0.0]), at([0.0, -h]), at([0.0, h]));
-        let detailed = index[(p[1] * 64.0) as usize * 64 + (p[0] * 64.0) as usize] != 0;
-        if detailed && [xl, xh, yl, yh].iter().all(|&e| cell(e) == cell(p)) {
+        let entry = index[(p[1] * 64.0) as usize * 64 + (p[0] * 64.0) as usize];
+        if entry != 0 && [xl, xh, yl, yh].iter().all(|&e| cell(e) == cell(p)) {
+            fine_compared += usize::from(entry & FINE_BIT != 0);
             assert_eq!(cross, 0.0);
             let scale = dx.max(dy);
             assert!(((xh[0] - xl[0]) / (2.0 * h) - dx).abs() <= 1e-5 * scale);
@@ -690,7 +706,10 @@ fn detailed_leaves_keep_the_pdf_exact() {
             compared += 1;
         }
     }
-    assert!(compared > 1000, "{compared}");
+    assert!(
+        compared > 1000 && fine_compared > 100,
+        "{compared} {fine_compared}"
+    );
 
     // The same estimate of the irradiance, with less spread.
     let (a, sa) = irradiance_estimate(&shaped, n, 78);
@@ -702,20 +721,43 @@ fn detailed_leaves_keep_the_pdf_exact() {
     assert!(shaped.with_detail(&index[1..], &tables).is_err());
     assert!(shaped.with_detail(&index, &tables[1..]).is_err());
     assert!(shaped.with_detail(&[], &tables).is_err());
-    let count = (tables.len() / DETAIL_LEN) as u32;
-    let mut far = index.clone();
-    far[9] = count + 1;
-    let hostile = shaped.with_detail(&far, &tables).unwrap();
-    assert_eq!(
-        hostile.check_values(),
-        Err(QuadtreeError::BadDetailIndex(9))
-    );
+    assert!(tree.with_fine_detail(&fine[1..]).is_err());
+    fn with<'a>(
+        shaped: EnvmapTree<'a>,
+        index: &'a [u32],
+        tables: &'a [f32],
+        fine: &'a [f32],
+    ) -> EnvmapTree<'a> {
+        shaped
+            .with_detail(index, tables)
+            .and_then(|t| t.with_fine_detail(fine))
+            .unwrap()
+    }
+    let (count, fine_count) = ((tables.len() / DETAIL_LEN) as u32, fine.len() / FINE_LEN);
+    let mut past = [index.clone(), index.clone(), index.clone()];
+    past[0][9] = count + 1;
+    past[1][9] = FINE_BIT | (fine_count as u32 + 1);
+    past[2][9] = FINE_BIT;
+    let hostile: Vec<EnvmapTree<'_>> = past
+        .iter()
+        .map(|i| with(shaped, i, &tables, &fine))
+        .collect();
+    for t in &hostile {
+        assert_eq!(t.check_values(), Err(QuadtreeError::BadDetailIndex(9)));
+    }
     let mut bad = tables.clone();
     bad[40] = f32::INFINITY;
-    let bad_tree = shaped.with_detail(&index, &bad).unwrap();
+    let bad_tree = with(shaped, &index, &bad, &fine);
     assert_eq!(bad_tree.check_values(), Err(QuadtreeError::BadDetail(40)));
+    let mut bad_fine = fine.clone();
+    bad_fine[77] = -1.0;
+    let bad_fine_tree = with(shaped, &index, &tables, &bad_fine);
+    assert_eq!(
+        bad_fine_tree.check_values(),
+        Err(QuadtreeError::BadFineDetail(77))
+    );
     // Bad values never make it panic, and the pdf stays finite.
-    for t in [hostile, bad_tree] {
+    for t in hostile.into_iter().chain([bad_tree, bad_fine_tree]) {
         let mut r = Rng(4);
         for _ in 0..2000 {
             let (d, pdf) = t.sample(n, [r.next(), r.next()]);

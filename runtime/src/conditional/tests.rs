@@ -8,7 +8,7 @@ use nuld_core::blob::{BlobError, ConditionalError, SectionTag};
 use nuld_core::conditional::{randomization_shift, sections, torus_shift};
 use nuld_core::envmap_tree::{
     build, detail_index_len, node_count, top_len, top_normal, top_row, EnvmapTree, NodeRecord,
-    TreeInfo, DETAIL_LEN, DETAIL_SIDE,
+    TreeInfo, DETAIL_LEN, DETAIL_SIDE, FINE_BIT, FINE_LEN, FINE_SIDE,
 };
 use nuld_core::network::{instance_offset, interleaved_index, lattice_point, Activation};
 use nuld_core::quadtree::QuadtreeError;
@@ -28,8 +28,8 @@ struct Parts {
     detail: DetailParts,
 }
 
-/// An environment prior's detail, owned: index, tables.
-type DetailParts = (Vec<u32>, Vec<f32>);
+/// An environment prior's detail, owned: index, tables, fine tables.
+type DetailParts = (Vec<u32>, Vec<f32>, Vec<f32>);
 
 /// An environment prior's sections, owned: info, records, top weights.
 type TreeParts = (TreeInfo, Vec<NodeRecord>, Vec<f32>);
@@ -88,7 +88,7 @@ fn parts() -> Parts {
         table,
         weights,
         tree: None,
-        detail: (Vec::new(), Vec::new()),
+        detail: (Vec::new(), Vec::new(), Vec::new()),
     }
 }
 
@@ -101,12 +101,15 @@ fn encode(p: &Parts) -> Bytes {
     if let Some((info, nodes, top)) = &p.tree {
         sections.extend(nuld_core::envmap_tree::sections(info, nodes, top));
     }
-    let (index, tables) = &p.detail;
+    let (index, tables, fine) = &p.detail;
     if !index.is_empty() {
         sections.push(nuld_core::envmap_tree::detail_sections(index, tables)[0]);
     }
     if !tables.is_empty() {
         sections.push(nuld_core::envmap_tree::detail_sections(index, tables)[1]);
+    }
+    if !fine.is_empty() {
+        sections.push(nuld_core::envmap_tree::fine_section(fine));
     }
     let meta = [0u8, 0, 0];
     let len = encoded_len(&meta, &sections);
@@ -244,17 +247,23 @@ fn test_tree() -> TreeParts {
     (info, nodes, top)
 }
 
-/// Detail for [`test_tree`]: every third leaf (86 of 256) drawn by its own table, each a
-/// dim noise with one bright cell (a sun inside the leaf), stored as
-/// `cell_table` reads it (column sums, then the cells column by column).
+/// Detail for [`test_tree`]: every third leaf (86 of 256) drawn by its own
+/// table, every fifth of those (18) a fine one; each a dim noise with one
+/// bright cell (a sun inside the leaf), stored as `cell_table` reads it (column
+/// sums, then the cells column by column).
 fn test_detail() -> DetailParts {
     let mut index = std::vec![0u32; detail_index_len(4)];
-    let mut tables = Vec::new();
-    for leaf in (0..index.len()).step_by(3) {
-        let t = (tables.len() / DETAIL_LEN) as u32;
-        index[leaf] = t + 1;
-        let bright = noise(t, 7) as usize % (DETAIL_SIDE * DETAIL_SIDE);
-        let cells: Vec<f32> = (0..DETAIL_SIDE * DETAIL_SIDE)
+    let (mut tables, mut fine) = (Vec::new(), Vec::new());
+    for (k, leaf) in (0..index.len()).step_by(3).enumerate() {
+        let (n, out, bit, len) = if k % 5 == 0 {
+            (FINE_SIDE, &mut fine, FINE_BIT, FINE_LEN)
+        } else {
+            (DETAIL_SIDE, &mut tables, 0, DETAIL_LEN)
+        };
+        let t = (out.len() / len) as u32;
+        index[leaf] = bit | (t + 1);
+        let bright = noise(t, 7) as usize % (n * n);
+        let cells: Vec<f32> = (0..n * n)
             .map(|c| {
                 if c == bright {
                     40.0
@@ -263,10 +272,10 @@ fn test_detail() -> DetailParts {
                 }
             })
             .collect();
-        tables.extend(cells.chunks(DETAIL_SIDE).map(|c| c.iter().sum::<f32>()));
-        tables.extend(cells);
+        out.extend(cells.chunks(n).map(|c| c.iter().sum::<f32>()));
+        out.extend(cells);
     }
-    (index, tables)
+    (index, tables, fine)
 }
 
 /// An environment sampler's parts: `parts()` on the sphere, conditions the
@@ -298,6 +307,7 @@ fn envmap_tables_interpolate_primary_points_and_warp_them_through_the_tree() {
     let (ti, nodes, top) = p.tree.clone().unwrap();
     let tree = EnvmapTree::new(ti.levels, &nodes, ti.grid, &top)
         .and_then(|t| t.with_detail(&p.detail.0, &p.detail.1))
+        .and_then(|t| t.with_fine_detail(&p.detail.2))
         .unwrap();
     let info = p.info;
     let stored = |node: u32, k: u32, i: u32| {
@@ -484,9 +494,29 @@ fn environment_blobs_without_a_sound_prior_are_refused() {
         assert_eq!(parse(&p), tree_err(want));
     }
     type DetailMutation = fn(&mut DetailParts);
-    let cases: [(DetailMutation, ConditionalError); 5] = [
+    let cases: [(DetailMutation, ConditionalError); 8] = [
         (|d| d.1.clear(), ConditionalError::TreeDetailAlone),
         (|d| d.0.clear(), ConditionalError::TreeDetailAlone),
+        (
+            |d| {
+                d.0.clear();
+                d.1.clear();
+            },
+            ConditionalError::TreeDetailAlone,
+        ),
+        (
+            |d| {
+                d.2.pop();
+            },
+            ConditionalError::Tree(QuadtreeError::Length {
+                expected: 17 * FINE_LEN as u64,
+                got: 18 * FINE_LEN as u64 - 1,
+            }),
+        ),
+        (
+            |d| d.0[0] = FINE_BIT | 19,
+            ConditionalError::Tree(QuadtreeError::BadDetailIndex(0)),
+        ),
         (
             |d| {
                 d.0.pop();
@@ -501,13 +531,13 @@ fn environment_blobs_without_a_sound_prior_are_refused() {
                 d.1.pop();
             },
             ConditionalError::Tree(QuadtreeError::Length {
-                expected: 85 * DETAIL_LEN as u64,
-                got: 86 * DETAIL_LEN as u64 - 1,
+                expected: 67 * DETAIL_LEN as u64,
+                got: 68 * DETAIL_LEN as u64 - 1,
             }),
         ),
         (
-            |d| d.0[7] = 87,
-            ConditionalError::Tree(QuadtreeError::BadDetailIndex(7)),
+            |d| d.0[3] = 69,
+            ConditionalError::Tree(QuadtreeError::BadDetailIndex(3)),
         ),
     ];
     for (change, want) in cases {
@@ -523,9 +553,18 @@ fn environment_blobs_without_a_sound_prior_are_refused() {
             DETAIL_LEN as u64 + 20
         )))
     );
-    // The last table named and every value sound: it parses.
     let mut p = envmap_parts();
-    p.detail.0[7] = 86;
+    p.detail.2[FINE_LEN + 5] = f32::NAN;
+    assert_eq!(
+        parse(&p),
+        tree_err(ConditionalError::Tree(QuadtreeError::BadFineDetail(
+            FINE_LEN as u64 + 5
+        )))
+    );
+    // The last tables named and every value sound: it parses.
+    let mut p = envmap_parts();
+    p.detail.0[3] = 68;
+    p.detail.0[6] = FINE_BIT | 18;
     assert!(parse(&p).is_ok());
 }
 

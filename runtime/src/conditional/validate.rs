@@ -10,7 +10,7 @@ use nuld_core::conditional::{
 };
 use nuld_core::envmap_tree::{
     corner_len, detail_index_len, node_count, top_len, EnvmapTree, NodeRecord, TreeInfo,
-    DETAIL_LEN, MAX_TREE_LEVELS, TOP_LEVELS,
+    DETAIL_LEN, FINE_LEN, MAX_TREE_LEVELS, TOP_LEVELS,
 };
 use nuld_core::marginal2d::Marginal2DError;
 use nuld_core::network::{Activation, OffsetHash};
@@ -373,9 +373,26 @@ fn tree_view<'a>(layout: &Layout<'a>) -> Result<EnvmapTree<'a>, BlobError> {
         }
         _ => return fail(ConditionalError::TreeDetailAlone),
     };
+    // The fine tables, optional, only beside the detail.
+    let fine_tag = SectionTag::EnvmapTreeFineDetail;
+    let fine: &[f32] = match layout.section(fine_tag) {
+        Err(_) => &[],
+        Ok(_) if index.is_empty() => return fail(ConditionalError::TreeDetailAlone),
+        Ok((_, bytes)) => {
+            let values = bytes.len() / 4;
+            typed_section(
+                layout,
+                fine_tag,
+                ConditionalError::TreeDetailElementSize,
+                || Ok((values / FINE_LEN * FINE_LEN) as u64),
+                tree_length,
+            )?
+        }
+    };
     EnvmapTree::view(info.levels, nodes, info.grid, top)
         .and_then(|t| t.with_corners(corners))
         .and_then(|t| t.with_detail(index, tables))
+        .and_then(|t| t.with_fine_detail(fine))
         .map_err(|e| ConditionalError::Tree(e).into())
 }
 
