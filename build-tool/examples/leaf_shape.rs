@@ -6,7 +6,8 @@
 //! point inside its leaf by the bilinear warp of the leaf's four corner values
 //! (`nuld_core::bilinear`; the map's `L` at the corners, floored), and inside
 //! the sharp leaves (around lamps and the sun) by the piecewise-constant warp of
-//! the leaf's light on 16 x 16 cells (`nuld_core::cell_table`, the detail). At
+//! the leaf's light on 16 x 16 cells (`nuld_core::cell_table`, the detail; 64 x
+//! 64 in the few leaves that hold the most light, a sun's). At
 //! 64 normals spread over the sphere (`z` from 1 down to -0.6), 200 000 random
 //! primary samples each, prints the number of detailed leaves and the state's
 //! size, then the relative variance of `L cos / (E pdf)` (the single-sample
