@@ -69,6 +69,18 @@ pub fn fine_section(tables: &[f32]) -> crate::blob::SectionSpec<'_> {
     }
 }
 
+/// [`QuadtreeError::Length`] (the length rounded down to whole tables
+/// expected) unless `tables` is a whole number of tables of `len` values.
+fn whole_tables(tables: &[f32], len: usize) -> Result<(), QuadtreeError> {
+    if tables.len() % len == 0 {
+        return Ok(());
+    }
+    Err(QuadtreeError::Length {
+        expected: (tables.len() / len * len) as u64,
+        got: tables.len() as u64,
+    })
+}
+
 /// Entries of the detail index of a tree with `levels` levels: one per leaf,
 /// `4^L`.
 pub fn detail_index_len(levels: u32) -> usize {
@@ -112,12 +124,7 @@ impl<'a> EnvmapTree<'a> {
                 got: index.len() as u64,
             });
         }
-        if tables.len() % DETAIL_LEN != 0 {
-            return Err(QuadtreeError::Length {
-                expected: (tables.len() / DETAIL_LEN * DETAIL_LEN) as u64,
-                got: tables.len() as u64,
-            });
-        }
+        whole_tables(tables, DETAIL_LEN)?;
         Ok(Self {
             detail_index: index,
             detail: tables,
@@ -130,12 +137,7 @@ impl<'a> EnvmapTree<'a> {
     /// point by fine table `t` of `tables` ([`FINE_LEN`] values each, `64 x 64`
     /// cells). An error unless the length is a whole number of tables (`O(1)`).
     pub fn with_fine_detail(self, tables: &'a [f32]) -> Result<Self, QuadtreeError> {
-        if tables.len() % FINE_LEN != 0 {
-            return Err(QuadtreeError::Length {
-                expected: (tables.len() / FINE_LEN * FINE_LEN) as u64,
-                got: tables.len() as u64,
-            });
-        }
+        whole_tables(tables, FINE_LEN)?;
         Ok(Self {
             fine: tables,
             ..self

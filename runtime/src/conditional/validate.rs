@@ -10,7 +10,7 @@ use nuld_core::conditional::{
 };
 use nuld_core::envmap_tree::{
     corner_len, detail_index_len, node_count, top_len, EnvmapTree, NodeRecord, TreeInfo,
-    DETAIL_LEN, FINE_LEN, MAX_TREE_LEVELS, TOP_LEVELS,
+    MAX_TREE_LEVELS, TOP_LEVELS,
 };
 use nuld_core::marginal2d::Marginal2DError;
 use nuld_core::network::{Activation, OffsetHash};
@@ -360,16 +360,7 @@ fn tree_view<'a>(layout: &Layout<'a>) -> Result<EnvmapTree<'a>, BlobError> {
                 || Ok(detail_index_len(info.levels) as u64),
                 tree_length,
             )?;
-            // Whole tables: the length rounded down to one, refused if it differs.
-            let values = layout.section(tags[1])?.1.len() / 4;
-            let tables = typed_section(
-                layout,
-                tags[1],
-                ConditionalError::TreeDetailElementSize,
-                || Ok((values / DETAIL_LEN * DETAIL_LEN) as u64),
-                tree_length,
-            )?;
-            (index, tables)
+            (index, detail_tables(layout, tags[1])?)
         }
         _ => return fail(ConditionalError::TreeDetailAlone),
     };
@@ -378,22 +369,27 @@ fn tree_view<'a>(layout: &Layout<'a>) -> Result<EnvmapTree<'a>, BlobError> {
     let fine: &[f32] = match layout.section(fine_tag) {
         Err(_) => &[],
         Ok(_) if index.is_empty() => return fail(ConditionalError::TreeDetailAlone),
-        Ok((_, bytes)) => {
-            let values = bytes.len() / 4;
-            typed_section(
-                layout,
-                fine_tag,
-                ConditionalError::TreeDetailElementSize,
-                || Ok((values / FINE_LEN * FINE_LEN) as u64),
-                tree_length,
-            )?
-        }
+        Ok(_) => detail_tables(layout, fine_tag)?,
     };
     EnvmapTree::view(info.levels, nodes, info.grid, top)
         .and_then(|t| t.with_corners(corners))
         .and_then(|t| t.with_detail(index, tables))
         .and_then(|t| t.with_fine_detail(fine))
         .map_err(|e| ConditionalError::Tree(e).into())
+}
+
+/// A detail-table section (tag 21 or 22) as `f32` values, its element size
+/// checked; whether they make whole tables, [`EnvmapTree::with_detail`] and
+/// [`EnvmapTree::with_fine_detail`] check.
+fn detail_tables<'a>(layout: &Layout<'a>, tag: SectionTag) -> Result<&'a [f32], BlobError> {
+    let values = layout.section(tag)?.1.len() / 4;
+    typed_section(
+        layout,
+        tag,
+        ConditionalError::TreeDetailElementSize,
+        || Ok(values as u64),
+        tree_length,
+    )
 }
 
 /// The BRDF prior's five sections: with `check`, every value read once
