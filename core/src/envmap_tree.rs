@@ -28,8 +28,10 @@
 //! **The top levels are exact.** The bound is loose for a node that spans a large
 //! part of the sphere across the horizon, and the first levels' choices move the
 //! most mass: with the bound alone, 3 to 20 % of the samples of courtyard's light
-//! fell below the horizon. So the weights of the nodes of levels
-//! `1..=`[`TOP_LEVELS`] (84 nodes) are tabulated exactly, `Σ_leaves max(0, n.m1)`,
+//! fell below the horizon. So the weights of the nodes of levels `1..=T` (`T`
+//! the tree's *top levels*, [`TOP_LEVELS`] = 4 in a tree written today: 340
+//! nodes; 3 and 84 nodes in blobs written before, [`LEGACY_TOP_LEVELS`]) are
+//! tabulated exactly, `Σ_leaves max(0, n.m1)`,
 //! for a `G x G` grid of normals placed by their octahedral square points (nodes
 //! at `j / (G - 1)`, on the square's edges, so no cell crosses the seam), and
 //! interpolated bilinearly at the query; the bound times [`TOP_FLOOR`] stands
@@ -106,12 +108,28 @@ impl NodeRecord {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Pod, Zeroable)]
 pub struct TreeInfo {
-    /// Levels below the root, [`TOP_LEVELS`] to [`MAX_TREE_LEVELS`].
+    /// Levels below the root, the top levels to [`MAX_TREE_LEVELS`].
     pub levels: u32,
     /// Normals per axis of the top-weight table, 2 to 1024.
     pub grid: u32,
+    /// Levels whose weights the top table holds ([`LEGACY_TOP_LEVELS`] to
+    /// [`MAX_TOP_LEVELS`]); 0 in blobs written before this field, which read as
+    /// [`LEGACY_TOP_LEVELS`] ([`Self::top_levels`]).
+    pub top_levels: u32,
     /// Reserved, zero.
-    pub reserved: [u32; 2],
+    pub reserved: u32,
+}
+
+impl TreeInfo {
+    /// The top levels this info names: [`Self::top_levels`], 0 read as
+    /// [`LEGACY_TOP_LEVELS`] (the depth of every tree written before the field).
+    pub fn top_levels(&self) -> u32 {
+        if self.top_levels == 0 {
+            LEGACY_TOP_LEVELS
+        } else {
+            self.top_levels
+        }
+    }
 }
 
 /// Size of [`TreeInfo`] in bytes.
@@ -183,26 +201,39 @@ fn first_child(node: Node) -> usize {
     quadtree::level_offset(node.level + 1) - 1 + 4 * node.z as usize
 }
 
-/// Levels whose nodes' weights are tabulated over a grid of normals (module docs).
-pub const TOP_LEVELS: u32 = 3;
+/// Levels whose nodes' weights a tree written today tabulates over a grid of
+/// normals (module docs): 340 nodes a normal. Below them the bound is loose
+/// where a node straddles the normal's horizon, and level 4's nodes (about 13°
+/// across) were where most of the leaves' probabilities' distance from `L cos`
+/// entered (docs/results/envmap.md#top-levels).
+pub const TOP_LEVELS: u32 = 4;
 
-const _: () = assert!(node_count_const(TOP_LEVELS) == 84);
+/// The top levels of the trees written before [`TreeInfo::top_levels`] (84
+/// nodes a normal), which still load.
+pub const LEGACY_TOP_LEVELS: u32 = 3;
+
+/// The deepest top table a reader accepts: 1364 nodes a normal.
+pub const MAX_TOP_LEVELS: u32 = 5;
+
+const _: () = assert!(node_count_const(LEGACY_TOP_LEVELS) == 84);
+const _: () = assert!(node_count_const(TOP_LEVELS) == 340);
 
 const fn node_count_const(levels: u32) -> usize {
     ((1usize << (2 * (levels + 1))) - 4) / 3
 }
 
-/// Records of levels `1..=`[`TOP_LEVELS`]: one top-table row's entries.
-const TOP_NODES: usize = node_count_const(TOP_LEVELS);
+/// Records of levels `1..=`[`MAX_TOP_LEVELS`]: the longest top-table row.
+const MAX_TOP_NODES: usize = node_count_const(MAX_TOP_LEVELS);
 
 /// Share of the bound that stands under a tabulated top-level weight.
 pub const TOP_FLOOR: f64 = 1e-3;
 
-/// Entries of a top-weight table on a grid of `grid x grid` normals: `grid² x
-/// node_count(TOP_LEVELS)` (84 per normal), `[normal j1 grid + j0][node]` with
-/// the nodes in the records' order.
-pub fn top_len(grid: u32) -> usize {
-    (grid as usize) * (grid as usize) * node_count(TOP_LEVELS)
+/// Entries of a top-weight table of `top_levels` levels on a grid of `grid x
+/// grid` normals: `grid² x node_count(top_levels)` (340 per normal at
+/// [`TOP_LEVELS`]), `[normal j1 grid + j0][node]` with the nodes in the
+/// records' order.
+pub fn top_len(grid: u32, top_levels: u32) -> usize {
+    (grid as usize) * (grid as usize) * node_count(top_levels.min(MAX_TOP_LEVELS))
 }
 
 /// The unit normal of top-table grid node `(j0, j1)` of `grid x grid`: the
@@ -212,19 +243,20 @@ pub fn top_normal(grid: u32, j: [u32; 2]) -> [f64; 3] {
     square_to_sphere_real([j[0] as f64 / g, j[1] as f64 / g])
 }
 
-/// One row of a top-weight table, for the unit normal `n`: the exact weight
-/// `Σ_leaves max(0, n.m1)` of each node of levels `1..=TOP_LEVELS`, summed from
-/// the leaf records of `nodes` (a tree of `levels >= TOP_LEVELS` levels) in `f64`,
-/// each node of the deepest top level over its leaves, every node above over its
-/// four children. `row` holds [`node_count`]`(TOP_LEVELS)` values (zeros for a
-/// tree of no levels). `O(4^L)`.
-pub fn top_row(levels: u32, nodes: &[NodeRecord], n: [f64; 3], row: &mut [f32]) {
-    let mut sums = [0.0f64; 84];
+/// One row of a top-weight table of `top_levels` levels (at most
+/// [`MAX_TOP_LEVELS`]), for the unit normal `n`: the exact weight `Σ_leaves
+/// max(0, n.m1)` of each node of levels `1..=top_levels`, summed from the leaf
+/// records of `nodes` (a tree of `levels >= top_levels` levels) in `f64`, each
+/// node of the deepest top level over its leaves, every node above over its four
+/// children. `row` holds [`node_count`]`(top_levels)` values (zeros for a tree
+/// of no levels). `O(4^L)`.
+pub fn top_row(levels: u32, top_levels: u32, nodes: &[NodeRecord], n: [f64; 3], row: &mut [f32]) {
+    let mut sums = [0.0f64; MAX_TOP_NODES];
     if levels == 0 {
         row.iter_mut().for_each(|v| *v = 0.0);
         return;
     }
-    let deepest = TOP_LEVELS.min(levels);
+    let deepest = top_levels.min(MAX_TOP_LEVELS).min(levels);
     // Level `l`'s records start at its node (0, 0), each level in Morton order.
     let first = |l: u32| node_index(l, 0, 0);
     let leaves = nodes.get(first(levels)..).unwrap_or(&[]);
@@ -308,6 +340,8 @@ pub struct EnvmapTree<'a> {
     nodes: &'a [NodeRecord],
     grid: u32,
     top: &'a [f32],
+    /// Levels whose weights `top` holds.
+    top_levels: u32,
     /// The leaf shape: `(2^L + 1)^2` corner values, row-major; empty for
     /// uniform leaves.
     corners: &'a [f32],
@@ -321,8 +355,9 @@ pub struct EnvmapTree<'a> {
 }
 
 impl<'a> EnvmapTree<'a> {
-    /// The tree of `levels` levels ([`TOP_LEVELS`] to [`MAX_TREE_LEVELS`]) over
-    /// `nodes`, with the top-weight table `top` on `grid x grid` normals (at
+    /// The tree of `levels` levels (`top_levels` to [`MAX_TREE_LEVELS`]) over
+    /// `nodes`, with the top-weight table `top` of `top_levels` levels
+    /// ([`LEGACY_TOP_LEVELS`] to [`MAX_TOP_LEVELS`]) on `grid x grid` normals (at
     /// least 2 per axis): checks the counts ([`node_count`], [`top_len`]), every value
     /// finite, every spread and top weight non-negative, and some light (a level-1
     /// record with positive mass). A tree whose parents are not the sums of their
@@ -333,8 +368,9 @@ impl<'a> EnvmapTree<'a> {
         nodes: &'a [NodeRecord],
         grid: u32,
         top: &'a [f32],
+        top_levels: u32,
     ) -> Result<Self, QuadtreeError> {
-        let tree = Self::view(levels, nodes, grid, top)?;
+        let tree = Self::view(levels, nodes, grid, top, top_levels)?;
         tree.check_values()?;
         Ok(tree)
     }
@@ -347,13 +383,17 @@ impl<'a> EnvmapTree<'a> {
         nodes: &'a [NodeRecord],
         grid: u32,
         top: &'a [f32],
+        top_levels: u32,
     ) -> Result<Self, QuadtreeError> {
-        if !(TOP_LEVELS..=MAX_TREE_LEVELS.min(MAX_LEVELS)).contains(&levels) {
+        if !(LEGACY_TOP_LEVELS..=MAX_TOP_LEVELS).contains(&top_levels) {
+            return Err(QuadtreeError::TopLevels(top_levels));
+        }
+        if !(top_levels..=MAX_TREE_LEVELS.min(MAX_LEVELS)).contains(&levels) {
             return Err(QuadtreeError::Levels(levels));
         }
-        if !(2..=1024).contains(&grid) || top.len() != top_len(grid) {
+        if !(2..=1024).contains(&grid) || top.len() != top_len(grid, top_levels) {
             return Err(QuadtreeError::Length {
-                expected: top_len(grid.clamp(2, 1024)) as u64,
+                expected: top_len(grid.clamp(2, 1024), top_levels) as u64,
                 got: top.len() as u64,
             });
         }
@@ -368,6 +408,7 @@ impl<'a> EnvmapTree<'a> {
             nodes,
             grid,
             top,
+            top_levels,
             corners: &[],
             detail_index: &[],
             detail: &[],
@@ -523,7 +564,7 @@ impl<'a> EnvmapTree<'a> {
             (j0, s - T::of(j0 as f64))
         });
         let [(x0, tx), (y0, ty)] = cell;
-        let (g, per) = (self.grid as usize, TOP_NODES);
+        let (g, per) = (self.grid as usize, node_count(self.top_levels));
         let row = |dx: usize, dy: usize| ((y0 as usize + dy) * g + x0 as usize + dx) * per;
         Lit {
             tree: *self,
@@ -541,6 +582,11 @@ impl<'a> EnvmapTree<'a> {
     /// The top-weight table.
     pub fn top(&self) -> &'a [f32] {
         self.top
+    }
+
+    /// Levels whose weights the top table holds.
+    pub fn top_levels(&self) -> u32 {
+        self.top_levels
     }
 
     /// The direction at primary sample `u` in `[0,1]^2` (clamped) for `normal`,
@@ -647,7 +693,7 @@ impl<T: Real> ChildWeights<T> for Lit<'_, T> {
             return [T::ONE; 4];
         };
         let bound: [T; 4] = core::array::from_fn(|k| c[k].weight(self.n));
-        if level < TOP_LEVELS {
+        if level < self.tree.top_levels {
             core::array::from_fn(|k| self.top_weight(first + k).max(bound[k] * T::of(TOP_FLOOR)))
         } else {
             bound

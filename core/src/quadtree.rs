@@ -61,6 +61,9 @@ pub enum QuadtreeError {
     /// A fine-table value is negative, NaN or infinite (index into the fine
     /// tables).
     BadFineDetail(u64),
+    /// An environment tree's top table names a depth outside
+    /// [`crate::envmap_tree::LEGACY_TOP_LEVELS`]`..=`[`crate::envmap_tree::MAX_TOP_LEVELS`].
+    TopLevels(u32),
 }
 
 impl core::fmt::Display for QuadtreeError {
@@ -83,6 +86,12 @@ impl core::fmt::Display for QuadtreeError {
             Self::BadFineDetail(i) => {
                 write!(f, "fine detail value {i} is negative or not finite")
             }
+            Self::TopLevels(t) => write!(
+                f,
+                "top table of {t} levels (from {} to {})",
+                crate::envmap_tree::LEGACY_TOP_LEVELS,
+                crate::envmap_tree::MAX_TOP_LEVELS
+            ),
         }
     }
 }

@@ -121,9 +121,10 @@ const NULD_WARP_BRDF_TABLE: u32 = 3u;
 // `TreeInfo` fields (core/src/envmap_tree.rs).
 const NULD_TREE_INFO_LEVELS: u32 = 0u;
 const NULD_TREE_INFO_GRID: u32 = 4u;
-// `TOP_LEVELS`, `node_count(TOP_LEVELS)`, `quadtree::MAX_LEVELS`.
-const NULD_TREE_TOP_LEVELS: u32 = 3u;
-const NULD_TREE_TOP_NODES: u32 = 84u;
+const NULD_TREE_INFO_TOP_LEVELS: u32 = 8u;
+// `LEGACY_TOP_LEVELS`, `MAX_TOP_LEVELS`, `quadtree::MAX_LEVELS`.
+const NULD_TREE_LEGACY_TOP_LEVELS: u32 = 3u;
+const NULD_TREE_MAX_TOP_LEVELS: u32 = 5u;
 const NULD_TREE_MAX_LEVELS: u32 = 24u;
 // `DETAIL_SIDE`, `DETAIL_LEN` (core/src/envmap_tree.rs).
 const NULD_TREE_DETAIL_SIDE: u32 = 16u;
@@ -993,6 +994,10 @@ struct NuldTree {
     top: u32,
     levels: u32,
     grid: u32,
+    // `TreeInfo::top_levels` (0 read as the legacy 3) and a top-table row's
+    // entries, `node_count(top_levels)`.
+    top_levels: u32,
+    top_nodes: u32,
     // The leaf shape's corner values (tag 19); 0 without them (uniform leaves).
     corners: u32,
     // The detail index (tag 20) and tables (tag 21); 0 without them.
@@ -1008,11 +1013,15 @@ struct NuldTree {
 // Rust: `ConditionalSampler::tree`: the blob's environment prior.
 fn nuld_tree() -> NuldTree {
     let info = nuld_section(NULD_TAG_ENVMAP_TREE_INFO);
+    let named = nuld_u32(info + NULD_TREE_INFO_TOP_LEVELS);
+    let top_levels = min(select(named, NULD_TREE_LEGACY_TOP_LEVELS, named == 0u), NULD_TREE_MAX_TOP_LEVELS);
     return NuldTree(
         nuld_section(NULD_TAG_ENVMAP_TREE_NODES),
         nuld_section(NULD_TAG_ENVMAP_TREE_TOP),
         min(nuld_u32(info + NULD_TREE_INFO_LEVELS), NULD_TREE_MAX_LEVELS),
         max(nuld_u32(info + NULD_TREE_INFO_GRID), 2u),
+        top_levels,
+        ((1u << (2u * (top_levels + 1u))) - 4u) / 3u,
         nuld_section(NULD_TAG_ENVMAP_TREE_CORNERS),
         nuld_section(NULD_TAG_ENVMAP_TREE_DETAIL_INDEX),
         nuld_section(NULD_TAG_ENVMAP_TREE_DETAIL),
@@ -1255,10 +1264,10 @@ fn nuld_lit_square(t: NuldTree, q0: vec2<f32>) -> NuldLit {
 // Rust: `Lit::top_weight`: top-table node `node` interpolated at the normal.
 fn nuld_top_weight(t: NuldTree, lit: NuldLit, node: u32) -> f32 {
     let row = lit.j0.y * t.grid + lit.j0.x;
-    let w00 = nuld_f32(t.top + 4u * (row * NULD_TREE_TOP_NODES + node));
-    let w10 = nuld_f32(t.top + 4u * ((row + 1u) * NULD_TREE_TOP_NODES + node));
-    let w01 = nuld_f32(t.top + 4u * ((row + t.grid) * NULD_TREE_TOP_NODES + node));
-    let w11 = nuld_f32(t.top + 4u * ((row + t.grid + 1u) * NULD_TREE_TOP_NODES + node));
+    let w00 = nuld_f32(t.top + 4u * (row * t.top_nodes + node));
+    let w10 = nuld_f32(t.top + 4u * ((row + 1u) * t.top_nodes + node));
+    let w01 = nuld_f32(t.top + 4u * ((row + t.grid) * t.top_nodes + node));
+    let w11 = nuld_f32(t.top + 4u * ((row + t.grid + 1u) * t.top_nodes + node));
     let a = w00 + (w10 - w00) * lit.t.x;
     let b = w01 + (w11 - w01) * lit.t.x;
     return a + (b - a) * lit.t.y;
@@ -1272,7 +1281,7 @@ fn nuld_children(t: NuldTree, lit: NuldLit, level: u32, x: u32, y: u32) -> vec4<
     var w: vec4<f32>;
     for (var k = 0u; k < 4u; k++) {
         var v = nuld_node_weight(t, first + k, lit.n);
-        if level < NULD_TREE_TOP_LEVELS {
+        if level < t.top_levels {
             v = max(nuld_top_weight(t, lit, first + k), v * NULD_TREE_TOP_FLOOR);
         }
         if !(v > 0.0 && nuld_is_finite(v)) {

@@ -377,7 +377,7 @@ pub fn doc_example_brdf_blob() -> Aligned<[u8; 1776]> {
 #[doc(hidden)]
 pub fn doc_example_envmap_blob() -> Aligned<[u8; 3200]> {
     use nuld_core::envmap_tree::{
-        build, node_count, top_normal, top_row, NodeRecord, TreeInfo, TOP_LEVELS,
+        build, node_count, top_normal, top_row, NodeRecord, TreeInfo, LEGACY_TOP_LEVELS,
     };
     let (info, params, table, _) =
         doc_example_parts(ConditionalTarget::EnvmapNormal, [0.0, 0.0], [1.0, 1.0]);
@@ -386,7 +386,9 @@ pub fn doc_example_envmap_blob() -> Aligned<[u8; 3200]> {
         ..info
     };
     let weights: [f32; 4] = [1.0, 0.95, 1.2, 0.98];
-    let levels = TOP_LEVELS;
+    // A tree of 3 levels, every one of them in the top table (the depth of the
+    // trees written before `TreeInfo::top_levels`, which still load).
+    let levels = LEGACY_TOP_LEVELS;
     let mut leaves = [[0.0f64; 4]; 64];
     for (k, leaf) in leaves.iter_mut().enumerate() {
         let p = [
@@ -406,6 +408,7 @@ pub fn doc_example_envmap_blob() -> Aligned<[u8; 3200]> {
     for (r, row) in top.chunks_mut(84).enumerate() {
         top_row(
             levels,
+            levels,
             &nodes,
             top_normal(2, [r as u32 % 2, r as u32 / 2]),
             row,
@@ -414,7 +417,8 @@ pub fn doc_example_envmap_blob() -> Aligned<[u8; 3200]> {
     let tree = TreeInfo {
         levels,
         grid: 2,
-        reserved: [0; 2],
+        top_levels: levels,
+        reserved: 0,
     };
     let meta = [
         3, b'd', b'o', b'c', 7, b'e', b'n', b'v', b'-', b'd', b'o', b'c', 0,

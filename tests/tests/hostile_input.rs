@@ -900,9 +900,9 @@ fn metal_semantics_hold(layout: &Layout<'_>, warp: u32, params: usize, table: us
 
 /// The environment prior's sections (core/FORMAT.md, tags 7-9), checked from the
 /// raw bytes: a 16-byte info (its `elem_size`, as the conditional info's, unread)
-/// with levels 3 to 12, a grid of 2 to 1024 normals and
-/// zero reserved words; `(4^(L+1) - 4) / 3` records of four finite `f32` with a
-/// spread >= 0 and some level-1 record with mass; `84 G^2` finite top weights >= 0;
+/// with levels `T` to 12, a grid of 2 to 1024 normals, top levels `T` 3 to 5 (0
+/// read as 3) and a zero reserved word; `(4^(L+1) - 4) / 3` records of four finite `f32` with a
+/// spread >= 0 and some level-1 record with mass; `(4^(T+1) - 4) / 3 G^2` finite top weights >= 0;
 /// and, if there is a leaf shape (tag 19), `(2^L + 1)^2` finite values >= 0; and
 /// if there is detail (tags 20, 21, and the fine tables, 22), both sections, an
 /// entry per leaf naming a table, a fine table or none, whole tables of finite
@@ -921,14 +921,22 @@ fn tree_semantics_hold(layout: &Layout<'_>) -> bool {
     }
     let word = |b: &[u8], at: usize| u32::from_le_bytes(b[at..at + 4].try_into().unwrap());
     let (levels, grid) = (word(info, 0), word(info, 4));
-    if !((3..=12).contains(&levels) && (2..=1024).contains(&grid))
-        || word(info, 8) != 0
+    let top_levels = match word(info, 8) {
+        0 => 3,
+        t => t,
+    };
+    if !((3..=5).contains(&top_levels)
+        && (top_levels..=12).contains(&levels)
+        && (2..=1024).contains(&grid))
         || word(info, 12) != 0
     {
         return false;
     }
     let records = ((1u128 << (2 * (levels + 1))) - 4) / 3;
-    if nodes.len() as u128 != 16 * records || top.len() as u128 != 4 * 84 * (grid as u128).pow(2) {
+    let top_nodes = ((1u128 << (2 * (top_levels + 1))) - 4) / 3;
+    if nodes.len() as u128 != 16 * records
+        || top.len() as u128 != 4 * top_nodes * (grid as u128).pow(2)
+    {
         return false;
     }
     let real = |b: &[u8], at: usize| f32::from_bits(word(b, at));

@@ -15,8 +15,8 @@ use nuld_core::brdf::{F0, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
 use nuld_core::brdf_prior::BrdfPriorInfo;
 use nuld_core::conditional::{ConditionalInfo, PointWarp, MAX_METALLIC_NODES, RANDOMIZE_SALTS};
 use nuld_core::envmap_tree::{
-    node_count, TreeInfo, DETAIL_LEN, DETAIL_SIDE, FINE_BIT, FINE_LEN, FINE_SIDE, TOP_FLOOR,
-    TOP_LEVELS,
+    TreeInfo, DETAIL_LEN, DETAIL_SIDE, FINE_BIT, FINE_LEN, FINE_SIDE, LEGACY_TOP_LEVELS,
+    MAX_TOP_LEVELS, TOP_FLOOR,
 };
 use nuld_core::marginal2d::MAX_BLEND;
 use nuld_core::network::{
@@ -205,8 +205,9 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_MAX_BLEND", MAX_BLEND as u64),
         ("NULD_TREE_INFO_LEVELS", at!(TreeInfo, levels)),
         ("NULD_TREE_INFO_GRID", at!(TreeInfo, grid)),
-        ("NULD_TREE_TOP_LEVELS", TOP_LEVELS as u64),
-        ("NULD_TREE_TOP_NODES", node_count(TOP_LEVELS) as u64),
+        ("NULD_TREE_INFO_TOP_LEVELS", at!(TreeInfo, top_levels)),
+        ("NULD_TREE_LEGACY_TOP_LEVELS", LEGACY_TOP_LEVELS as u64),
+        ("NULD_TREE_MAX_TOP_LEVELS", MAX_TOP_LEVELS as u64),
         ("NULD_TREE_MAX_LEVELS", MAX_LEVELS as u64),
         ("NULD_TREE_DETAIL_SIDE", DETAIL_SIDE as u64),
         ("NULD_TREE_DETAIL_LEN", DETAIL_LEN as u64),

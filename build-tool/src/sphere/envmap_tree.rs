@@ -439,22 +439,22 @@ impl EnvmapTree {
         build(levels, &leaves, &mut nodes)?;
         if grid < 2 {
             return Err(QuadtreeError::Length {
-                expected: top_len(2) as u64,
+                expected: top_len(2, TOP_LEVELS) as u64,
                 got: 0,
             });
         }
         let per = node_count(TOP_LEVELS);
-        let mut top = vec![0.0; top_len(grid)];
+        let mut top = vec![0.0; top_len(grid, TOP_LEVELS)];
         top.par_chunks_mut(per).enumerate().for_each(|(r, row)| {
             let j = [r as u32 % grid, r as u32 / grid];
-            top_row(levels, &nodes, top_normal(grid, j), row);
+            top_row(levels, TOP_LEVELS, &nodes, top_normal(grid, j), row);
         });
         let corners = leaf_corners(&light, levels, &leaves);
         let masses: Vec<f64> = leaves.iter().map(|m| m[0]).collect();
         let (detail_index, detail, fine) = detail_tables(&light, levels, sharp, &masses);
         // Refuses a map without light, as the runtime would (every value,
         // corners and detail included, read once).
-        CoreTree::view(levels, &nodes, grid, &top)?
+        CoreTree::view(levels, &nodes, grid, &top, TOP_LEVELS)?
             .with_corners(&corners)?
             .with_detail(&detail_index, &detail)?
             .with_fine_detail(&fine)?
@@ -473,7 +473,7 @@ impl EnvmapTree {
 
     /// The tree as core reads it (`O(1)`: the values were checked when built).
     pub fn tree(&self) -> CoreTree<'_> {
-        CoreTree::view(self.levels, &self.nodes, self.grid, &self.top)
+        CoreTree::view(self.levels, &self.nodes, self.grid, &self.top, TOP_LEVELS)
             .and_then(|t| t.with_corners(&self.corners))
             .and_then(|t| t.with_detail(&self.detail_index, &self.detail))
             .and_then(|t| t.with_fine_detail(&self.fine))
@@ -485,7 +485,8 @@ impl EnvmapTree {
         TreeInfo {
             levels: self.levels,
             grid: self.grid,
-            reserved: [0; 2],
+            top_levels: TOP_LEVELS,
+            reserved: 0,
         }
     }
 
@@ -655,11 +656,12 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("nuld-tree-{}", std::process::id()));
         let map = EnvmapDensity::from_file_filtered(tiny_map(&dir), Domain::Sphere).unwrap();
         let tree = EnvmapTree::new(&map, 6, 9).unwrap();
-        // The records, the top table, the corners and the detail.
+        // The records, the top table (levels 1 to 4: 340 nodes a normal), the
+        // corners and the detail.
         let detail = 4 * (tree.detail_index.len() + tree.detail.len());
         assert_eq!(
             tree.state_bytes(),
-            16 * node_count(6) + 4 * 81 * 84 + 4 * 65 * 65 + detail
+            16 * node_count(6) + 4 * 81 * ((4usize.pow(5) - 4) / 3) + 4 * 65 * 65 + detail
         );
         let total: f32 = tree.nodes[..4].iter().map(|r| r.mass()).sum();
         assert!((total - 1.0).abs() < 1e-3, "{total}");

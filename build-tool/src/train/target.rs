@@ -251,7 +251,7 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("nuld-target-coarse-{}", std::process::id()));
         let path = crate::sphere::envmap::tiny_map(&dir);
         let map = EnvmapDensity::from_file_filtered(&path, Domain::Sphere).unwrap();
-        let tree = EnvmapTree::new(&map, 3, 2).unwrap();
+        let tree = EnvmapTree::new(&map, nuld_core::envmap_tree::TOP_LEVELS, 2).unwrap();
         let cells = map.width() * map.height();
         let whole = EnvmapTarget::with_coarse_cells(map.clone(), tree.clone(), cells);
         assert!(std::ptr::eq(whole.coarse_map(), &whole.map));
@@ -262,10 +262,10 @@ mod tests {
         assert_eq!(coarse.height() * 2, small.map.height());
         assert!((coarse.integral() / small.map.integral() - 1.0).abs() < 1e-12);
         assert_eq!(coarse.negative_pixels(), small.map.negative_pixels());
-        assert_eq!(whole.summary(), "64 x 32 cells, a prior of 3 levels");
+        assert_eq!(whole.summary(), "64 x 32 cells, a prior of 4 levels");
         assert_eq!(
             small.summary(),
-            "64 x 32 cells, a prior of 3 levels, lit for the pool on a copy of 32 x 16 cells"
+            "64 x 32 cells, a prior of 4 levels, lit for the pool on a copy of 32 x 16 cells"
         );
         // A real map is over the default limit only from 1024 x 512 pixels up.
         assert_eq!(COARSE_CELLS, 4 * 1024 * 512);

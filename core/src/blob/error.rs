@@ -500,7 +500,7 @@ pub enum ConditionalError {
         /// [`crate::envmap_tree::TREE_INFO_LEN`].
         expected: u64,
     },
-    /// The reserved words of the tree info are not zero.
+    /// The reserved word of the tree info is not zero.
     TreeReserved,
     /// The [`SectionTag::EnvmapTreeNodes`] elements are not 16 bytes.
     TreeNodeElementSize(u32),
@@ -670,7 +670,7 @@ impl core::fmt::Display for ConditionalError {
                 f,
                 "blob environment tree info section is {got} bytes, not {expected}"
             ),
-            Self::TreeReserved => write!(f, "blob environment tree info's reserved words are not 0"),
+            Self::TreeReserved => write!(f, "blob environment tree info's reserved word is not 0"),
             Self::TreeNodeElementSize(e) => {
                 write!(f, "blob environment tree nodes are {e} bytes each, not 16")
             }

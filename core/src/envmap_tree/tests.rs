@@ -51,11 +51,16 @@ fn tree_nodes(levels: u32) -> Vec<NodeRecord> {
 const GRID: u32 = 9;
 
 fn top_table(levels: u32, nodes: &[NodeRecord]) -> Vec<f32> {
-    let per = node_count(TOP_LEVELS);
-    let mut top = vec![0.0; top_len(GRID)];
+    top_table_of(levels, nodes, TOP_LEVELS)
+}
+
+/// The top table of `top_levels` levels on the `GRID x GRID` normals.
+fn top_table_of(levels: u32, nodes: &[NodeRecord], top_levels: u32) -> Vec<f32> {
+    let per = node_count(top_levels);
+    let mut top = vec![0.0; top_len(GRID, top_levels)];
     for (r, row) in top.chunks_mut(per).enumerate() {
         let j = [r as u32 % GRID, r as u32 / GRID];
-        top_row(levels, nodes, top_normal(GRID, j), row);
+        top_row(levels, top_levels, nodes, top_normal(GRID, j), row);
     }
     top
 }
@@ -147,10 +152,18 @@ fn a_nodes_weight_bounds_its_lit_mass_from_above_and_is_tight_above_the_horizon(
 /// grid normals they are positive wherever the query's normal sees the node.
 #[test]
 fn top_weights_are_exact_at_grid_normals_and_positive_where_lit() {
+    // Today's depth, and the depth of the trees written before it, which still load.
+    for top_levels in [TOP_LEVELS, LEGACY_TOP_LEVELS] {
+        top_weights_exact(top_levels);
+    }
+}
+
+fn top_weights_exact(top_levels: u32) {
     let levels = 5;
     let nodes = tree_nodes(levels);
-    let top = top_table(levels, &nodes);
-    let tree = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let top = top_table_of(levels, &nodes, top_levels);
+    let tree = EnvmapTree::new(levels, &nodes, GRID, &top, top_levels).unwrap();
+    assert_eq!(tree.top_levels(), top_levels);
     let side = 1u32 << levels;
     let lit_mass = |n: DVec3, l: u32, x: u32, y: u32| {
         let b = side >> l;
@@ -166,7 +179,7 @@ fn top_weights_are_exact_at_grid_normals_and_positive_where_lit() {
     for j in [[0, 0], [3, 5], [8, 8], [4, 4]] {
         let n = top_normal(GRID, j);
         let lit = tree.lit(n);
-        for l in 0..TOP_LEVELS {
+        for l in 0..top_levels {
             let s = 1u32 << l;
             for node in 0..s * s {
                 let (x, y) = (node % s, node / s);
@@ -204,7 +217,7 @@ fn the_pdf_integrates_to_one_over_the_sphere() {
     let levels = 6;
     let nodes = tree_nodes(levels);
     let top = top_table(levels, &nodes);
-    let tree = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let tree = EnvmapTree::new(levels, &nodes, GRID, &top, TOP_LEVELS).unwrap();
     let m = 256;
     for n in normals() {
         let mut sum = 0.0;
@@ -291,7 +304,7 @@ fn samples_follow_the_pdf_and_invert_undoes_sample() {
     let levels = 6;
     let nodes = tree_nodes(levels);
     let top = top_table(levels, &nodes);
-    let tree = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let tree = EnvmapTree::new(levels, &nodes, GRID, &top, TOP_LEVELS).unwrap();
     let n = [0.6, -0.3, 0.1];
     let bins = 64;
     check_samples(&tree, n, 5, 1e-9, bins, |i, j| {
@@ -337,7 +350,7 @@ fn the_estimate_with_the_pdf_is_the_irradiance() {
     let levels = 7;
     let nodes = tree_nodes(levels);
     let top = top_table(levels, &nodes);
-    let flat = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let flat = EnvmapTree::new(levels, &nodes, GRID, &top, TOP_LEVELS).unwrap();
     let corners = corner_values(levels);
     let (index, tables, fine) = detail_values(levels);
     let detailed = flat
@@ -382,7 +395,7 @@ fn f32_agrees_with_f64() {
     let levels = 6;
     let nodes = tree_nodes(levels);
     let top = top_table(levels, &nodes);
-    let tree = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let tree = EnvmapTree::new(levels, &nodes, GRID, &top, TOP_LEVELS).unwrap();
     let mut r = Rng(3);
     let mut agreeing = 0;
     for _ in 0..2000 {
@@ -407,22 +420,31 @@ fn f32_agrees_with_f64() {
 fn bad_trees_are_refused_and_hostile_queries_do_not_panic() {
     let nodes = tree_nodes(4);
     let top = top_table(4, &nodes);
-    let new = |l, n: &[NodeRecord]| EnvmapTree::new(l, n, GRID, &top).map(|_| ());
+    let new = |l, n: &[NodeRecord]| EnvmapTree::new(l, n, GRID, &top, TOP_LEVELS).map(|_| ());
     assert_eq!(new(2, &nodes), Err(QuadtreeError::Levels(2)));
     assert_eq!(new(13, &nodes), Err(QuadtreeError::Levels(13)));
+    // A tree shallower than its top table.
+    assert_eq!(new(3, &nodes), Err(QuadtreeError::Levels(3)));
+    for t in [0, 2, 6, u32::MAX] {
+        assert_eq!(
+            EnvmapTree::new(4, &nodes, GRID, &top, t).map(|_| ()),
+            Err(QuadtreeError::TopLevels(t))
+        );
+    }
+    // A table of another depth than the one named.
     assert!(matches!(
-        new(3, &nodes),
-        Err(QuadtreeError::Length { expected: 84, .. })
+        EnvmapTree::new(4, &nodes, GRID, &top, LEGACY_TOP_LEVELS),
+        Err(QuadtreeError::Length { expected, got }) if expected == 84 * 81 && got == 340 * 81
     ));
     assert!(matches!(
-        EnvmapTree::new(4, &nodes, GRID + 1, &top),
+        EnvmapTree::new(4, &nodes, GRID + 1, &top, TOP_LEVELS),
         Err(QuadtreeError::Length { .. })
     ));
-    assert!(EnvmapTree::new(4, &nodes, 1, &top[..84]).is_err());
+    assert!(EnvmapTree::new(4, &nodes, 1, &top[..340], TOP_LEVELS).is_err());
     let mut bad_top = top.clone();
     bad_top[5] = -1.0;
     assert_eq!(
-        EnvmapTree::new(4, &nodes, GRID, &bad_top).map(|_| ()),
+        EnvmapTree::new(4, &nodes, GRID, &bad_top, TOP_LEVELS).map(|_| ()),
         Err(QuadtreeError::BadTopWeight(5))
     );
     let mut bad = nodes.clone();
@@ -445,7 +467,7 @@ fn bad_trees_are_refused_and_hostile_queries_do_not_panic() {
     for r in odd.iter_mut().step_by(5) {
         r.moment = [1e30, -1e30, 0.0];
     }
-    let tree = EnvmapTree::new(4, &odd, GRID, &top).unwrap();
+    let tree = EnvmapTree::new(4, &odd, GRID, &top, TOP_LEVELS).unwrap();
     for n in [
         [0.0f32; 3],
         [f32::NAN, 0.0, 1.0],
@@ -471,7 +493,7 @@ fn slopes_are_the_warps_derivatives_and_invert_the_pdf() {
     let levels = 6;
     let nodes = tree_nodes(levels);
     let top = top_table(levels, &nodes);
-    let flat = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let flat = EnvmapTree::new(levels, &nodes, GRID, &top, TOP_LEVELS).unwrap();
     let corners = corner_values(levels);
     let shaped = flat.with_corners(&corners).unwrap();
     let q = crate::sphere::sphere_to_square(DVec3::new(0.2, 0.5, 0.7).normalize()).to_array();
@@ -544,7 +566,7 @@ fn a_leaf_shape_keeps_the_pdf_exact() {
     let nodes = tree_nodes(levels);
     let top = top_table(levels, &nodes);
     let corners = corner_values(levels);
-    let flat = EnvmapTree::new(levels, &nodes, GRID, &top).unwrap();
+    let flat = EnvmapTree::new(levels, &nodes, GRID, &top, TOP_LEVELS).unwrap();
     let tree = flat.with_corners(&corners).unwrap();
     let n = [0.6, -0.3, 0.1];
     let m = 256;
@@ -639,7 +661,7 @@ fn detailed_leaves_keep_the_pdf_exact() {
     let corners = corner_values(levels);
     let (index, tables, fine) = detail_values(levels);
     assert!(!fine.is_empty() && index.iter().any(|&e| e != 0 && e & FINE_BIT == 0));
-    let shaped = EnvmapTree::new(levels, &nodes, GRID, &top)
+    let shaped = EnvmapTree::new(levels, &nodes, GRID, &top, TOP_LEVELS)
         .unwrap()
         .with_corners(&corners)
         .unwrap();

@@ -8,7 +8,8 @@ use nuld_core::blob::{BlobError, ConditionalError, SectionTag};
 use nuld_core::conditional::{randomization_shift, sections, torus_shift};
 use nuld_core::envmap_tree::{
     build, detail_index_len, node_count, top_len, top_normal, top_row, EnvmapTree, NodeRecord,
-    TreeInfo, DETAIL_LEN, DETAIL_SIDE, FINE_BIT, FINE_LEN, FINE_SIDE,
+    TreeInfo, DETAIL_LEN, DETAIL_SIDE, FINE_BIT, FINE_LEN, FINE_SIDE, LEGACY_TOP_LEVELS,
+    TOP_LEVELS,
 };
 use nuld_core::network::{instance_offset, interleaved_index, lattice_point, Activation};
 use nuld_core::quadtree::QuadtreeError;
@@ -212,8 +213,14 @@ fn corners_reproduce_the_stored_points_exactly() {
 }
 
 /// A tree of 4 levels over a light brighter towards `+x` and `+z`, top weights
-/// on 3 x 3 normals.
+/// on 3 x 3 normals, as written today ([`TOP_LEVELS`] tabulated).
 fn test_tree() -> TreeParts {
+    test_tree_of(TOP_LEVELS)
+}
+
+/// [`test_tree`] with `top_levels` levels in its top table, the info naming
+/// them (0, as blobs written before the field, for [`LEGACY_TOP_LEVELS`]).
+fn test_tree_of(top_levels: u32) -> TreeParts {
     let levels = 4;
     let side = 1usize << levels;
     let leaves: Vec<[f64; 4]> = (0..side * side)
@@ -230,10 +237,11 @@ fn test_tree() -> TreeParts {
     let mut nodes = std::vec![NodeRecord::zeroed(); node_count(levels)];
     build(levels, &leaves, &mut nodes).unwrap();
     let grid = 3;
-    let mut top = std::vec![0.0; top_len(grid)];
-    for (r, row) in top.chunks_mut(84).enumerate() {
+    let mut top = std::vec![0.0; top_len(grid, top_levels)];
+    for (r, row) in top.chunks_mut(node_count(top_levels)).enumerate() {
         top_row(
             levels,
+            top_levels,
             &nodes,
             top_normal(grid, [r as u32 % grid, r as u32 / grid]),
             row,
@@ -242,7 +250,12 @@ fn test_tree() -> TreeParts {
     let info = TreeInfo {
         levels,
         grid,
-        reserved: [0; 2],
+        top_levels: if top_levels == LEGACY_TOP_LEVELS {
+            0
+        } else {
+            top_levels
+        },
+        reserved: 0,
     };
     (info, nodes, top)
 }
@@ -292,6 +305,48 @@ fn envmap_parts() -> Parts {
     p
 }
 
+/// A blob written before `TreeInfo::top_levels` (the field 0, a top table of
+/// [`LEGACY_TOP_LEVELS`] levels) still loads, and samples the tree that core
+/// reads from its sections, with its pdf.
+#[test]
+fn envmap_blobs_of_the_legacy_top_depth_load_and_sample_their_tree() {
+    let mut p = envmap_parts();
+    p.tree = Some(test_tree_of(LEGACY_TOP_LEVELS));
+    let (ti, nodes, top) = p.tree.clone().unwrap();
+    assert_eq!((ti.top_levels, ti.top_levels()), (0, LEGACY_TOP_LEVELS));
+    assert_eq!(top.len(), 9 * 84);
+    let bytes = encode(&p);
+    let cs = Blob::parse(bytes.get()).unwrap().conditional().unwrap();
+    let tree = EnvmapTree::new(ti.levels, &nodes, ti.grid, &top, LEGACY_TOP_LEVELS)
+        .and_then(|t| t.with_detail(&p.detail.0, &p.detail.1))
+        .and_then(|t| t.with_fine_detail(&p.detail.2))
+        .unwrap();
+    let today = test_tree();
+    let today = EnvmapTree::new(4, &today.1, 3, &today.2, TOP_LEVELS).unwrap();
+    let mut differs = 0;
+    for k in 0..64u32 {
+        let q = [(k % 8) as f32 / 7.0, (k / 8) as f32 / 7.0];
+        let u = [0.37f32, 0.81];
+        let got = cs.sample_randomized(Vec2::from(q), k, 3, 11);
+        let point = torus_shift(
+            torus_shift(
+                lattice_point::<f32>(3, p.info.n, p.info.lattice_generator),
+                instance_offset(k),
+            ),
+            randomization_shift(11),
+        );
+        let (want, pdf) = tree.sample_square(q, point);
+        assert_eq!((got.direction.to_array(), got.pdf), (want, pdf), "{k}");
+        assert_eq!(
+            cs.pdf(Vec2::from(q), got.direction),
+            tree.pdf_square(q, want)
+        );
+        // The depth is read: level 4's tabulated weights move some samples.
+        differs += usize::from(today.sample_square(q, u) != tree.sample_square(q, u));
+    }
+    assert!(differs > 8, "{differs}");
+}
+
 /// Table mode of an environment sampler: the corners' stored primary points
 /// interpolated bilinearly in the square (at a node the stored point), then the
 /// tree's warp at the normal of the condition, whose pdf the sample carries;
@@ -305,7 +360,7 @@ fn envmap_tables_interpolate_primary_points_and_warp_them_through_the_tree() {
     let cs = Blob::parse(bytes.get()).unwrap().conditional().unwrap();
     assert_eq!(cs.target(), ConditionalTarget::EnvmapNormal);
     let (ti, nodes, top) = p.tree.clone().unwrap();
-    let tree = EnvmapTree::new(ti.levels, &nodes, ti.grid, &top)
+    let tree = EnvmapTree::new(ti.levels, &nodes, ti.grid, &top, ti.top_levels())
         .and_then(|t| t.with_detail(&p.detail.0, &p.detail.1))
         .and_then(|t| t.with_fine_detail(&p.detail.2))
         .unwrap();
@@ -457,17 +512,38 @@ fn environment_blobs_without_a_sound_prior_are_refused() {
     );
     let tree_err = |e| Err(BlobError::Conditional(e));
     type Mutation = fn(&mut TreeParts);
-    let cases: [(Mutation, ConditionalError); 6] = [
+    let cases: [(Mutation, ConditionalError); 10] = [
         (
             |t| t.0.levels = 2,
             ConditionalError::Tree(QuadtreeError::Levels(2)),
         ),
-        (|t| t.0.reserved[1] = 1, ConditionalError::TreeReserved),
+        // A tree shallower than its top table.
+        (
+            |t| t.0.levels = 3,
+            ConditionalError::Tree(QuadtreeError::Levels(3)),
+        ),
+        (|t| t.0.reserved = 1, ConditionalError::TreeReserved),
+        (
+            |t| t.0.top_levels = 2,
+            ConditionalError::Tree(QuadtreeError::TopLevels(2)),
+        ),
+        (
+            |t| t.0.top_levels = 6,
+            ConditionalError::Tree(QuadtreeError::TopLevels(6)),
+        ),
+        // The info names another depth than the table holds (0: the legacy 3).
+        (
+            |t| t.0.top_levels = 0,
+            ConditionalError::Tree(QuadtreeError::Length {
+                expected: 9 * 84,
+                got: 9 * 340,
+            }),
+        ),
         (
             |t| t.0.grid = 4,
             ConditionalError::Tree(QuadtreeError::Length {
-                expected: 16 * 84,
-                got: 9 * 84,
+                expected: 16 * 340,
+                got: 9 * 340,
             }),
         ),
         (

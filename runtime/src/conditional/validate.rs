@@ -10,7 +10,7 @@ use nuld_core::conditional::{
 };
 use nuld_core::envmap_tree::{
     corner_len, detail_index_len, node_count, top_len, EnvmapTree, NodeRecord, TreeInfo,
-    MAX_TREE_LEVELS, TOP_LEVELS,
+    LEGACY_TOP_LEVELS, MAX_TOP_LEVELS, MAX_TREE_LEVELS,
 };
 use nuld_core::marginal2d::Marginal2DError;
 use nuld_core::network::{Activation, OffsetHash};
@@ -307,15 +307,20 @@ fn tree_view<'a>(layout: &Layout<'a>) -> Result<EnvmapTree<'a>, BlobError> {
     let info: TreeInfo = record(layout, SectionTag::EnvmapTreeInfo, |got, expected| {
         ConditionalError::TreeInfoSize { got, expected }
     })?;
-    if info.reserved != [0; 2] {
+    if info.reserved != 0 {
         return fail(ConditionalError::TreeReserved);
     }
-    if !(TOP_LEVELS..=MAX_TREE_LEVELS).contains(&info.levels) {
+    // 0 in the blobs written before the field: their depth.
+    let top_levels = info.top_levels();
+    if !(LEGACY_TOP_LEVELS..=MAX_TOP_LEVELS).contains(&top_levels) {
+        return fail(ConditionalError::Tree(QuadtreeError::TopLevels(top_levels)));
+    }
+    if !(top_levels..=MAX_TREE_LEVELS).contains(&info.levels) {
         return fail(ConditionalError::Tree(QuadtreeError::Levels(info.levels)));
     }
     if !(2..=1024).contains(&info.grid) {
         return fail(ConditionalError::Tree(QuadtreeError::Length {
-            expected: top_len(info.grid.clamp(2, 1024)) as u64,
+            expected: top_len(info.grid.clamp(2, 1024), top_levels) as u64,
             got: 0,
         }));
     }
@@ -330,7 +335,7 @@ fn tree_view<'a>(layout: &Layout<'a>) -> Result<EnvmapTree<'a>, BlobError> {
         layout,
         SectionTag::EnvmapTreeTop,
         ConditionalError::TreeTopElementSize,
-        || Ok(top_len(info.grid) as u64),
+        || Ok(top_len(info.grid, top_levels) as u64),
         tree_length,
     )?;
     // The leaf shape is optional: without it the leaves are uniform.
@@ -371,7 +376,7 @@ fn tree_view<'a>(layout: &Layout<'a>) -> Result<EnvmapTree<'a>, BlobError> {
         Ok(_) if index.is_empty() => return fail(ConditionalError::TreeDetailAlone),
         Ok(_) => detail_tables(layout, fine_tag)?,
     };
-    EnvmapTree::view(info.levels, nodes, info.grid, top)
+    EnvmapTree::view(info.levels, nodes, info.grid, top, top_levels)
         .and_then(|t| t.with_corners(corners))
         .and_then(|t| t.with_detail(index, tables))
         .and_then(|t| t.with_fine_detail(fine))

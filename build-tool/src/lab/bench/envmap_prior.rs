@@ -21,6 +21,9 @@ use anyhow::{anyhow, Result};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Metadata;
 use nuld_core::conditional::PointWarp;
+use nuld_core::envmap_tree::{
+    node_count, top_len, top_normal, top_row, EnvmapTree as CoreTree, LEGACY_TOP_LEVELS,
+};
 use nuld_core::network::hash_u32;
 use nuld_core::network::Activation;
 use nuld_runtime::glam::Vec3;
@@ -106,6 +109,27 @@ pub fn measure(
             sobol_burley::sample(s % N, 1, seed),
         ]
     };
+    // The same tree with the shallower top table of the blobs written before
+    // `TOP_LEVELS` was 4: what the deeper table costs.
+    let mut legacy_top = vec![0.0f32; top_len(grid, LEGACY_TOP_LEVELS)];
+    for (r, row) in legacy_top
+        .chunks_mut(node_count(LEGACY_TOP_LEVELS))
+        .enumerate()
+    {
+        let j = [r as u32 % grid, r as u32 / grid];
+        top_row(
+            levels,
+            LEGACY_TOP_LEVELS,
+            &tree.nodes,
+            top_normal(grid, j),
+            row,
+        );
+    }
+    let legacy_core = CoreTree::view(levels, &tree.nodes, grid, &legacy_top, LEGACY_TOP_LEVELS)
+        .and_then(|t| t.with_corners(&tree.corners))
+        .and_then(|t| t.with_detail(&tree.detail_index, &tree.detail))
+        .and_then(|t| t.with_fine_detail(&tree.fine))
+        .map_err(|e| anyhow!("{e}"))?;
     // A shallow tree of the same map, whose records (87 KB) stay in the caches:
     // the difference per level from the deep one tells cache misses from the
     // descent's own latency.
@@ -144,6 +168,13 @@ pub fn measure(
         samples,
         |s| {
             black_box(core.sample(normals32[at(s)], u(s)));
+        },
+    );
+    rounds.add(
+        format!("tree L {levels}, top {grid}, {LEGACY_TOP_LEVELS} top levels (blobs before): sample + pdf (f32)"),
+        samples,
+        |s| {
+            black_box(legacy_core.sample(normals32[at(s)], u(s)));
         },
     );
     rounds.add(

@@ -198,11 +198,11 @@ mod tests {
         let rows = evaluate(&map, &s, &|_| {}).unwrap();
         assert_eq!(rows.len(), 4);
         assert_eq!((rows[2].kind, rows[2].size, rows[2].grid), ("tree", 16, 2));
-        // The records, the top table and the corners (no leaf of the tiny map
-        // is sharp enough for detail).
+        // The records, the top table (levels 1 to 4: 340 nodes a normal) and
+        // the corners (no leaf of the tiny map is sharp enough for detail).
         assert_eq!(
             rows[3].state_bytes,
-            16 * ((4usize.pow(5) - 1) / 3 - 1) + 4 * 81 * 84 + 4 * 17 * 17
+            16 * ((4usize.pow(5) - 1) / 3 - 1) + 4 * 81 * ((4usize.pow(5) - 4) / 3) + 4 * 17 * 17
         );
         for r in &rows[..2] {
             let nodes = (r.grid * r.grid) as usize;
