@@ -24,6 +24,7 @@
 //! Results: docs/results/rendering.md#fixed-instance-weight, docs/results/envmap.md#clear-skies.
 use glam::{DVec2, DVec3};
 use nuld_build_tool::sphere::envmap_tree::{prior_levels, PRIOR_GRID};
+use nuld_build_tool::sphere::geometry::spiral_normal;
 use nuld_build_tool::sphere::{DirectionDensity, EnvmapDensity, EnvmapTree};
 use nuld_core::blob::Domain;
 use nuld_core::envmap_tree::node_index;
@@ -59,10 +60,7 @@ fn main() {
     let rows: Vec<[f64; 8]> = (0..64)
         .into_par_iter()
         .map(|k| {
-            let z = 1.0 - (k as f64 + 0.5) / 64.0 * 1.6;
-            let r = (1.0 - z * z).sqrt();
-            let ph = 2.399963 * k as f64;
-            let n = DVec3::new(r * ph.cos(), r * ph.sin(), z);
+            let n = spiral_normal(k as usize, 64);
             let e = map.irradiance(n);
             let q = nuld_core::sphere::sphere_to_square(n).to_array();
             let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(k);

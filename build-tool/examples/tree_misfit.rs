@@ -16,8 +16,9 @@
 //! grid. Below the top levels a node's weight is the moments' bound, loose
 //! where a node straddles the normal's horizon: the misfit grows at the first
 //! level below the table. Results: docs/results/envmap.md#top-levels.
-use glam::DVec3;
+
 use nuld_build_tool::sphere::envmap_tree::{prior_levels, PRIOR_GRID};
+use nuld_build_tool::sphere::geometry::spiral_normal;
 use nuld_build_tool::sphere::{EnvmapDensity, EnvmapTree};
 use nuld_core::blob::Domain;
 use nuld_core::envmap_tree::{
@@ -55,10 +56,7 @@ fn main() {
         let per_normal: Vec<Vec<f64>> = (0..64)
             .into_par_iter()
             .map(|k| {
-                let z = 1.0 - (k as f64 + 0.5) / 64.0 * 1.6;
-                let r = (1.0 - z * z).sqrt();
-                let ph = 2.399963 * k as f64;
-                let n = DVec3::new(r * ph.cos(), r * ph.sin(), z);
+                let n = spiral_normal(k, 64);
                 misfit_by_level(&tree, levels, sphere_to_square(n).to_array())
             })
             .collect();

@@ -16,6 +16,17 @@ pub(crate) fn acos_clamped(x: f64) -> f64 {
     x.clamp(-1.0, 1.0).acos()
 }
 
+/// Normal `k` of `count` spread over the sphere for the lab's per-normal
+/// studies: a golden-angle spiral with `z` from 1 (the zenith, `k = 0`'s
+/// half-step below it) down to -0.6, so that most normals see a map's sky
+/// and some look below its horizon. Unit length; `count` 0 reads as 1.
+pub fn spiral_normal(k: usize, count: usize) -> DVec3 {
+    let z = 1.0 - (k as f64 + 0.5) / count.max(1) as f64 * 1.6;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.399963 * k as f64;
+    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
 /// Normalized `w`, or `+z` when `w` is zero or not finite.
 #[inline]
 pub(crate) fn unit_or_z(w: DVec3) -> DVec3 {
@@ -170,6 +181,17 @@ pub fn map_jacobian(domain: Domain, p: DVec2) -> (DVec3, DVec3) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn spiral_normals_are_unit_and_span_their_band() {
+        let n: Vec<DVec3> = (0..64).map(|k| spiral_normal(k, 64)).collect();
+        assert!(n.iter().all(|v| (v.length() - 1.0).abs() < 1e-12));
+        assert!((n[0].z - (1.0 - 0.8 / 64.0)).abs() < 1e-12);
+        assert!((n[63].z - (1.0 - 63.5 / 64.0 * 1.6)).abs() < 1e-12);
+        // Consecutive normals turn by the golden angle about z.
+        let turn = n[2].y.atan2(n[2].x) - n[1].y.atan2(n[1].x);
+        assert!((turn.rem_euclid(std::f64::consts::TAU) - 2.399963).abs() < 1e-9);
+    }
     use crate::seeding::rng;
     use glam::DVec2;
     use nuld_core::sphere::square_to_hemisphere;
