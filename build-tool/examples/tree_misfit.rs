@@ -4,7 +4,7 @@
 //! cores).
 //!
 //! The tree as the bake builds it, its top table tabulated again for each
-//! depth `T` (`nuld_core::envmap_tree::top_row`; the bake writes
+//! depth `T` (`envmap_tree::top_table`; the bake writes
 //! `TOP_LEVELS`). At 64 normals spread over the sphere (`z` from 1 down to
 //! -0.6, as `leaf_shape`), for each level `l` the probability `P(node)` that
 //! the descent gives each node of level `l` (the product of its ancestors'
@@ -17,13 +17,12 @@
 //! where a node straddles the normal's horizon: the misfit grows at the first
 //! level below the table. Results: docs/results/envmap.md#top-levels.
 
-use nuld_build_tool::sphere::envmap_tree::{prior_levels, PRIOR_GRID};
+use nuld_build_tool::sphere::envmap_tree::{prior_levels, top_table, PRIOR_GRID};
 use nuld_build_tool::sphere::geometry::spiral_normal;
 use nuld_build_tool::sphere::{EnvmapDensity, EnvmapTree};
 use nuld_core::blob::Domain;
 use nuld_core::envmap_tree::{
-    node_count, node_index, top_len, top_normal, top_row, EnvmapTree as CoreTree,
-    LEGACY_TOP_LEVELS, MAX_TOP_LEVELS,
+    node_index, EnvmapTree as CoreTree, LEGACY_TOP_LEVELS, MAX_TOP_LEVELS,
 };
 use nuld_core::quadtree::{ChildWeights, Node};
 use nuld_core::sphere::{sphere_to_square, square_to_sphere_real};
@@ -45,13 +44,7 @@ fn main() {
         args[1]
     );
     for t in LEGACY_TOP_LEVELS..=MAX_TOP_LEVELS {
-        let mut top = vec![0.0f32; top_len(grid, t)];
-        top.par_chunks_mut(node_count(t))
-            .enumerate()
-            .for_each(|(r, row)| {
-                let j = [r as u32 % grid, r as u32 / grid];
-                top_row(levels, t, nodes, top_normal(grid, j), row);
-            });
+        let top = top_table(levels, t, nodes, grid);
         let tree = CoreTree::new(levels, nodes, grid, &top, t).unwrap();
         let per_normal: Vec<Vec<f64>> = (0..64)
             .into_par_iter()

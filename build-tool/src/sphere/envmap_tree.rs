@@ -335,6 +335,21 @@ fn detail_tables(
     (index, tables, fine)
 }
 
+/// The top-weight table of `top_levels` levels for the tree of `levels` levels
+/// whose records are `nodes`: [`top_row`] at each of the `grid x grid` normals
+/// ([`top_normal`]), [`top_len`]`(grid, top_levels)` values, the rows in
+/// parallel (each row reads every leaf record once).
+pub fn top_table(levels: u32, top_levels: u32, nodes: &[NodeRecord], grid: u32) -> Vec<f32> {
+    let mut top = vec![0.0; top_len(grid, top_levels)];
+    top.par_chunks_mut(node_count(top_levels))
+        .enumerate()
+        .for_each(|(r, row)| {
+            let j = [r as u32 % grid, r as u32 / grid];
+            top_row(levels, top_levels, nodes, top_normal(grid, j), row);
+        });
+    top
+}
+
 /// [`QuadtreeError::Levels`] unless `levels` is in [`TOP_LEVELS`]`..=`[`MAX_TREE_LEVELS`].
 fn check_levels(levels: u32) -> Result<(), QuadtreeError> {
     if (TOP_LEVELS..=MAX_TREE_LEVELS).contains(&levels) {
@@ -443,12 +458,7 @@ impl EnvmapTree {
                 got: 0,
             });
         }
-        let per = node_count(TOP_LEVELS);
-        let mut top = vec![0.0; top_len(grid, TOP_LEVELS)];
-        top.par_chunks_mut(per).enumerate().for_each(|(r, row)| {
-            let j = [r as u32 % grid, r as u32 / grid];
-            top_row(levels, TOP_LEVELS, &nodes, top_normal(grid, j), row);
-        });
+        let top = top_table(levels, TOP_LEVELS, &nodes, grid);
         let corners = leaf_corners(&light, levels, &leaves);
         let masses: Vec<f64> = leaves.iter().map(|m| m[0]).collect();
         let (detail_index, detail, fine) = detail_tables(&light, levels, sharp, &masses);

@@ -15,15 +15,13 @@ use super::runtime::{envmap_parts, random_parts, random_shape};
 use crate::baselines::EnvmapLight;
 use crate::conditional::blob::ConditionalParts;
 use crate::pointset::AlignedBytes;
-use crate::sphere::envmap_tree::{prior_levels, PRIOR_GRID};
+use crate::sphere::envmap_tree::{prior_levels, top_table, PRIOR_GRID};
 use crate::sphere::{DirectionDensity, EnvmapDensity, EnvmapTree};
 use anyhow::{anyhow, Result};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Metadata;
 use nuld_core::conditional::PointWarp;
-use nuld_core::envmap_tree::{
-    node_count, top_len, top_normal, top_row, EnvmapTree as CoreTree, LEGACY_TOP_LEVELS,
-};
+use nuld_core::envmap_tree::{EnvmapTree as CoreTree, LEGACY_TOP_LEVELS};
 use nuld_core::network::hash_u32;
 use nuld_core::network::Activation;
 use nuld_runtime::glam::Vec3;
@@ -111,20 +109,7 @@ pub fn measure(
     };
     // The same tree with the shallower top table of the blobs written before
     // `TOP_LEVELS` was 4: what the deeper table costs.
-    let mut legacy_top = vec![0.0f32; top_len(grid, LEGACY_TOP_LEVELS)];
-    for (r, row) in legacy_top
-        .chunks_mut(node_count(LEGACY_TOP_LEVELS))
-        .enumerate()
-    {
-        let j = [r as u32 % grid, r as u32 / grid];
-        top_row(
-            levels,
-            LEGACY_TOP_LEVELS,
-            &tree.nodes,
-            top_normal(grid, j),
-            row,
-        );
-    }
+    let legacy_top = top_table(levels, LEGACY_TOP_LEVELS, &tree.nodes, grid);
     let legacy_core = CoreTree::view(levels, &tree.nodes, grid, &legacy_top, LEGACY_TOP_LEVELS)
         .and_then(|t| t.with_corners(&tree.corners))
         .and_then(|t| t.with_detail(&tree.detail_index, &tree.detail))
