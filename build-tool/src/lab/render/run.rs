@@ -1,7 +1,8 @@
 //! `build-tool render`: the whole evaluation of paper Fig. 8 into one directory.
 //!
 //! Writes into `DIR`: `render.csv` ([`super::summary::CSV_HEADER`], one row per
-//! technique, sampler, spp and seed), `render-summary.md` (equal-sample-count
+//! technique, sampler, spp and seed; the RMSE over the image and over each
+//! surface class), `render-summary.md` (equal-sample-count
 //! and equal-time tables, means over the seeds with their standard errors),
 //! `reference.png` and the cached `reference-KEY.bin`, `images/T-S-N.png`
 //! (technique `T`, sampler `S`, `N` spp, the first seed; tone-mapped with the
@@ -21,8 +22,8 @@ use super::nuld_sampler::FixedWeight;
 use super::picture::{error_map, exposure, tone_map, Picture};
 use super::reference::Reference;
 use super::sampler::Technique;
-use super::scene::Scene;
-use super::summary::{csv, errors, markdown, Row};
+use super::scene::{Scene, SurfaceClass};
+use super::summary::{csv, errors, errors_by_surface, markdown, Row};
 use crate::conditional::bake::BakeConfig;
 use crate::output::{ensure_dir, write_atomic};
 use crate::plot::{render_composite, Composite, Tile};
@@ -211,11 +212,15 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
             (r, t.elapsed().as_secs_f64())
         }
     };
-    let mask = setup.per_pixel(
+    let classes = setup.per_pixel(
         || (),
-        |_, x, y| matches!(setup.primary(x, y), Primary::Surface { .. }),
+        |_, x, y| match setup.primary(x, y) {
+            Primary::Surface { position, at } => Some(SurfaceClass::of(position, &at.material)),
+            Primary::Background(_) => None,
+        },
         &|| {},
     );
+    let mask: Vec<bool> = classes.iter().map(Option::is_some).collect();
     let surface = mask.iter().filter(|m| **m).count().max(1);
     let reference_stderr = reference
         .stderr
@@ -298,6 +303,7 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
                 let image = setup.render(sampler.as_ref(), n, seed, &|| progress.inc(1));
                 let seconds = t.elapsed().as_secs_f64();
                 let (rmse, bias) = errors(&image, &reference.image, &mask);
+                let rmse_by_surface = errors_by_surface(&image, &reference.image, &classes);
                 let row = Row {
                     technique: sampler.technique().name().to_string(),
                     sampler: sampler.name().to_string(),
@@ -306,6 +312,7 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
                     rmse,
                     bias,
                     seconds,
+                    rmse_by_surface,
                 };
                 if k == 0 {
                     let picture = tone_map(&image, exposure);
@@ -487,7 +494,10 @@ mod tests {
         let csv_text = std::fs::read_to_string(out.join("render.csv")).unwrap();
         let mut lines = csv_text.lines();
         assert_eq!(lines.next(), Some(CSV_HEADER));
-        assert_eq!(CSV_HEADER, "technique,sampler,spp,seed,rmse,bias,seconds");
+        assert_eq!(
+            CSV_HEADER,
+            "technique,sampler,spp,seed,rmse,bias,seconds,rmse_dielectric,rmse_metal,rmse_ground"
+        );
         let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
         let per_seed: usize = (Technique::ALL.iter())
             .map(|t| lineup::names(*t, true).len())
@@ -510,6 +520,19 @@ mod tests {
                                 && nums[0].is_finite()
                                 && nums[1].is_finite()
                                 && nums[2] >= 0.0,
+                            "{row:?}"
+                        );
+                        // The scene shows every class; the image's mean square
+                        // error is their pixel-weighted mean, so its RMSE lies
+                        // between theirs (to the CSV's 7 digits).
+                        let by_class = &nums[3..6];
+                        let lo = by_class.iter().copied().fold(f64::INFINITY, f64::min);
+                        let hi = by_class.iter().copied().fold(0.0, f64::max);
+                        assert!(
+                            lo > 0.0
+                                && hi.is_finite()
+                                && nums[0] >= lo * (1.0 - 1e-6)
+                                && nums[0] <= hi * (1.0 + 1e-6),
                             "{row:?}"
                         );
                     }
@@ -547,8 +570,16 @@ mod tests {
         assert_eq!(second.reference_seconds, 0.0, "the reference is reused");
         for (a, b) in first.rows.iter().zip(&second.rows) {
             assert_eq!(
-                (a.rmse.to_bits(), a.bias.to_bits()),
-                (b.rmse.to_bits(), b.bias.to_bits()),
+                (
+                    a.rmse.to_bits(),
+                    a.bias.to_bits(),
+                    a.rmse_by_surface.map(f64::to_bits)
+                ),
+                (
+                    b.rmse.to_bits(),
+                    b.bias.to_bits(),
+                    b.rmse_by_surface.map(f64::to_bits)
+                ),
                 "{}",
                 a.sampler
             );

@@ -88,6 +88,63 @@ pub struct Hit {
     pub material: Material,
 }
 
+/// The classes of surface that `render` splits its error by: what decides a
+/// pixel's error differs between them (under environment sampling alone a
+/// smooth metal's rare hits on bright light carry weights in the thousands, the
+/// ground's never do).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SurfaceClass {
+    /// Spheres of metallic 0.5 or less.
+    DielectricSpheres,
+    /// Spheres of metallic above 0.5.
+    MetalSpheres,
+    /// The ground plane `z = 0`.
+    Ground,
+}
+
+impl SurfaceClass {
+    /// Every class, in print order (`index` is the place in it).
+    pub const ALL: [SurfaceClass; 3] = [
+        SurfaceClass::DielectricSpheres,
+        SurfaceClass::MetalSpheres,
+        SurfaceClass::Ground,
+    ];
+
+    /// The class of a surface point at `position` of `material`: the ground where
+    /// `z` is within 1e-9 of 0 (every sphere rests above it), else a sphere,
+    /// metal for metallic above 0.5.
+    pub fn of(position: DVec3, material: &Material) -> Self {
+        match (position.z < 1e-9, material.metallic > 0.5) {
+            (true, _) => Self::Ground,
+            (false, true) => Self::MetalSpheres,
+            (false, false) => Self::DielectricSpheres,
+        }
+    }
+
+    /// Its place in [`Self::ALL`].
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+
+    /// Its name in prose: `dielectric spheres`, `metal spheres`, `ground`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::DielectricSpheres => "dielectric spheres",
+            Self::MetalSpheres => "metal spheres",
+            Self::Ground => "ground",
+        }
+    }
+
+    /// Its `render.csv` column: `rmse_dielectric`, `rmse_metal`, `rmse_ground`.
+    pub const fn column(self) -> &'static str {
+        match self {
+            Self::DielectricSpheres => "rmse_dielectric",
+            Self::MetalSpheres => "rmse_metal",
+            Self::Ground => "rmse_ground",
+        }
+    }
+}
+
 /// Spheres on the ground plane `z = 0` (an infinite plane of material `ground`;
 /// `None`: no ground).
 #[derive(Clone, Debug, PartialEq)]

@@ -5,7 +5,10 @@
 //! Over the `P` pixels that show a surface (the background is exact for every
 //! sampler and left out), with `e_p` the image minus the reference:
 //! `rmse = sqrt((1/P) Σ e_p^2)`, `bias = (1/P) Σ e_p` (each pixel is its own
-//! instance of the sampler, so this is the mean signed error over instances too).
+//! instance of the sampler, so this is the mean signed error over instances too),
+//! and the RMSE over each [`SurfaceClass`]'s pixels alone (where a few fireflies
+//! on the metals decide the image's figure, the ground's still tells the
+//! samplers apart).
 //!
 //! A render repeats every image at `K` seeds (other scrambles, instances and
 //! pools); the tables give each figure's mean over the seeds and its standard
@@ -13,10 +16,12 @@
 //! seed-to-seed spread.
 
 use super::integrator::Image;
+use super::scene::SurfaceClass;
 use std::fmt::Write as _;
 
 /// The header of `render.csv`.
-pub const CSV_HEADER: &str = "technique,sampler,spp,seed,rmse,bias,seconds";
+pub const CSV_HEADER: &str =
+    "technique,sampler,spp,seed,rmse,bias,seconds,rmse_dielectric,rmse_metal,rmse_ground";
 
 /// One line of `render.csv`.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -35,6 +40,9 @@ pub struct Row {
     pub bias: f64,
     /// Wall time of the render, seconds.
     pub seconds: f64,
+    /// Root mean squared error over each class's pixels, in
+    /// [`SurfaceClass::ALL`]'s order (0 for a class without pixels).
+    pub rmse_by_surface: [f64; 3],
 }
 
 /// `(rmse, bias)` of `image` against `reference` over the pixels where `mask` is
@@ -55,14 +63,45 @@ pub fn errors(image: &Image, reference: &Image, mask: &[bool]) -> (f64, f64) {
     ((s2 / k as f64).sqrt(), s / k as f64)
 }
 
+/// The RMSE of `image` against `reference` over each class's pixels
+/// ([`SurfaceClass::ALL`]'s order; `None` pixels, the background, left out; 0
+/// for a class without pixels).
+pub fn errors_by_surface(
+    image: &Image,
+    reference: &Image,
+    classes: &[Option<SurfaceClass>],
+) -> [f64; 3] {
+    let mut sums = [(0.0, 0usize); 3];
+    for ((a, b), c) in image.values.iter().zip(&reference.values).zip(classes) {
+        if let Some(c) = c {
+            let s = &mut sums[c.index()];
+            s.0 += (a - b) * (a - b);
+            s.1 += 1;
+        }
+    }
+    sums.map(|(s2, k)| match k {
+        0 => 0.0,
+        _ => (s2 / k as f64).sqrt(),
+    })
+}
+
 /// `render.csv`: [`CSV_HEADER`] and one line per row.
 pub fn csv(rows: &[Row]) -> String {
     let mut out = format!("{CSV_HEADER}\n");
     for r in rows {
         let _ = writeln!(
             out,
-            "{},{},{},{},{:.6e},{:.6e},{:.4}",
-            r.technique, r.sampler, r.spp, r.seed, r.rmse, r.bias, r.seconds
+            "{},{},{},{},{:.6e},{:.6e},{:.4},{:.6e},{:.6e},{:.6e}",
+            r.technique,
+            r.sampler,
+            r.spp,
+            r.seed,
+            r.rmse,
+            r.bias,
+            r.seconds,
+            r.rmse_by_surface[0],
+            r.rmse_by_surface[1],
+            r.rmse_by_surface[2]
         );
     }
     out
@@ -133,7 +172,7 @@ fn stat(
     technique: &str,
     sampler: &str,
     spp: u32,
-    f: fn(&Row) -> f64,
+    f: impl Fn(&Row) -> f64,
 ) -> Option<Stat> {
     let v: Vec<f64> = rows
         .iter()
@@ -162,6 +201,11 @@ pub fn means(rows: &[Row]) -> Vec<Row> {
             rmse: m(|r| r.rmse),
             bias: m(|r| r.bias),
             seconds: m(|r| r.seconds),
+            rmse_by_surface: [
+                m(|r| r.rmse_by_surface[0]),
+                m(|r| r.rmse_by_surface[1]),
+                m(|r| r.rmse_by_surface[2]),
+            ],
             ..r.clone()
         });
     }
@@ -194,7 +238,8 @@ pub fn rmse_at_time(rows: &[Row], technique: &str, sampler: &str, seconds: f64) 
 
 /// `render-summary.md`: per technique, the RMSE table at equal sample counts
 /// (rows = samplers, columns = spp; mean ± standard error over the seeds, the
-/// lowest mean of each column in bold), the bias table likewise, and the RMSE
+/// lowest mean of each column in bold), the bias table likewise, the RMSE
+/// table of each [`SurfaceClass`]'s pixels alone (where the rows hold them), and the RMSE
 /// table at equal time (the mean times of `owen-sobol` at each spp; `–` where a
 /// sampler's measured times do not reach).
 pub fn markdown(rows: &[Row]) -> String {
@@ -216,25 +261,26 @@ pub fn markdown(rows: &[Row]) -> String {
             continue;
         }
         let at = |s: &str, n: u32, f: fn(&Row) -> f64| stat(rows, technique, s, n, f);
-        let best = |n: u32| {
-            samplers
-                .iter()
-                .filter_map(|s| at(s, n, |r| r.rmse).map(|st| st.mean))
-                .fold(f64::INFINITY, f64::min)
-        };
         let spp_columns: Vec<String> = spp.iter().map(|n| n.to_string()).collect();
-        table(
-            &mut out,
-            &format!("{technique}: RMSE at equal sample count (spp)"),
-            &spp_columns,
-            &samplers,
-            |s, c| {
+        let ranked = |out: &mut String, title: &str, figure: &dyn Fn(&Row) -> f64| {
+            let best = |n: u32| {
+                samplers
+                    .iter()
+                    .filter_map(|s| stat(rows, technique, s, n, figure).map(|st| st.mean))
+                    .fold(f64::INFINITY, f64::min)
+            };
+            table(out, title, &spp_columns, &samplers, |s, c| {
                 let n = spp[c];
-                at(s, n, |r| r.rmse).map(|st| match st.mean == best(n) {
+                stat(rows, technique, s, n, figure).map(|st| match st.mean == best(n) {
                     true => format!("**{}**", st.show(false)),
                     false => st.show(false),
                 })
-            },
+            });
+        };
+        ranked(
+            &mut out,
+            &format!("{technique}: RMSE at equal sample count (spp)"),
+            &|r| r.rmse,
         );
         table(
             &mut out,
@@ -243,6 +289,22 @@ pub fn markdown(rows: &[Row]) -> String {
             &samplers,
             |s, c| at(s, spp[c], |r| r.bias).map(|st| st.show(true)),
         );
+        // Rows of a scene without classes (all 0) have no split to show.
+        if rows
+            .iter()
+            .any(|r| r.rmse_by_surface.iter().any(|&e| e > 0.0))
+        {
+            for class in SurfaceClass::ALL {
+                ranked(
+                    &mut out,
+                    &format!(
+                        "{technique}: RMSE on the {} alone at equal sample count",
+                        class.name()
+                    ),
+                    &|r| r.rmse_by_surface[class.index()],
+                );
+            }
+        }
         let budgets: Vec<f64> = spp
             .iter()
             .filter_map(|&n| at("owen-sobol", n, |r| r.seconds).map(|st| st.mean))
@@ -310,6 +372,7 @@ mod tests {
             rmse,
             bias: 0.0,
             seconds,
+            rmse_by_surface: [0.0; 3],
         }
     }
 
@@ -330,13 +393,61 @@ mod tests {
     }
 
     #[test]
+    fn errors_by_surface_are_each_class_rmse_alone() {
+        use SurfaceClass::*;
+        let a = Image {
+            width: 5,
+            height: 1,
+            values: vec![1.0, 5.0, 100.0, 3.0, 7.0],
+        };
+        let b = Image {
+            width: 5,
+            height: 1,
+            values: vec![2.0, 2.0, 0.0, 3.0, 1.0],
+        };
+        let classes = [
+            Some(Ground),
+            Some(Ground),
+            None,
+            Some(MetalSpheres),
+            Some(MetalSpheres),
+        ];
+        // Ground: errors -1 and 3, sqrt(10 / 2); metal: 0 and 6, sqrt(36 / 2);
+        // no dielectric pixel: 0; the background's 100 counts nowhere.
+        let e = errors_by_surface(&a, &b, &classes);
+        assert_eq!(e[DielectricSpheres.index()], 0.0);
+        assert!((e[Ground.index()] - 5f64.sqrt()).abs() < 1e-15);
+        assert!((e[MetalSpheres.index()] - 18f64.sqrt()).abs() < 1e-15);
+        // The summary ranks each class on its own: the sampler lower on the
+        // ground is in bold there though higher over the image.
+        let with = |sampler: &str, rmse: f64, ground: f64| Row {
+            rmse_by_surface: [0.5, 0.5, ground],
+            ..row(sampler, 4, rmse, 1.0)
+        };
+        let md = markdown(&[with("ours", 2.0, 0.25), with("owen-sobol", 1.0, 0.75)]);
+        let ground = md
+            .split("## brdf: RMSE on the ground alone")
+            .nth(1)
+            .expect("a ground table");
+        assert!(ground.contains("| ours | **2.5000e-1** |"), "{md}");
+        assert!(md.contains("| owen-sobol | **1.0000e0** |"), "{md}");
+        // The CSV's last columns are the classes', in their order.
+        let columns = SurfaceClass::ALL.map(SurfaceClass::column).join(",");
+        assert!(CSV_HEADER.ends_with(&format!(",{columns}")));
+        // Rows without classes print no split.
+        assert!(!markdown(&[row("a", 4, 1.0, 1.0)]).contains("alone"));
+    }
+
+    #[test]
     fn equal_time_interpolates_log_log_and_refuses_to_extrapolate() {
         // rmse = 1/sqrt(t): at t = 4 between (1, 1) and (16, 0.25) it is 0.5.
         let rows = vec![row("a", 4, 1.0, 1.0), row("a", 64, 0.25, 16.0)];
         assert!((rmse_at_time(&rows, "brdf", "a", 4.0).unwrap() - 0.5).abs() < 1e-12);
         assert!(rmse_at_time(&rows, "brdf", "a", 32.0).is_none());
         let csv = csv(&rows);
-        assert!(csv.starts_with("technique,sampler,spp,seed,rmse,bias,seconds\nbrdf,a,4,0,"));
+        assert!(csv.starts_with(
+            "technique,sampler,spp,seed,rmse,bias,seconds,rmse_dielectric,rmse_metal,rmse_ground\nbrdf,a,4,0,"
+        ));
         let md = markdown(&[
             row("owen-sobol", 4, 1.0, 1.0),
             row("owen-sobol", 64, 0.5, 2.0),
