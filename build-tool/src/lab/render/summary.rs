@@ -65,23 +65,15 @@ pub fn errors(image: &Image, reference: &Image, mask: &[bool]) -> (f64, f64) {
 
 /// The RMSE of `image` against `reference` over each class's pixels
 /// ([`SurfaceClass::ALL`]'s order; `None` pixels, the background, left out; 0
-/// for a class without pixels).
+/// for a class without pixels): [`errors`] over each class's mask.
 pub fn errors_by_surface(
     image: &Image,
     reference: &Image,
     classes: &[Option<SurfaceClass>],
 ) -> [f64; 3] {
-    let mut sums = [(0.0, 0usize); 3];
-    for ((a, b), c) in image.values.iter().zip(&reference.values).zip(classes) {
-        if let Some(c) = c {
-            let s = &mut sums[c.index()];
-            s.0 += (a - b) * (a - b);
-            s.1 += 1;
-        }
-    }
-    sums.map(|(s2, k)| match k {
-        0 => 0.0,
-        _ => (s2 / k as f64).sqrt(),
+    SurfaceClass::ALL.map(|class| {
+        let mask: Vec<bool> = classes.iter().map(|c| *c == Some(class)).collect();
+        errors(image, reference, &mask).0
     })
 }
 
