@@ -668,16 +668,26 @@ pub struct Lit<'a, T> {
 }
 
 impl<T: Real> Lit<'_, T> {
-    /// Bilinear interpolation of top-table node `node`'s weight at the normal.
+    /// Bilinear interpolation of the weights of the four top-table nodes from
+    /// `first` on (a node's children, stored side by side) at the normal. Each
+    /// of the four grid normals' rows is read as one run of four values, not
+    /// four lookups (a missing run reads as 0).
     #[inline]
-    fn top_weight(&self, node: usize) -> T {
+    fn top_weights(&self, first: usize) -> [T; 4] {
         let [tx, ty] = self.top_at;
-        let v = self
-            .top_rows
-            .map(|r| T::of(self.tree.top.get(r + node).copied().unwrap_or(0.0) as f64));
-        let a = v[0] + (v[1] - v[0]) * tx;
-        let b = v[2] + (v[3] - v[2]) * tx;
-        a + (b - a) * ty
+        let run = |r: usize| -> [f32; 4] {
+            match self.tree.top.get(r + first..r + first + 4) {
+                Some(&[a, b, c, d]) => [a, b, c, d],
+                _ => [0.0; 4],
+            }
+        };
+        let v = self.top_rows.map(run);
+        core::array::from_fn(|k| {
+            let at = |row: usize| T::of(v[row][k] as f64);
+            let a = at(0) + (at(1) - at(0)) * tx;
+            let b = at(2) + (at(3) - at(2)) * tx;
+            a + (b - a) * ty
+        })
     }
 }
 
@@ -694,7 +704,8 @@ impl<T: Real> ChildWeights<T> for Lit<'_, T> {
         };
         let bound: [T; 4] = core::array::from_fn(|k| c[k].weight(self.n));
         if level < self.tree.top_levels {
-            core::array::from_fn(|k| self.top_weight(first + k).max(bound[k] * T::of(TOP_FLOOR)))
+            let top = self.top_weights(first);
+            core::array::from_fn(|k| top[k].max(bound[k] * T::of(TOP_FLOOR)))
         } else {
             bound
         }

@@ -1261,7 +1261,7 @@ fn nuld_lit_square(t: NuldTree, q0: vec2<f32>) -> NuldLit {
     return lit;
 }
 
-// Rust: `Lit::top_weight`: top-table node `node` interpolated at the normal.
+// Rust: `Lit::top_weights` (one of its four): top-table node `node` interpolated at the normal.
 fn nuld_top_weight(t: NuldTree, lit: NuldLit, node: u32) -> f32 {
     let row = lit.j0.y * t.grid + lit.j0.x;
     let w00 = nuld_f32(t.top + 4u * (row * t.top_nodes + node));
