@@ -303,7 +303,7 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
                 let image = setup.render(sampler.as_ref(), n, seed, &|| progress.inc(1));
                 let seconds = t.elapsed().as_secs_f64();
                 let (rmse, bias) = errors(&image, &reference.image, &mask);
-                let rmse_by_surface = errors_by_surface(&image, &reference.image, &classes);
+                let by_surface = errors_by_surface(&image, &reference.image, &classes);
                 let row = Row {
                     technique: sampler.technique().name().to_string(),
                     sampler: sampler.name().to_string(),
@@ -312,7 +312,8 @@ pub fn render(config: &RenderConfig, out: &Path) -> Result<RenderReport> {
                     rmse,
                     bias,
                     seconds,
-                    rmse_by_surface,
+                    rmse_by_surface: by_surface.map(|(rmse, _)| rmse),
+                    bias_by_surface: by_surface.map(|(_, bias)| bias),
                 };
                 if k == 0 {
                     let picture = tone_map(&image, exposure);
@@ -496,7 +497,8 @@ mod tests {
         assert_eq!(lines.next(), Some(CSV_HEADER));
         assert_eq!(
             CSV_HEADER,
-            "technique,sampler,spp,seed,rmse,bias,seconds,rmse_dielectric,rmse_metal,rmse_ground"
+            "technique,sampler,spp,seed,rmse,bias,seconds,rmse_dielectric,rmse_metal,rmse_ground,\
+             bias_dielectric,bias_metal,bias_ground"
         );
         let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
         let per_seed: usize = (Technique::ALL.iter())
@@ -533,6 +535,16 @@ mod tests {
                                 && hi.is_finite()
                                 && nums[0] >= lo * (1.0 - 1e-6)
                                 && nums[0] <= hi * (1.0 + 1e-6),
+                            "{row:?}"
+                        );
+                        // Likewise the image's bias, the pixel-weighted mean of
+                        // the classes' biases (signed; the CSV's rounding apart).
+                        let biases = &nums[6..9];
+                        let lo = biases.iter().copied().fold(f64::INFINITY, f64::min);
+                        let hi = biases.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                        let slack = 1e-6 * (lo.abs() + hi.abs());
+                        assert!(
+                            nums[1] >= lo - slack && nums[1] <= hi + slack && lo < hi,
                             "{row:?}"
                         );
                     }
@@ -573,12 +585,14 @@ mod tests {
                 (
                     a.rmse.to_bits(),
                     a.bias.to_bits(),
-                    a.rmse_by_surface.map(f64::to_bits)
+                    a.rmse_by_surface.map(f64::to_bits),
+                    a.bias_by_surface.map(f64::to_bits)
                 ),
                 (
                     b.rmse.to_bits(),
                     b.bias.to_bits(),
-                    b.rmse_by_surface.map(f64::to_bits)
+                    b.rmse_by_surface.map(f64::to_bits),
+                    b.bias_by_surface.map(f64::to_bits)
                 ),
                 "{}",
                 a.sampler

@@ -135,12 +135,23 @@ impl SurfaceClass {
         }
     }
 
-    /// Its `render.csv` column: `rmse_dielectric`, `rmse_metal`, `rmse_ground`.
+    /// Its RMSE's `render.csv` column: `rmse_dielectric`, `rmse_metal`,
+    /// `rmse_ground`.
     pub const fn column(self) -> &'static str {
         match self {
             Self::DielectricSpheres => "rmse_dielectric",
             Self::MetalSpheres => "rmse_metal",
             Self::Ground => "rmse_ground",
+        }
+    }
+
+    /// Its bias's `render.csv` column: `bias_dielectric`, `bias_metal`,
+    /// `bias_ground`.
+    pub const fn bias_column(self) -> &'static str {
+        match self {
+            Self::DielectricSpheres => "bias_dielectric",
+            Self::MetalSpheres => "bias_metal",
+            Self::Ground => "bias_ground",
         }
     }
 }

@@ -6,9 +6,10 @@
 //! sampler and left out), with `e_p` the image minus the reference:
 //! `rmse = sqrt((1/P) Σ e_p^2)`, `bias = (1/P) Σ e_p` (each pixel is its own
 //! instance of the sampler, so this is the mean signed error over instances too),
-//! and the RMSE over each [`SurfaceClass`]'s pixels alone (where a few fireflies
-//! on the metals decide the image's figure, the ground's still tells the
-//! samplers apart).
+//! and the RMSE and bias over each [`SurfaceClass`]'s pixels alone (where a few
+//! fireflies on the metals decide the image's figure, the ground's still tells
+//! the samplers apart; and a fixed instance's bias on one class can hide in the
+//! image's mean behind another's of the other sign).
 //!
 //! A render repeats every image at `K` seeds (other scrambles, instances and
 //! pools); the tables give each figure's mean over the seeds and its standard
@@ -20,8 +21,8 @@ use super::scene::SurfaceClass;
 use std::fmt::Write as _;
 
 /// The header of `render.csv`.
-pub const CSV_HEADER: &str =
-    "technique,sampler,spp,seed,rmse,bias,seconds,rmse_dielectric,rmse_metal,rmse_ground";
+pub const CSV_HEADER: &str = "technique,sampler,spp,seed,rmse,bias,seconds,\
+rmse_dielectric,rmse_metal,rmse_ground,bias_dielectric,bias_metal,bias_ground";
 
 /// One line of `render.csv`.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -43,6 +44,9 @@ pub struct Row {
     /// Root mean squared error over each class's pixels, in
     /// [`SurfaceClass::ALL`]'s order (0 for a class without pixels).
     pub rmse_by_surface: [f64; 3],
+    /// Mean signed error over each class's pixels, in [`SurfaceClass::ALL`]'s
+    /// order (0 for a class without pixels).
+    pub bias_by_surface: [f64; 3],
 }
 
 /// `(rmse, bias)` of `image` against `reference` over the pixels where `mask` is
@@ -63,17 +67,17 @@ pub fn errors(image: &Image, reference: &Image, mask: &[bool]) -> (f64, f64) {
     ((s2 / k as f64).sqrt(), s / k as f64)
 }
 
-/// The RMSE of `image` against `reference` over each class's pixels
-/// ([`SurfaceClass::ALL`]'s order; `None` pixels, the background, left out; 0
-/// for a class without pixels): [`errors`] over each class's mask.
+/// `(rmse, bias)` of `image` against `reference` over each class's pixels
+/// ([`SurfaceClass::ALL`]'s order; `None` pixels, the background, left out;
+/// `(0, 0)` for a class without pixels): [`errors`] over each class's mask.
 pub fn errors_by_surface(
     image: &Image,
     reference: &Image,
     classes: &[Option<SurfaceClass>],
-) -> [f64; 3] {
+) -> [(f64, f64); 3] {
     SurfaceClass::ALL.map(|class| {
         let mask: Vec<bool> = classes.iter().map(|c| *c == Some(class)).collect();
-        errors(image, reference, &mask).0
+        errors(image, reference, &mask)
     })
 }
 
@@ -83,7 +87,7 @@ pub fn csv(rows: &[Row]) -> String {
     for r in rows {
         let _ = writeln!(
             out,
-            "{},{},{},{},{:.6e},{:.6e},{:.4},{:.6e},{:.6e},{:.6e}",
+            "{},{},{},{},{:.6e},{:.6e},{:.4},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e}",
             r.technique,
             r.sampler,
             r.spp,
@@ -93,7 +97,10 @@ pub fn csv(rows: &[Row]) -> String {
             r.seconds,
             r.rmse_by_surface[0],
             r.rmse_by_surface[1],
-            r.rmse_by_surface[2]
+            r.rmse_by_surface[2],
+            r.bias_by_surface[0],
+            r.bias_by_surface[1],
+            r.bias_by_surface[2]
         );
     }
     out
@@ -198,6 +205,11 @@ pub fn means(rows: &[Row]) -> Vec<Row> {
                 m(|r| r.rmse_by_surface[1]),
                 m(|r| r.rmse_by_surface[2]),
             ],
+            bias_by_surface: [
+                m(|r| r.bias_by_surface[0]),
+                m(|r| r.bias_by_surface[1]),
+                m(|r| r.bias_by_surface[2]),
+            ],
             ..r.clone()
         });
     }
@@ -230,8 +242,8 @@ pub fn rmse_at_time(rows: &[Row], technique: &str, sampler: &str, seconds: f64) 
 
 /// `render-summary.md`: per technique, the RMSE table at equal sample counts
 /// (rows = samplers, columns = spp; mean ± standard error over the seeds, the
-/// lowest mean of each column in bold), the bias table likewise, the RMSE
-/// table of each [`SurfaceClass`]'s pixels alone (where the rows hold them), and the RMSE
+/// lowest mean of each column in bold), the bias table likewise, the RMSE and
+/// bias tables of each [`SurfaceClass`]'s pixels alone (where the rows hold them), and the RMSE
 /// table at equal time (the mean times of `owen-sobol` at each spp; `–` where a
 /// sampler's measured times do not reach).
 pub fn markdown(rows: &[Row]) -> String {
@@ -294,6 +306,21 @@ pub fn markdown(rows: &[Row]) -> String {
                         class.name()
                     ),
                     &|r| r.rmse_by_surface[class.index()],
+                );
+                table(
+                    &mut out,
+                    &format!(
+                        "{technique}: bias on the {} alone at equal sample count",
+                        class.name()
+                    ),
+                    &spp_columns,
+                    &samplers,
+                    |s, c| {
+                        stat(rows, technique, s, spp[c], |r| {
+                            r.bias_by_surface[class.index()]
+                        })
+                        .map(|st| st.show(true))
+                    },
                 );
             }
         }
@@ -365,6 +392,7 @@ mod tests {
             bias: 0.0,
             seconds,
             rmse_by_surface: [0.0; 3],
+            bias_by_surface: [0.0; 3],
         }
     }
 
@@ -406,14 +434,17 @@ mod tests {
         ];
         // Ground: errors -1 and 3, sqrt(10 / 2); metal: 0 and 6, sqrt(36 / 2);
         // no dielectric pixel: 0; the background's 100 counts nowhere.
+        // Biases: ground (-1 + 3) / 2 = 1, metal (0 + 6) / 2 = 3.
         let e = errors_by_surface(&a, &b, &classes);
-        assert_eq!(e[DielectricSpheres.index()], 0.0);
-        assert!((e[Ground.index()] - 5f64.sqrt()).abs() < 1e-15);
-        assert!((e[MetalSpheres.index()] - 18f64.sqrt()).abs() < 1e-15);
+        assert_eq!(e[DielectricSpheres.index()], (0.0, 0.0));
+        assert!((e[Ground.index()].0 - 5f64.sqrt()).abs() < 1e-15);
+        assert!((e[MetalSpheres.index()].0 - 18f64.sqrt()).abs() < 1e-15);
+        assert_eq!((e[Ground.index()].1, e[MetalSpheres.index()].1), (1.0, 3.0));
         // The summary ranks each class on its own: the sampler lower on the
         // ground is in bold there though higher over the image.
         let with = |sampler: &str, rmse: f64, ground: f64| Row {
             rmse_by_surface: [0.5, 0.5, ground],
+            bias_by_surface: [0.0, 0.0, -ground / 2.0],
             ..row(sampler, 4, rmse, 1.0)
         };
         let md = markdown(&[with("ours", 2.0, 0.25), with("owen-sobol", 1.0, 0.75)]);
@@ -423,9 +454,22 @@ mod tests {
             .expect("a ground table");
         assert!(ground.contains("| ours | **2.5000e-1** |"), "{md}");
         assert!(md.contains("| owen-sobol | **1.0000e0** |"), "{md}");
-        // The CSV's last columns are the classes', in their order.
-        let columns = SurfaceClass::ALL.map(SurfaceClass::column).join(",");
-        assert!(CSV_HEADER.ends_with(&format!(",{columns}")));
+        // Each class's bias, signed, in a table of its own.
+        let ground_bias = md
+            .split("## brdf: bias on the ground alone")
+            .nth(1)
+            .expect("a ground bias table");
+        assert!(ground_bias.contains("| ours | -1.25e-1 |"), "{md}");
+        // The CSV's last columns are the classes' RMSEs then their biases, in
+        // the classes' order.
+        let rmse = SurfaceClass::ALL.map(SurfaceClass::column).join(",");
+        let bias = SurfaceClass::ALL.map(SurfaceClass::bias_column).join(",");
+        assert!(CSV_HEADER.ends_with(&format!(",{rmse},{bias}")));
+        let line = csv(&[with("ours", 2.0, 0.25)]);
+        assert!(
+            line.ends_with(",2.500000e-1,0.000000e0,0.000000e0,-1.250000e-1\n"),
+            "{line}"
+        );
         // Rows without classes print no split.
         assert!(!markdown(&[row("a", 4, 1.0, 1.0)]).contains("alone"));
     }
@@ -438,7 +482,8 @@ mod tests {
         assert!(rmse_at_time(&rows, "brdf", "a", 32.0).is_none());
         let csv = csv(&rows);
         assert!(csv.starts_with(
-            "technique,sampler,spp,seed,rmse,bias,seconds,rmse_dielectric,rmse_metal,rmse_ground\nbrdf,a,4,0,"
+            "technique,sampler,spp,seed,rmse,bias,seconds,rmse_dielectric,rmse_metal,rmse_ground,\
+             bias_dielectric,bias_metal,bias_ground\nbrdf,a,4,0,"
         ));
         let md = markdown(&[
             row("owen-sobol", 4, 1.0, 1.0),
