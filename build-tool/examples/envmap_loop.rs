@@ -15,6 +15,7 @@
 //! Prints ns per sample, the best of three runs of 4·10^6 samples each, one
 //! thread. (`bench` times every method through one harness, where the sampler
 //! has several callers and is compiled apart from them.)
+use nuld_build_tool::conditional::distill::fill_lattice_table;
 use nuld_build_tool::lab::bench::envmap_prior::{sampler_blob, sampler_parts};
 use nuld_build_tool::pointset::AlignedBytes;
 use nuld_build_tool::sphere::envmap_tree::{prior_levels, PRIOR_GRID};
@@ -79,17 +80,10 @@ fn bench_blob(lattice: bool) -> AlignedBytes {
     let mut parts = sampler_parts(Arc::new(tree)).unwrap();
     if lattice {
         let shape = parts.info.shape().unwrap();
-        let (n, g) = (shape.n() as usize, shape.lattice_generator());
         let instances = parts.info.instances;
-        for (at, code) in parts.table.iter_mut().enumerate() {
-            let (k, i) = ((at / n) as u32 % instances, (at % n) as u32);
-            let l = nuld_core::network::lattice_point::<f64>(i, n as u32, g);
-            let p = nuld_core::conditional::torus_shift(l, shape.instance_offset(k));
-            *code = nuld_core::conditional::pack_point(
-                nuld_core::quantize::unorm16_encode(p[0]),
-                nuld_core::quantize::unorm16_encode(p[1]),
-            );
-        }
+        fill_lattice_table(&mut parts.table, &shape, instances, |k| {
+            shape.instance_offset(k)
+        });
     }
     sampler_blob(parts).unwrap()
 }

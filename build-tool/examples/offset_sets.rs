@@ -12,11 +12,10 @@
 //! the seeds' standard errors do not hold. The blob's other sections, and its
 //! metal layer if it has one, are left as they are (a BRDF blob's metal table
 //! then keeps its own points). Results: docs/results/rendering.md#offset-sets.
+use nuld_build_tool::conditional::distill::fill_lattice_table;
 use nuld_build_tool::pointset::AlignedBytes;
 use nuld_core::blob::{checksum, Layout, SectionTag, CHECKSUM_OFFSET};
-use nuld_core::conditional::{pack_point, torus_shift, ConditionalInfo};
-use nuld_core::network::lattice_point;
-use nuld_core::quantize::unorm16_encode;
+use nuld_core::conditional::ConditionalInfo;
 use std::path::Path;
 
 fn main() {
@@ -31,28 +30,24 @@ fn main() {
     let (_, info) = layout.section(SectionTag::ConditionalInfo).unwrap();
     let info: ConditionalInfo = bytemuck::pod_read_unaligned(info);
     let shape = info.shape().expect("a conditional sampler's shape");
-    let (n, instances) = (info.n, info.instances);
     let (table, _) = layout.section(SectionTag::PointTable).unwrap();
+    let range = table.offset as usize..(table.offset + table.len) as usize;
     let mut bytes = blob.as_slice().to_vec();
-    let start = table.offset as usize;
-    for at in 0..table.len as usize / 4 {
-        let (k, i) = ((at as u32 / n) % instances, at as u32 % n);
-        let l = lattice_point::<f64>(i, n, shape.lattice_generator());
-        // The hash's own offset of `key + BASE`, not `Shape::instance_offset`,
-        // which would wrap `k + BASE` at the network's instance slots.
-        let z = shape
-            .offset_hash()
-            .offset::<f64>(shape.instance_key(k) + base);
-        let p = torus_shift(l, z);
-        let code = pack_point(unorm16_encode(p[0]), unorm16_encode(p[1]));
-        bytes[start + 4 * at..start + 4 * at + 4].copy_from_slice(&code.to_le_bytes());
-    }
+    let mut codes: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes[range.clone()]);
+    // The hash's own offset of `key + BASE`, not `Shape::instance_offset`,
+    // which would wrap `k + BASE` at the network's instance slots.
+    fill_lattice_table(&mut codes, &shape, info.instances, |k| {
+        shape.offset_hash().offset(shape.instance_key(k) + base)
+    });
+    bytes[range].copy_from_slice(bytemuck::cast_slice(&codes));
     let sum = checksum(&bytes);
     bytes[CHECKSUM_OFFSET..CHECKSUM_OFFSET + 8].copy_from_slice(&sum.to_le_bytes());
     std::fs::write(&args[2], &bytes).unwrap();
     eprintln!(
-        "wrote {}: n {n}, {instances} instances at the offsets of {base}..{}",
+        "wrote {}: n {}, {} instances at the offsets of {base}..{}",
         args[2],
-        base + instances
+        info.n,
+        info.instances,
+        base + info.instances
     );
 }

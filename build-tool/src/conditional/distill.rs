@@ -31,8 +31,8 @@ use crate::sphere::EnvmapDensity;
 use crate::train::target::LoadedTarget;
 use glam::DVec2;
 use nuld_core::brdf::{BrdfModel, BrdfParts};
-use nuld_core::conditional::{pack_point, ConditionalInfo, PointWarp};
-use nuld_core::network::{Shape, MAX_HIDDEN_LAYERS};
+use nuld_core::conditional::{pack_point, torus_shift, ConditionalInfo, PointWarp};
+use nuld_core::network::{lattice_point, Shape, MAX_HIDDEN_LAYERS};
 use nuld_core::quantize::unorm16_encode;
 use nuld_core::sphere::square_to_sphere;
 use rayon::prelude::*;
@@ -165,6 +165,29 @@ fn point_table(
             })
         })
         .collect()
+}
+
+/// Fills a point table (entries `(node, k, i)` in the blob's order, `k` below
+/// `instances`) with the untrained lattice: point `i` of `shape`'s rank-1
+/// lattice shifted on the torus by `offset(k)`, as u16 unorm codes. What a bake
+/// whose learned residual is dropped ships (to its network's rounding), for
+/// examples that time or judge the lattice in a blob's place
+/// (`examples/envmap_loop.rs`, `examples/offset_sets.rs`).
+pub fn fill_lattice_table(
+    table: &mut [u32],
+    shape: &Shape,
+    instances: u32,
+    offset: impl Fn(u32) -> [f64; 2],
+) {
+    let (n, g) = (shape.n() as u64, shape.lattice_generator());
+    for (at, code) in table.iter_mut().enumerate() {
+        let (k, i) = (
+            (at as u64 / n % instances as u64) as u32,
+            (at as u64 % n) as u32,
+        );
+        let p = torus_shift(lattice_point::<f64>(i, n as u32, g), offset(k));
+        *code = pack_point(unorm16_encode(p[0]), unorm16_encode(p[1]));
+    }
 }
 
 /// The irradiance `E(n)` at every weight-grid node's normal.
