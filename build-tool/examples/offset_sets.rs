@@ -20,8 +20,8 @@ use std::path::Path;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    if args.len() != 4 {
-        eprintln!("usage: offset_sets BLOB OUT BASE");
+    if !(4..=5).contains(&args.len()) {
+        eprintln!("usage: offset_sets BLOB OUT BASE [r2]");
         std::process::exit(2);
     }
     let base: u32 = args[3].parse().expect("BASE an instance number");
@@ -36,8 +36,13 @@ fn main() {
     let mut codes: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes[range.clone()]);
     // The hash's own offset of `key + BASE`, not `Shape::instance_offset`,
     // which would wrap `k + BASE` at the network's instance slots.
+    let r2 = args.get(4).is_some_and(|a| a == "r2");
     fill_lattice_table(&mut codes, &shape, info.instances, |k| {
-        shape.offset_hash().offset(shape.instance_key(k) + base)
+        if r2 {
+            r2_offset(k + base)
+        } else {
+            shape.offset_hash().offset(shape.instance_key(k) + base)
+        }
     });
     bytes[range].copy_from_slice(bytemuck::cast_slice(&codes));
     let sum = checksum(&bytes);
@@ -50,4 +55,10 @@ fn main() {
         info.instances,
         base + info.instances
     );
+}
+
+/// Term `k` of the R2 sequence (the plastic number's Kronecker sequence), in
+/// 24-bit fixed point: `frac(k (0.7548776662, 0.5698402910))`.
+fn r2_offset(k: u32) -> [f64; 2] {
+    [0xc13f_a9a9u32, 0x91e1_0da7].map(|a| (k.wrapping_mul(a) >> 8) as f64 / (1u32 << 24) as f64)
 }
