@@ -2,7 +2,8 @@
 //! instances hold: rewrites the point table of an environment or BRDF blob with
 //! each instance's rank-1 lattice (the unbiased mode's lattice, no training)
 //! shifted by the offset of instance `k + BASE` instead of `k`, `cargo run
-//! --release -p nuld-build-tool --example offset_sets -- BLOB OUT BASE [r2]`.
+//! --release -p nuld-build-tool --example offset_sets -- BLOB OUT BASE [r2 |
+//! cosets]`.
 //!
 //! With `BASE` 0 the table holds what an untrained bake ships at each instance's
 //! own offset (`bake --envmap MAP --n 16 --steps 1` ships it where the trained
@@ -12,13 +13,19 @@
 //! the seeds' standard errors do not hold. With `r2` the offsets are terms `k +
 //! BASE` of the R2 sequence instead (the plastic number's Kronecker sequence,
 //! whose consecutive terms are evenly spread over the square), to see whether
-//! offsets spread evenly spread a render's luck less. The blob's other sections, and its
+//! offsets spread evenly spread a render's luck less. With `cosets` instance `k`
+//! holds the coset number `bitreverse(k)` of the lattice in a rank-1 lattice of
+//! `S n` points that contains it (`S` instances, a power of two), all moved by
+//! one shift drawn from `BASE`: the union of the instances is that finer
+//! lattice, and the shifts are a lattice rule over the shifts that give
+//! different sets. The blob's other sections, and its
 //! metal layer if it has one, are left as they are (a BRDF blob's metal table
 //! then keeps its own points). Results: docs/results/rendering.md#offset-sets.
 use glam::DVec2;
 use nuld_build_tool::conditional::distill::fill_lattice_table;
 use nuld_build_tool::metrics::l2::asd_uniform;
 use nuld_build_tool::pointset::AlignedBytes;
+use nuld_build_tool::train::{gcd, shortest_lattice_vector};
 use nuld_core::blob::{checksum, Layout, SectionTag, CHECKSUM_OFFSET};
 use nuld_core::conditional::ConditionalInfo;
 use nuld_core::network::{shifted_lattice_point, Shape};
@@ -27,7 +34,7 @@ use std::path::Path;
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if !(4..=5).contains(&args.len()) {
-        eprintln!("usage: offset_sets BLOB OUT BASE [r2]");
+        eprintln!("usage: offset_sets BLOB OUT BASE [r2 | cosets]");
         std::process::exit(2);
     }
     let base: u32 = args[3].parse().expect("BASE an instance number");
@@ -42,13 +49,13 @@ fn main() {
     let mut codes: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes[range.clone()]);
     // The hash's own offset of `key + BASE`, not `Shape::instance_offset`,
     // which would wrap `k + BASE` at the network's instance slots.
-    let r2 = args.get(4).is_some_and(|a| a == "r2");
-    let offset = |k: u32| {
-        if r2 {
-            r2_offset(k + base)
-        } else {
-            shape.offset_hash().offset(shape.instance_key(k) + base)
-        }
+    let kind = args.get(4).map_or("hash", |a| a.as_str());
+    let cosets = Cosets::new(shape.n(), shape.lattice_generator(), info.instances);
+    let shift: [f64; 2] = shape.offset_hash().offset(base);
+    let offset = |k: u32| match kind {
+        "r2" => r2_offset(k + base),
+        "cosets" => cosets.offset(k, shift),
+        _ => shape.offset_hash().offset(shape.instance_key(k) + base),
     };
     fill_lattice_table(&mut codes, &shape, info.instances, offset);
     print_torus_spread(&shape, info.instances, offset);
@@ -113,4 +120,49 @@ fn print_torus_spread(shape: &Shape, instances: u32, offset: impl Fn(u32) -> [f6
         asd_uniform(&union) / one,
         across / within
     );
+}
+
+/// The cosets of the rank-1 lattice of `n` points and generator `g` in the
+/// rank-1 lattice of `S n` points and generator `G` (`G = g mod n`, so that it
+/// holds the smaller one; of those coprime to `S n`, the one with the longest
+/// shortest vector on the torus), in bit-reversed order so that consecutive
+/// instances lie far apart.
+struct Cosets {
+    count: u32,
+    big_n: u64,
+    big_g: u64,
+}
+
+impl Cosets {
+    fn new(n: u32, g: u32, count: u32) -> Self {
+        assert!(
+            count.is_power_of_two(),
+            "cosets: the instances a power of two"
+        );
+        let big_n = n as u64 * count as u64;
+        let big_g = (0..count as u64)
+            .map(|j| g as u64 + j * n as u64)
+            .filter(|&c| gcd(c, big_n) == 1)
+            .max_by(|&a, &b| {
+                let s = |c| shortest_lattice_vector(big_n, c);
+                s(a).total_cmp(&s(b)).then(b.cmp(&a))
+            })
+            .unwrap_or(g as u64);
+        Self {
+            count,
+            big_n,
+            big_g,
+        }
+    }
+
+    fn offset(&self, k: u32, shift: [f64; 2]) -> [f64; 2] {
+        let bits = self.count.trailing_zeros();
+        let c = if bits == 0 {
+            0
+        } else {
+            ((k % self.count).reverse_bits() >> (32 - bits)) as u64
+        };
+        let p = [c, c * self.big_g % self.big_n].map(|v| v as f64 / self.big_n as f64);
+        [0, 1].map(|a| (p[a] + shift[a]).fract())
+    }
 }

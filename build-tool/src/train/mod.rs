@@ -280,31 +280,41 @@ impl TrainConfig {
 
 /// The rank-1 lattice generator `g` for `n` points: the `g` in `1..n` coprime to
 /// `n` whose lattice `(i/n, frac(i g / n))` has the largest minimum distance on the
-/// torus (the shortest nonzero lattice vector; ties to the smallest `g`). `O(n^2)`.
+/// torus ([`shortest_lattice_vector`]; ties to the smallest `g`). `O(n^2)`.
 pub fn lattice_generator(n: u32) -> u32 {
-    let gcd = |mut a: u32, mut b: u32| {
-        while b != 0 {
-            (a, b) = (b, a % b);
-        }
-        a
-    };
-    let wrap = |x: f64| x.min(1.0 - x);
     let mut best = (1u32, -1.0);
     for g in 1..n.max(2) {
-        if gcd(g, n) != 1 {
+        if gcd(g as u64, n as u64) != 1 {
             continue;
         }
-        let mut shortest = f64::INFINITY;
-        for i in 1..n {
-            let x = wrap(i as f64 / n as f64);
-            let y = wrap(((i as u64 * g as u64) % n as u64) as f64 / n as f64);
-            shortest = shortest.min(x * x + y * y);
-        }
+        let shortest = shortest_lattice_vector(n as u64, g as u64);
         if shortest > best.1 {
             best = (g, shortest);
         }
     }
     best.0
+}
+
+/// The squared length of the shortest nonzero vector on the torus of the rank-1
+/// lattice `(i/n, frac(i g / n))`, `i < n`: its points' minimum squared distance.
+/// `O(n)`.
+pub fn shortest_lattice_vector(n: u64, g: u64) -> f64 {
+    let wrap = |x: f64| x.min(1.0 - x);
+    (1..n)
+        .map(|i| {
+            let x = wrap(i as f64 / n as f64);
+            let y = wrap((i as u128 * g as u128 % n as u128) as f64 / n as f64);
+            x * x + y * y
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The greatest common divisor of `a` and `b` (Euclid).
+pub fn gcd(mut a: u64, mut b: u64) -> u64 {
+    while b != 0 {
+        (a, b) = (b, a % b);
+    }
+    a
 }
 
 /// What one step reports.
@@ -663,5 +673,15 @@ mod tests {
         let g = lattice_generator(89);
         assert!(g == 34 || g == 55, "{g}");
         assert_eq!(lattice_generator(1), 1);
+        // n = 8, g = 3: point 2 is (2/8, 6/8), (1/4, 1/4) from the origin on
+        // the torus, the shortest of the seven; by hand.
+        assert_eq!(shortest_lattice_vector(8, 3), 0.125);
+        // n = 4, g = 1: the diagonal's first point, (1/4)^2 + (1/4)^2.
+        assert_eq!(shortest_lattice_vector(4, 1), 0.125);
+        assert!((shortest_lattice_vector(5, 2) - 0.2).abs() < 1e-15);
+        assert_eq!(
+            (gcd(12, 18), gcd(7, 0), gcd(0, 7), gcd(9, 28)),
+            (6, 7, 7, 1)
+        );
     }
 }
