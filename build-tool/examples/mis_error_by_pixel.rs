@@ -16,12 +16,11 @@ use nuld_build_tool::lab::render::camera::Camera;
 use nuld_build_tool::lab::render::environment::Environment;
 use nuld_build_tool::lab::render::integrator::Setup;
 use nuld_build_tool::lab::render::lineup;
-use nuld_build_tool::lab::render::reference::Reference;
 use nuld_build_tool::lab::render::sampler::Technique;
 use nuld_build_tool::lab::render::scene::Scene;
 use nuld_build_tool::pointset::AlignedBytes;
 use std::path::Path;
-use surfaces::{surface_pixels, SurfacePixel, CLASSES};
+use surfaces::{cached_reference, surface_pixels, SurfacePixel, CLASSES};
 
 mod surfaces;
 
@@ -104,18 +103,4 @@ fn main() {
             );
         }
     }
-}
-
-/// The one `reference-KEY.bin` `render` cached in `dir`.
-fn cached_reference(dir: &Path, width: u32, height: u32) -> Reference {
-    let key = std::fs::read_dir(dir)
-        .unwrap()
-        .filter_map(|e| e.ok()?.file_name().into_string().ok())
-        .find_map(|f| {
-            u64::from_str_radix(f.strip_prefix("reference-")?.strip_suffix(".bin")?, 16).ok()
-        })
-        .expect("a reference-KEY.bin in REFERENCE_DIR");
-    Reference::load(dir, key, width, height)
-        .unwrap()
-        .expect("the reference of a 160 x 120 render")
 }

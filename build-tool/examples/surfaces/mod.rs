@@ -1,8 +1,11 @@
 //! What the examples that split `render`'s error by surface
-//! (`render_bias_by_surface`, `mis_error_by_pixel`) share: the scene's surface
-//! classes and which one each pixel shows.
+//! (`render_bias_by_surface`, `mis_error_by_pixel`, `ground_error_by_instance`)
+//! share: the scene's surface classes, which one each pixel shows, and the
+//! reference `render` cached.
 use nuld_build_tool::lab::render::integrator::{Primary, Setup};
+use nuld_build_tool::lab::render::reference::Reference;
 use nuld_build_tool::lab::render::scene::SurfaceClass;
+use std::path::Path;
 
 /// The surface classes, in print order ([`SurfacePixel::class`] indexes it).
 pub const CLASSES: [&str; 3] = [
@@ -39,4 +42,20 @@ pub fn surface_pixels(setup: &Setup<'_>) -> Vec<Option<SurfacePixel>> {
             Primary::Background(_) => None,
         })
         .collect()
+}
+
+/// The one `reference-KEY.bin` `render` cached in `dir`.
+// Not every example that declares this module reads it.
+#[allow(dead_code)]
+pub fn cached_reference(dir: &Path, width: u32, height: u32) -> Reference {
+    let key = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .find_map(|f| {
+            u64::from_str_radix(f.strip_prefix("reference-")?.strip_suffix(".bin")?, 16).ok()
+        })
+        .expect("a reference-KEY.bin in REFERENCE_DIR");
+    Reference::load(dir, key, width, height)
+        .unwrap()
+        .expect("the reference of a 160 x 120 render")
 }
