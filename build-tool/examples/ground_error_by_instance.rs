@@ -13,18 +13,14 @@
 //! their share of its pixels, and the worst instances. If a few instances held
 //! most of the error, a set of 64 offsets' luck would be whether it drew them.
 //! Results: docs/results/rendering.md#offset-designs.
-use nuld_build_tool::lab::render::brdf_warp::LobeTable;
-use nuld_build_tool::lab::render::camera::Camera;
 use nuld_build_tool::lab::render::environment::Environment;
-use nuld_build_tool::lab::render::integrator::Setup;
 use nuld_build_tool::lab::render::lineup;
 use nuld_build_tool::lab::render::sampler::{PixelKey, Technique};
-use nuld_build_tool::lab::render::scene::Scene;
 use nuld_build_tool::pointset::AlignedBytes;
 use nuld_core::blob::{Layout, SectionTag};
 use nuld_core::conditional::ConditionalInfo;
 use std::path::Path;
-use surfaces::{cached_reference, surface_pixels, SurfacePixel};
+use surfaces::{cached_reference, EvalScene, SurfacePixel};
 
 mod surfaces;
 
@@ -44,17 +40,11 @@ fn main() {
         "mis" => Technique::Mis,
         _ => Technique::Envmap,
     };
-    let (width, height) = (160, 120);
-    let scene = Scene::spheres_on_ground();
-    let camera = Camera::evaluation(width, height);
-    let setup = Setup {
-        scene: &scene,
-        camera: &camera,
-        env: &env,
-    };
-    let lobes = LobeTable::new(&scene.materials());
+    let (width, height) = EvalScene::SIZE;
+    let eval = EvalScene::new(&env);
+    let (setup, lobes) = (eval.setup(&env), &eval.lobes);
     let reference = cached_reference(Path::new(&args[2]), width, height);
-    let pixels = surface_pixels(&setup);
+    let pixels = &eval.pixels;
     let envmap = AlignedBytes::read(Path::new(&args[4])).unwrap();
     let layout = Layout::read(envmap.as_slice()).unwrap();
     let (_, info) = layout.section(SectionTag::ConditionalInfo).unwrap();
@@ -68,7 +58,7 @@ fn main() {
             Some(envmap.as_slice()),
             n,
             seed,
-            &lobes,
+            lobes,
             &env,
             &mut weights,
         )
@@ -81,7 +71,7 @@ fn main() {
         for (i, p) in pixels.iter().enumerate() {
             if let Some(SurfacePixel { class: GROUND, .. }) = *p {
                 let (x, y) = (i as u32 % width, i as u32 / width);
-                let key = PixelKey::new(seed, camera.pixel_index(x, y));
+                let key = PixelKey::new(seed, eval.camera.pixel_index(x, y));
                 let k = key.instance() as usize % instances;
                 let e = img.values[i] - reference.image.values[i];
                 sum[k] += e * e;

@@ -11,16 +11,12 @@
 //! spheres, ground), the share of its ten worst pixels, and the four worst with
 //! their roughness, view angle, error and reference value.
 //! Results: docs/results/rendering.md#mis-both.
-use nuld_build_tool::lab::render::brdf_warp::LobeTable;
-use nuld_build_tool::lab::render::camera::Camera;
 use nuld_build_tool::lab::render::environment::Environment;
-use nuld_build_tool::lab::render::integrator::Setup;
 use nuld_build_tool::lab::render::lineup;
 use nuld_build_tool::lab::render::sampler::Technique;
-use nuld_build_tool::lab::render::scene::Scene;
 use nuld_build_tool::pointset::AlignedBytes;
 use std::path::Path;
-use surfaces::{cached_reference, surface_pixels, SurfacePixel, CLASSES};
+use surfaces::{cached_reference, EvalScene, SurfacePixel, CLASSES};
 
 mod surfaces;
 
@@ -32,17 +28,11 @@ fn main() {
     }
     let env = Environment::from_file(Path::new(&args[1])).unwrap();
     let n: u32 = args[3].parse().expect("N a sample count");
-    let (width, height) = (160, 120);
-    let scene = Scene::spheres_on_ground();
-    let camera = Camera::evaluation(width, height);
-    let setup = Setup {
-        scene: &scene,
-        camera: &camera,
-        env: &env,
-    };
-    let lobes = LobeTable::new(&scene.materials());
+    let (width, height) = EvalScene::SIZE;
+    let eval = EvalScene::new(&env);
+    let (setup, lobes) = (eval.setup(&env), &eval.lobes);
     let reference = cached_reference(Path::new(&args[2]), width, height);
-    let pixels = surface_pixels(&setup);
+    let pixels = &eval.pixels;
     let brdf = AlignedBytes::read(Path::new(&args[4])).unwrap();
     let envmap = AlignedBytes::read(Path::new(&args[5])).unwrap();
     for seed in 0..4u64 {
@@ -53,7 +43,7 @@ fn main() {
             Some(envmap.as_slice()),
             n,
             seed,
-            &lobes,
+            lobes,
             &env,
             &mut weights,
         )

@@ -8,17 +8,13 @@
 //! `nuld-unbiased` and `owen-sobol` at `N` spp with the blob of `N`. The
 //! reference is the renderer's (1024 + 1024 samples per pixel, seed 7): its mean
 //! over a surface class of thousands of pixels is known to about 1e-4.
-use nuld_build_tool::lab::render::brdf_warp::LobeTable;
-use nuld_build_tool::lab::render::camera::Camera;
 use nuld_build_tool::lab::render::environment::Environment;
-use nuld_build_tool::lab::render::integrator::Setup;
 use nuld_build_tool::lab::render::lineup;
 use nuld_build_tool::lab::render::reference::Reference;
 use nuld_build_tool::lab::render::sampler::Technique;
-use nuld_build_tool::lab::render::scene::Scene;
 use nuld_build_tool::pointset::AlignedBytes;
 use std::path::Path;
-use surfaces::{surface_pixels, CLASSES};
+use surfaces::{EvalScene, CLASSES};
 
 mod surfaces;
 
@@ -29,18 +25,10 @@ fn main() {
         std::process::exit(2);
     }
     let env = Environment::from_file(Path::new(&args[1])).unwrap();
-    let scene = Scene::spheres_on_ground();
-    let camera = Camera::evaluation(160, 120);
-    let setup = Setup {
-        scene: &scene,
-        camera: &camera,
-        env: &env,
-    };
-    let lobes = LobeTable::new(&scene.materials());
-    let reference = Reference::render(&setup, &lobes, 1024, 7, &|| {});
-    let class: Vec<Option<usize>> = (surface_pixels(&setup).iter())
-        .map(|p| p.map(|p| p.class))
-        .collect();
+    let eval = EvalScene::new(&env);
+    let (setup, lobes) = (eval.setup(&env), &eval.lobes);
+    let reference = Reference::render(&setup, lobes, 1024, 7, &|| {});
+    let class: Vec<Option<usize>> = (eval.pixels.iter()).map(|p| p.map(|p| p.class)).collect();
     for arg in &args[2..] {
         let (n, path) = arg.split_once('=').expect("N=BLOB");
         let n: u32 = n.parse().expect("N a sample count");
@@ -56,7 +44,7 @@ fn main() {
                     None,
                     n,
                     seed,
-                    &lobes,
+                    lobes,
                     &env,
                     &mut weights,
                 )

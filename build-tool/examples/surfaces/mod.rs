@@ -1,10 +1,13 @@
 //! What the examples that split `render`'s error by surface
 //! (`render_bias_by_surface`, `mis_error_by_pixel`, `ground_error_by_instance`)
-//! share: the scene's surface classes, which one each pixel shows, and the
-//! reference `render` cached.
+//! share: `render`'s scene at 160 x 120 pixels, its surface classes, which one
+//! each pixel shows, and the reference `render` cached.
+use nuld_build_tool::lab::render::brdf_warp::LobeTable;
+use nuld_build_tool::lab::render::camera::Camera;
+use nuld_build_tool::lab::render::environment::Environment;
 use nuld_build_tool::lab::render::integrator::{Primary, Setup};
 use nuld_build_tool::lab::render::reference::Reference;
-use nuld_build_tool::lab::render::scene::SurfaceClass;
+use nuld_build_tool::lab::render::scene::{Scene, SurfaceClass};
 use std::path::Path;
 
 /// The surface classes, in print order ([`SurfacePixel::class`] indexes it).
@@ -13,6 +16,47 @@ pub const CLASSES: [&str; 3] = [
     SurfaceClass::ALL[1].name(),
     SurfaceClass::ALL[2].name(),
 ];
+
+/// `render --size 160x120`'s scene and camera, the BRDF lobes the lineup's
+/// samplers take, and the surface each pixel shows.
+pub struct EvalScene {
+    pub scene: Scene,
+    pub camera: Camera,
+    pub lobes: LobeTable,
+    pub pixels: Vec<Option<SurfacePixel>>,
+}
+
+impl EvalScene {
+    /// Width and height in pixels, as `render --size 160x120`.
+    pub const SIZE: (u32, u32) = (160, 120);
+
+    /// The scene lit by `env`, its pixels classified.
+    pub fn new(env: &Environment) -> Self {
+        let scene = Scene::spheres_on_ground();
+        let camera = Camera::evaluation(Self::SIZE.0, Self::SIZE.1);
+        let lobes = LobeTable::new(&scene.materials());
+        let pixels = surface_pixels(&Setup {
+            scene: &scene,
+            camera: &camera,
+            env,
+        });
+        Self {
+            scene,
+            camera,
+            lobes,
+            pixels,
+        }
+    }
+
+    /// What `render` renders the scene with under `env`.
+    pub fn setup<'a>(&'a self, env: &'a Environment) -> Setup<'a> {
+        Setup {
+            scene: &self.scene,
+            camera: &self.camera,
+            env,
+        }
+    }
+}
 
 /// A pixel that shows a surface.
 // Each example reads the fields it needs.
@@ -29,7 +73,7 @@ pub struct SurfacePixel {
 
 /// Per pixel of `setup`'s camera, row by row, the surface it shows; `None` on
 /// the background; the class is `render`'s ([`SurfaceClass::of`]).
-pub fn surface_pixels(setup: &Setup<'_>) -> Vec<Option<SurfacePixel>> {
+fn surface_pixels(setup: &Setup<'_>) -> Vec<Option<SurfacePixel>> {
     let (width, height) = (setup.camera.width(), setup.camera.height());
     (0..height)
         .flat_map(|y| (0..width).map(move |x| (x, y)))
