@@ -14,8 +14,8 @@
 //! most of the error, a set of 64 offsets' luck would be whether it drew them.
 //! Results: docs/results/rendering.md#offset-designs.
 use nuld_build_tool::lab::render::environment::Environment;
-use nuld_build_tool::lab::render::lineup;
 use nuld_build_tool::lab::render::sampler::{PixelKey, Technique};
+use nuld_build_tool::lab::render::scene::SurfaceClass;
 use nuld_build_tool::pointset::AlignedBytes;
 use nuld_core::blob::{Layout, SectionTag};
 use nuld_core::conditional::ConditionalInfo;
@@ -24,8 +24,8 @@ use surfaces::{cached_reference, EvalScene, SurfacePixel};
 
 mod surfaces;
 
-/// [`surfaces::CLASSES`]'s index of the ground.
-const GROUND: usize = 2;
+/// The ground's index among the surface classes.
+const GROUND: usize = SurfaceClass::Ground.index();
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -33,7 +33,6 @@ fn main() {
         eprintln!("usage: ground_error_by_instance MAP REFERENCE_DIR N ENVMAP_BLOB [envmap | mis]");
         std::process::exit(2);
     }
-    assert_eq!(surfaces::CLASSES[GROUND], "ground");
     let env = Environment::from_file(Path::new(&args[1])).unwrap();
     let n: u32 = args[3].parse().expect("N a sample count");
     let technique = match args.get(5).map_or("envmap", |a| a.as_str()) {
@@ -42,7 +41,6 @@ fn main() {
     };
     let (width, height) = EvalScene::SIZE;
     let eval = EvalScene::new(&env);
-    let (setup, lobes) = (eval.setup(&env), &eval.lobes);
     let reference = cached_reference(Path::new(&args[2]), width, height);
     let pixels = &eval.pixels;
     let envmap = AlignedBytes::read(Path::new(&args[4])).unwrap();
@@ -51,23 +49,10 @@ fn main() {
     let instances = bytemuck::pod_read_unaligned::<ConditionalInfo>(info).instances as usize;
     let (mut sum, mut count) = (vec![0.0f64; instances], vec![0u64; instances]);
     for seed in 0..4u64 {
-        let mut weights = Default::default();
-        let samplers = lineup::samplers(
-            &[technique],
-            None,
-            Some(envmap.as_slice()),
-            n,
-            seed,
-            lobes,
-            &env,
-            &mut weights,
-        )
-        .unwrap();
-        let table = samplers
-            .iter()
-            .find(|s| s.name() == "nuld-table")
-            .expect("the lineup's nuld-table");
-        let img = setup.render(table.as_ref(), n, seed, &|| {});
+        let blobs = [None, Some(envmap.as_slice())];
+        let [img] = &eval.render(&env, &[technique], blobs, (n, seed), &["nuld-table"])[..] else {
+            unreachable!("one image a name")
+        };
         for (i, p) in pixels.iter().enumerate() {
             if let Some(SurfacePixel { class: GROUND, .. }) = *p {
                 let (x, y) = (i as u32 % width, i as u32 / width);

@@ -12,7 +12,6 @@
 //! their roughness, view angle, error and reference value.
 //! Results: docs/results/rendering.md#mis-both.
 use nuld_build_tool::lab::render::environment::Environment;
-use nuld_build_tool::lab::render::lineup;
 use nuld_build_tool::lab::render::sampler::Technique;
 use nuld_build_tool::pointset::AlignedBytes;
 use std::path::Path;
@@ -30,30 +29,15 @@ fn main() {
     let n: u32 = args[3].parse().expect("N a sample count");
     let (width, height) = EvalScene::SIZE;
     let eval = EvalScene::new(&env);
-    let (setup, lobes) = (eval.setup(&env), &eval.lobes);
     let reference = cached_reference(Path::new(&args[2]), width, height);
     let pixels = &eval.pixels;
     let brdf = AlignedBytes::read(Path::new(&args[4])).unwrap();
     let envmap = AlignedBytes::read(Path::new(&args[5])).unwrap();
     for seed in 0..4u64 {
-        let mut weights = Default::default();
-        let samplers = lineup::samplers(
-            &[Technique::Mis],
-            Some(brdf.as_slice()),
-            Some(envmap.as_slice()),
-            n,
-            seed,
-            lobes,
-            &env,
-            &mut weights,
-        )
-        .unwrap();
-        for name in &args[6..] {
-            let s = samplers
-                .iter()
-                .find(|s| s.name() == name)
-                .unwrap_or_else(|| panic!("no MIS sampler {name}"));
-            let img = setup.render(s.as_ref(), n, seed, &|| {});
+        let blobs = [Some(brdf.as_slice()), Some(envmap.as_slice())];
+        let names: Vec<&str> = args[6..].iter().map(String::as_str).collect();
+        let images = eval.render(&env, &[Technique::Mis], blobs, (n, seed), &names);
+        for (name, img) in names.iter().zip(&images) {
             let mut by_class = [0.0f64; 3];
             let mut errors: Vec<(f64, usize)> = Vec::new();
             for (i, p) in pixels.iter().enumerate() {

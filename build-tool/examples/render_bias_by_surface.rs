@@ -9,7 +9,6 @@
 //! reference is the renderer's (1024 + 1024 samples per pixel, seed 7): its mean
 //! over a surface class of thousands of pixels is known to about 1e-4.
 use nuld_build_tool::lab::render::environment::Environment;
-use nuld_build_tool::lab::render::lineup;
 use nuld_build_tool::lab::render::reference::Reference;
 use nuld_build_tool::lab::render::sampler::Technique;
 use nuld_build_tool::pointset::AlignedBytes;
@@ -37,20 +36,11 @@ fn main() {
             // Per class: sum of errors, sum of reference values, pixels.
             let mut sums = [[0.0f64; 3]; 3];
             for seed in 0..4u64 {
-                let mut weights = Default::default();
-                let samplers = lineup::samplers(
-                    &[Technique::Brdf],
-                    Some(blob.as_slice()),
-                    None,
-                    n,
-                    seed,
-                    lobes,
-                    &env,
-                    &mut weights,
-                )
-                .unwrap();
-                let s = samplers.iter().find(|s| s.name() == name).unwrap();
-                let img = setup.render(s.as_ref(), n, seed, &|| {});
+                let blobs = [Some(blob.as_slice()), None];
+                let [img] = &eval.render(&env, &[Technique::Brdf], blobs, (n, seed), &[name])[..]
+                else {
+                    unreachable!("one image a name")
+                };
                 for (i, c) in class.iter().enumerate() {
                     if let Some(c) = *c {
                         sums[c][0] += img.values[i] - reference.image.values[i];

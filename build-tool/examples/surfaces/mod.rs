@@ -5,12 +5,16 @@
 use nuld_build_tool::lab::render::brdf_warp::LobeTable;
 use nuld_build_tool::lab::render::camera::Camera;
 use nuld_build_tool::lab::render::environment::Environment;
-use nuld_build_tool::lab::render::integrator::{Primary, Setup};
+use nuld_build_tool::lab::render::integrator::{Image, Primary, Setup};
+use nuld_build_tool::lab::render::lineup;
 use nuld_build_tool::lab::render::reference::Reference;
+use nuld_build_tool::lab::render::sampler::Technique;
 use nuld_build_tool::lab::render::scene::{Scene, SurfaceClass};
 use std::path::Path;
 
 /// The surface classes, in print order ([`SurfacePixel::class`] indexes it).
+// Not every example that declares this module reads it.
+#[allow(dead_code)]
 pub const CLASSES: [&str; 3] = [
     SurfaceClass::ALL[0].name(),
     SurfaceClass::ALL[1].name(),
@@ -55,6 +59,43 @@ impl EvalScene {
             camera: &self.camera,
             env,
         }
+    }
+
+    /// The images of the lineup's samplers `names` (`render.csv`'s `sampler`)
+    /// under `techniques` at `n` spp and `seed`, with the BRDF and environment
+    /// blobs given: bit for bit those `render` makes. Panics on a name the
+    /// lineup lacks.
+    pub fn render(
+        &self,
+        env: &Environment,
+        techniques: &[Technique],
+        [brdf, envmap]: [Option<&[u8]>; 2],
+        (n, seed): (u32, u64),
+        names: &[&str],
+    ) -> Vec<Image> {
+        let mut weights = Default::default();
+        let samplers = lineup::samplers(
+            techniques,
+            brdf,
+            envmap,
+            n,
+            seed,
+            &self.lobes,
+            env,
+            &mut weights,
+        )
+        .unwrap();
+        let setup = self.setup(env);
+        names
+            .iter()
+            .map(|&name| {
+                let s = samplers
+                    .iter()
+                    .find(|s| s.name() == name)
+                    .unwrap_or_else(|| panic!("no sampler {name} in the lineup"));
+                setup.render(s.as_ref(), n, seed, &|| {})
+            })
+            .collect()
     }
 }
 
