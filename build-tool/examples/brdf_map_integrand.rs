@@ -1,10 +1,11 @@
 //! How the BRDF sampler's fixed sets integrate a real map through a lobe, beside
 //! what the cap judge says of them: `cargo run --release -p nuld-build-tool
-//! --example brdf_map_integrand -- BLOB MAP [INSTANCES] [CAPS] [OPTIMIZED]` (16
-//! sets and 512 caps a scale by default; seconds).
+//! --example brdf_map_integrand -- BLOB MAP [INSTANCES] [CAPS] [OPTIMIZED|-]
+//! [CONDITIONS]` (16 sets and 512 caps a scale by default; seconds).
 //!
 //! At the render scene's materials (`lab::render::scene`: the ground, dielectric
-//! 0.8, at three views; spheres' roughnesses, dielectric and metal), every method's
+//! 0.8, at three views; spheres' roughnesses, dielectric and metal), or at
+//! `CONDITIONS` (`roughness,view°,metallic` separated by `/`), every method's
 //! `INSTANCES` sets of the blob's `N` directions, scored four ways, each over
 //! Owen-Sobol through the exact inverse CDF of the condition's `q = f cos / A`:
 //!
@@ -92,14 +93,18 @@ fn profile(sets: &[Vec<DVec3>], zs: &[f64]) -> Vec<f64> {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    if !(3..=6).contains(&args.len()) {
-        eprintln!("usage: brdf_map_integrand BLOB MAP [INSTANCES] [CAPS] [OPTIMIZED]");
+    if !(3..=7).contains(&args.len()) {
+        eprintln!(
+            "usage: brdf_map_integrand BLOB MAP [INSTANCES] [CAPS] [OPTIMIZED|-] [CONDITIONS]"
+        );
         std::process::exit(2);
     }
     let map = Environment::from_file(std::path::Path::new(&args[2])).unwrap();
     let instances: u32 = args.get(3).map_or(16, |s| s.parse().unwrap());
     let count: usize = args.get(4).map_or(512, |s| s.parse().unwrap());
-    let optimized_bytes = args.get(5).map(|p| std::fs::read(p).unwrap());
+    let optimized_bytes = (args.get(5))
+        .filter(|p| *p != "-")
+        .map(|p| std::fs::read(p).unwrap());
     let optimized: Option<Vec<Vec<DVec3>>> = optimized_bytes.as_ref().map(|b| {
         let sets = nuld_runtime::Blob::parse(b)
             .unwrap()
@@ -117,15 +122,23 @@ fn main() {
     let blob = nuld_runtime::Blob::parse(&bytes).unwrap();
     let cs = blob.brdf().unwrap().conditional();
     let n = cs.len() as usize;
-    let conditions = [
-        [0.8, 20.0, 0.0],
-        [0.8, 50.0, 0.0],
-        [0.8, 75.0, 0.0],
-        [0.4, 45.0, 0.0],
-        [0.1, 45.0, 0.0],
-        [0.4, 45.0, 1.0],
-        [0.1, 70.0, 1.0],
-    ];
+    let conditions: Vec<[f64; 3]> = match args.get(6) {
+        Some(list) => (list.split('/'))
+            .map(|c| {
+                let v: Vec<f64> = c.split(',').map(|x| x.parse().unwrap()).collect();
+                [v[0], v[1], v[2]]
+            })
+            .collect(),
+        None => vec![
+            [0.8, 20.0, 0.0],
+            [0.8, 50.0, 0.0],
+            [0.8, 75.0, 0.0],
+            [0.4, 45.0, 0.0],
+            [0.1, 45.0, 0.0],
+            [0.4, 45.0, 1.0],
+            [0.1, 70.0, 1.0],
+        ],
+    };
     let generators: Vec<PrimaryPoints> = [Generator::OwenSobol, Generator::Sot, Generator::Gbn]
         .into_iter()
         .map(|g| PrimaryPoints::new(g, n as u32, 1))
