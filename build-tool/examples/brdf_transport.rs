@@ -1,6 +1,8 @@
 //! Whether the BRDF prior's nodes could be blended as *maps* instead of as
 //! densities: `cargo run --release -p nuld-build-tool --example brdf_transport
-//! -- [K] [BLOB]` (about 40 s, 2 min with a blob).
+//! -- [K] [BLOB|-] [N CONDITIONS]` (about 40 s, 2 min with a blob). With `N` and
+//! `CONDITIONS` (`roughness,view°,metallic` separated by `/`), it prints part 1
+//! alone, for sets of `N` at those conditions.
 //!
 //! The shipped prior blends the (up to 8) nodes' densities and inverts the
 //! blend exactly: two binary searches, each step a blended read of every node
@@ -362,9 +364,20 @@ fn main() {
     eprintln!("maps: {:.1} s", start.elapsed().as_secs_f64());
 
     // 1. Held-out conditions.
-    let n = 64;
+    let n: u32 = args.get(3).map_or(64, |s| s.parse().unwrap());
+    let listed: Option<Vec<[f64; 3]>> = args.get(4).map(|list| {
+        (list.split('/'))
+            .map(|c| {
+                let v: Vec<f64> = c.split(',').map(|x| x.parse().unwrap()).collect();
+                [v[0], v[1], v[2]]
+            })
+            .collect()
+    });
     let candidates = selection::candidates(n, lattice_generator(n), k_count);
-    let settings = BrdfPriorSettings::default();
+    let settings = BrdfPriorSettings {
+        n,
+        ..BrdfPriorSettings::default()
+    };
     let score_at = |judge: &Judge<BrdfTarget>, to: &dyn Fn(DVec2) -> DVec3| {
         let sets: Vec<Vec<DVec3>> = candidates
             .iter()
@@ -374,7 +387,8 @@ fn main() {
         s.iter().sum::<f64>() / s.len() as f64
     };
     let f32u = |u: DVec2| [u.x as f32, u.y as f32];
-    let rows: Vec<Vec<f64>> = held_out(&settings)
+    let conditions = listed.clone().unwrap_or_else(|| held_out(&settings));
+    let rows: Vec<Vec<f64>> = conditions
         .par_iter()
         .enumerate()
         .map(|(index, &c)| {
@@ -404,6 +418,9 @@ fn main() {
     for (j, name) in names.iter().enumerate() {
         let (mean, worst) = summary(&rows, j);
         println!("{name:>28}: mean {mean:.3}, worst {worst:.3}");
+    }
+    if listed.is_some() {
+        return;
     }
 
     // 2. At nodes, each node's table alone.
@@ -553,7 +570,9 @@ fn main() {
     );
 
     // 5. A blob's points.
-    let Some(path) = args.get(2) else { return };
+    let Some(path) = args.get(2).filter(|p| *p != "-") else {
+        return;
+    };
     let bytes = std::fs::read(path).unwrap();
     let blob = nuld_runtime::Blob::parse(bytes.as_slice()).unwrap();
     let cs = blob.brdf().unwrap().conditional();
