@@ -1,8 +1,9 @@
 //! Whether the BRDF prior's nodes could be blended as *maps* instead of as
 //! densities: `cargo run --release -p nuld-build-tool --example brdf_transport
-//! -- [K] [BLOB|-] [N CONDITIONS]` (about 40 s, 2 min with a blob). With `N` and
-//! `CONDITIONS` (`roughness,view°,metallic` separated by `/`), it prints part 1
-//! alone, for sets of `N` at those conditions.
+//! -- [K] [BLOB|-] [N CONDITIONS [SIZE]]` (about 40 s, 2 min with a blob). With
+//! `N` and `CONDITIONS` (`roughness,view°,metallic` separated by `/`), it prints
+//! part 1 alone, for sets of `N` at those conditions, through a prior of `SIZE`
+//! vertices a side (default the shipped 96).
 //!
 //! The shipped prior blends the (up to 8) nodes' densities and inverts the
 //! blend exactly: two binary searches, each step a blended read of every node
@@ -58,7 +59,7 @@ use glam::{DVec2, DVec3, Vec2};
 use nuld_build_tool::lab::eval::brdf_prior::{self, held_out, judging, BrdfPriorSettings};
 use nuld_build_tool::lab::eval::prior_judge::Judge;
 use nuld_build_tool::seeding::rng;
-use nuld_build_tool::sphere::brdf_prior::{BrdfPrior, PRIOR_GRID};
+use nuld_build_tool::sphere::brdf_prior::{BrdfPrior, PriorSpace, PRIOR_GRID};
 use nuld_build_tool::sphere::{BrdfTarget, TabulatedWarp};
 use nuld_build_tool::train::lattice_generator;
 use nuld_core::blob::Domain;
@@ -342,7 +343,12 @@ fn turns(samples: usize, fs: &[&dyn Fn(usize) -> f32]) -> Vec<f64> {
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let k_count: u32 = args.get(1).map_or(64, |s| s.parse().unwrap());
-    let prior = BrdfPrior::shared();
+    let prior = match args.get(5) {
+        Some(size) => std::sync::Arc::new(
+            BrdfPrior::new(PRIOR_GRID, size.parse().unwrap(), PriorSpace::HalfVector).unwrap(),
+        ),
+        None => BrdfPrior::shared(),
+    };
     let warp = prior.warp();
     let variants = [
         (0, 33, 0.0),
