@@ -43,6 +43,8 @@ use nuld_core::blob::Domain;
 use rayon::prelude::*;
 use std::f64::consts::TAU;
 
+mod conditions;
+
 /// `cos 60°`: the band of [`rim_counts`].
 const RIM_COS: f64 = 0.5;
 
@@ -123,12 +125,7 @@ fn main() {
     let cs = blob.brdf().unwrap().conditional();
     let n = cs.len() as usize;
     let conditions: Vec<[f64; 3]> = match args.get(6) {
-        Some(list) => (list.split('/'))
-            .map(|c| {
-                let v: Vec<f64> = c.split(',').map(|x| x.parse().unwrap()).collect();
-                [v[0], v[1], v[2]]
-            })
-            .collect(),
+        Some(list) => conditions::parse(list),
         None => vec![
             [0.8, 20.0, 0.0],
             [0.8, 50.0, 0.0],

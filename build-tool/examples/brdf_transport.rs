@@ -52,6 +52,7 @@
 //!    the runtime's table-mode sample, its primary point alone, that point
 //!    through the transport prior, and the same for network mode on decoded
 //!    weights; at metallic 0, 0.5 and 1 in turn, then at 0 and 1 alone.
+mod conditions;
 #[allow(dead_code)]
 mod selection;
 
@@ -371,14 +372,8 @@ fn main() {
 
     // 1. Held-out conditions.
     let n: u32 = args.get(3).map_or(64, |s| s.parse().unwrap());
-    let listed: Option<Vec<[f64; 3]>> = args.get(4).map(|list| {
-        (list.split('/'))
-            .map(|c| {
-                let v: Vec<f64> = c.split(',').map(|x| x.parse().unwrap()).collect();
-                [v[0], v[1], v[2]]
-            })
-            .collect()
-    });
+    let listed = args.get(4).map(|list| conditions::parse(list));
+    let only_listed = listed.is_some();
     let candidates = selection::candidates(n, lattice_generator(n), k_count);
     let settings = BrdfPriorSettings {
         n,
@@ -393,8 +388,7 @@ fn main() {
         s.iter().sum::<f64>() / s.len() as f64
     };
     let f32u = |u: DVec2| [u.x as f32, u.y as f32];
-    let conditions = listed.clone().unwrap_or_else(|| held_out(&settings));
-    let rows: Vec<Vec<f64>> = conditions
+    let rows: Vec<Vec<f64>> = (listed.unwrap_or_else(|| held_out(&settings)))
         .par_iter()
         .enumerate()
         .map(|(index, &c)| {
@@ -425,7 +419,7 @@ fn main() {
         let (mean, worst) = summary(&rows, j);
         println!("{name:>28}: mean {mean:.3}, worst {worst:.3}");
     }
-    if listed.is_some() {
+    if only_listed {
         return;
     }
 
