@@ -130,7 +130,10 @@ pub struct EvalArgs {
     pub brdf_grids: Vec<[u32; 3]>,
     /// brdf-prior: table spaces, `direction` (the light direction's equal-area
     /// square), `half-vector` (the half vector's, its slopes stretched as the
-    /// blob's prior does) and `half-vector:P` (slopes divided by roughness^(P/100)).
+    /// blob's prior does), `half-vector:P` (slopes divided by roughness^(P/100)) and
+    /// `radial:A_B_C_Q:A_B_C_Q` (shared square, metal layer: slopes stretched by
+    /// roughness^(A/100) near the pole and roughness^(B/100) beyond the table
+    /// slope C/100, the in-plane slope further by max(cos θo, 0.05)^(Q/100)).
     #[arg(long, value_delimiter = ',', default_value = "direction,half-vector", value_parser = prior_space)]
     pub spaces: Vec<crate::sphere::brdf_prior::PriorSpace>,
     /// brdf-prior: held-out conditions judged (roughness 0.1 + 0.9 u^2, θo
@@ -296,11 +299,12 @@ fn condition_grid(s: &str) -> Result<[u32; 3], String> {
         .ok_or_else(bad)
 }
 
-/// `direction`, `half-vector` or `half-vector:P`.
+/// `direction`, `half-vector`, `half-vector:P` or `radial:A_B_C_Q:A_B_C_Q`.
 fn prior_space(s: &str) -> Result<crate::sphere::brdf_prior::PriorSpace, String> {
     crate::sphere::brdf_prior::PriorSpace::parse(s).ok_or_else(|| {
         format!(
-            "{s:?} is not a table space: direction, half-vector or half-vector:P (P in 0..=400)"
+            "{s:?} is not a table space: direction, half-vector, half-vector:P (P in 0..=400) \
+             or radial:A_B_C_Q:A_B_C_Q (each in 0..=400, C > 0)"
         )
     })
 }

@@ -28,6 +28,7 @@
 //!   the warp (`build-tool eval brdf-prior`).
 
 use super::envmap_prior::tabulated;
+use super::radial_half_vector::RadialMap;
 use crate::progress::Progress;
 use glam::{DVec2, DVec3};
 use nuld_core::brdf::{gltf_metallic, gltf_metallic_ends, view_direction};
@@ -79,16 +80,36 @@ pub enum PriorSpace {
         /// The stretch's exponent in hundredths.
         stretch_percent: u32,
     },
+    /// The half vector's square under a radial stretch and an in-plane
+    /// anisotropy ([`super::radial_half_vector`]); for measurements. Each layer
+    /// holds `[A, B, C, Q]` in hundredths: `k_s = roughness^(A/100)`, `k_b =
+    /// roughness^(B/100)`, the crossover `a = C/100` (> 0) and `β = max(cos θo,
+    /// 0.05)^(Q/100)`. `[25, 25, C, 0]` is the blob's shared square,
+    /// `[100, 100, C, 0]` its metal layer's.
+    Radial {
+        /// The shared square's (metallic 0 and 1).
+        shared: [u32; 4],
+        /// The metal layer's.
+        metal: [u32; 4],
+    },
 }
 
 impl PriorSpace {
-    /// `direction`, `half-vector` (the blob's) or `half-vector:P` (the stretch's
-    /// exponent `P` in hundredths).
+    /// `direction`, `half-vector` (the blob's), `half-vector:P` (the stretch's
+    /// exponent `P` in hundredths) or `radial:A_B_C_Q:A_B_C_Q` (shared square,
+    /// metal layer; [`Self::Radial`]).
     pub fn name(self) -> String {
         match self {
             Self::Direction => "direction".into(),
             Self::HalfVector => "half-vector".into(),
             Self::HalfVectorPower { stretch_percent } => format!("half-vector:{stretch_percent}"),
+            Self::Radial {
+                shared: s,
+                metal: m,
+            } => format!(
+                "radial:{}_{}_{}_{}:{}_{}_{}_{}",
+                s[0], s[1], s[2], s[3], m[0], m[1], m[2], m[3]
+            ),
         }
     }
 
@@ -97,6 +118,21 @@ impl PriorSpace {
         match name.trim() {
             "direction" => Some(Self::Direction),
             "half-vector" => Some(Self::HalfVector),
+            other if other.starts_with("radial:") => {
+                let layer = |text: &str| -> Option<[u32; 4]> {
+                    let v: Vec<u32> = text
+                        .split('_')
+                        .map(|x| x.parse().ok())
+                        .collect::<Option<_>>()?;
+                    let v: [u32; 4] = v.try_into().ok()?;
+                    (v[0] <= 400 && v[1] <= 400 && v[2] > 0 && v[3] <= 400).then_some(v)
+                };
+                let (shared, metal) = other["radial:".len()..].split_once(':')?;
+                Some(Self::Radial {
+                    shared: layer(shared)?,
+                    metal: layer(metal)?,
+                })
+            }
             other => {
                 let p = other.strip_prefix("half-vector:")?.parse().ok()?;
                 (p <= 400).then_some(Self::HalfVectorPower { stretch_percent: p })
@@ -104,16 +140,37 @@ impl PriorSpace {
         }
     }
 
-    /// The stretch `k` at `roughness` (1 for [`Self::Direction`]).
+    /// The stretch `k` at `roughness` (1 for [`Self::Direction`] and
+    /// [`Self::Radial`], whose [`Self::radial`] stretches instead).
     fn stretch(self, roughness: f64, metal_layer: bool) -> f64 {
         match self {
             Self::Direction => 1.0,
+            Self::Radial { .. } => 1.0,
             _ if metal_layer => metal_stretch(roughness),
             Self::HalfVector => stretch(roughness),
             Self::HalfVectorPower { stretch_percent } => {
                 stretch_with(roughness, stretch_percent as f64 / 100.0)
             }
         }
+    }
+
+    /// The radial map of [`Self::Radial`] at `roughness` for the view `wo` (in
+    /// the metal layer's square if `metal_layer`); `None` for the other spaces.
+    fn radial(self, wo: DVec3, roughness: f64, metal_layer: bool) -> Option<RadialMap> {
+        let Self::Radial { shared, metal } = self else {
+            return None;
+        };
+        let [a, b, c, q] = match metal_layer {
+            true => metal,
+            false => shared,
+        }
+        .map(|x| x as f64 / 100.0);
+        Some(RadialMap {
+            k_small: stretch_with(roughness, a),
+            k_big: stretch_with(roughness, b),
+            crossover: c,
+            aniso: wo.z.max(0.05).powf(q),
+        })
     }
 
     /// The light direction of the square point `p` for the view `wo` at
@@ -131,6 +188,7 @@ impl PriorSpace {
                 let d = square_to_hemisphere(p);
                 (d.z > 0.0).then_some((d, 1.0))
             }
+            Self::Radial { .. } => self.radial(wo, roughness, metal_layer)?.direction(wo, p),
             Self::HalfVector | Self::HalfVectorPower { .. } => {
                 let k = self.stretch(roughness, metal_layer);
                 half_vector_direction(wo.to_array(), p.to_array(), k)
@@ -149,6 +207,7 @@ impl PriorSpace {
     ) -> Option<(DVec2, f64)> {
         match self {
             Self::Direction => (wi.z > 0.0).then(|| (hemisphere_to_square(wi), 1.0)),
+            Self::Radial { .. } => self.radial(wo, roughness, metal_layer)?.point(wo, wi),
             Self::HalfVector | Self::HalfVectorPower { .. } => {
                 let k = self.stretch(roughness, metal_layer);
                 half_vector_point(wo.to_array(), wi.to_array(), k)
@@ -408,14 +467,19 @@ mod tests {
     /// tables approximate; and `pdf` returns the samples' pdf.
     #[test]
     fn the_estimate_with_the_priors_pdf_is_the_albedo() {
-        for space in [PriorSpace::Direction, PriorSpace::HalfVector] {
-            let prior = BrdfPrior::new([3, 4, 2], 32, space).unwrap();
-            assert_eq!(prior.state_bytes(), 4 * 24 * (2 * 32 * 32 + 32 + 1));
+        let radial = PriorSpace::parse("radial:100_25_50_0:150_100_50_100").unwrap();
+        for space in [PriorSpace::Direction, PriorSpace::HalfVector, radial] {
+            let grid = [3, 4, 2 + (space == radial) as u32];
+            let prior = BrdfPrior::new(grid, 32, space).unwrap();
+            let nodes = grid.iter().product::<u32>() as usize;
+            assert_eq!(prior.state_bytes(), 4 * nodes * (2 * 32 * 32 + 32 + 1));
             let warp = prior.warp();
             for (c, condition) in [
                 [0.55, 29.666666666666668, 0.0],
                 [0.4, 50.0, 0.3],
                 [0.8, 75.0, 1.0],
+                [0.15, 80.0, 1.0],
+                [0.15, 80.0, 0.5],
             ]
             .into_iter()
             .enumerate()

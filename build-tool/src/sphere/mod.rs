@@ -15,6 +15,8 @@
 //!   normal;
 //! * [`filtered_luminance`]: a map's bilinearly filtered luminance (the light of
 //!   `bake --envmap` and `render`) and its exact tabulation on half pixels;
+//! * [`radial_half_vector`]: a candidate square of the BRDF prior's tables, the
+//!   half vector's slopes stretched by their own size and along the view's plane;
 //! * [`brdf_albedo`]: the BRDF's directional albedo (the `brdf` normalizer and the
 //!   per-condition sample weight) and tables of it;
 //! * [`geometry`]: closed-form cap measures (uniform sphere and hemisphere, cosine);
@@ -41,6 +43,7 @@ pub mod equirect;
 pub mod filtered_luminance;
 pub mod geometry;
 pub mod metrics;
+pub mod radial_half_vector;
 pub mod spec;
 pub mod tabulated_warp;
 pub mod target;
