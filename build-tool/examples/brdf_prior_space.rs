@@ -84,11 +84,7 @@ fn main() {
     let warps: Vec<_> = priors.iter().map(|p| p.warp()).collect();
     let sets = selection::candidates(n, lattice_generator(n), k);
     let score = |judge: &Judge<BrdfTarget>, to: &dyn Fn(glam::DVec2) -> glam::DVec3| {
-        let dirs: Vec<Vec<glam::DVec3>> = (sets.iter())
-            .map(|set| set.iter().map(|&u| to(u)).collect())
-            .collect();
-        let s = selection::scores(&dirs, judge);
-        s.iter().sum::<f64>() / s.len() as f64
+        selection::mean_score_through(&sets, judge, to)
     };
     let rows: Vec<([f64; 3], Vec<f64>)> = (list.par_iter().enumerate())
         .map(|(index, &c)| {

@@ -380,12 +380,7 @@ fn main() {
         ..BrdfPriorSettings::default()
     };
     let score_at = |judge: &Judge<BrdfTarget>, to: &dyn Fn(DVec2) -> DVec3| {
-        let sets: Vec<Vec<DVec3>> = candidates
-            .iter()
-            .map(|set| set.iter().map(|&u| to(u)).collect())
-            .collect();
-        let s = selection::scores(&sets, judge);
-        s.iter().sum::<f64>() / s.len() as f64
+        selection::mean_score_through(&candidates, judge, to)
     };
     let f32u = |u: DVec2| [u.x as f32, u.y as f32];
     let rows: Vec<Vec<f64>> = (listed.unwrap_or_else(|| held_out(&settings)))

@@ -34,6 +34,21 @@ pub fn scores<C: Sync>(sets: &[Vec<DVec3>], judge: &Judge<C>) -> Vec<f64> {
         .collect()
 }
 
+/// The mean over `candidates` (primary-square sets) of their judged cap L2 over
+/// the judge's baseline once each point is mapped to a direction by `to`.
+#[allow(dead_code)] // the BRDF prior examples'
+pub fn mean_score_through<C: Sync>(
+    candidates: &[Vec<DVec2>],
+    judge: &Judge<C>,
+    to: &dyn Fn(DVec2) -> DVec3,
+) -> f64 {
+    let sets: Vec<Vec<DVec3>> = (candidates.iter())
+        .map(|set| set.iter().map(|&u| to(u)).collect())
+        .collect();
+    let s = scores(&sets, judge);
+    s.iter().sum::<f64>() / s.len() as f64
+}
+
 /// Mean of `scores` at the first `count` indices of `order`.
 pub fn mean_of(scores: &[f64], order: &[usize], count: usize) -> f64 {
     order[..count].iter().map(|&k| scores[k]).sum::<f64>() / count as f64

@@ -144,8 +144,7 @@ impl PriorSpace {
     /// [`Self::Radial`], whose [`Self::radial`] stretches instead).
     fn stretch(self, roughness: f64, metal_layer: bool) -> f64 {
         match self {
-            Self::Direction => 1.0,
-            Self::Radial { .. } => 1.0,
+            Self::Direction | Self::Radial { .. } => 1.0,
             _ if metal_layer => metal_stretch(roughness),
             Self::HalfVector => stretch(roughness),
             Self::HalfVectorPower { stretch_percent } => {

@@ -74,9 +74,9 @@ impl RadialMap {
         0.5 * (lo + hi)
     }
 
-    /// `dω_h / dω_table` of the radial map alone at table slope `t`.
-    fn radial_jacobian(&self, t: f64) -> f64 {
-        let (sigma, dsigma) = self.slope(t);
+    /// `dω_h / dω_table` of the radial map alone at table slope `t`, whose
+    /// [`Self::slope`] is `(sigma, dsigma)`.
+    fn radial_jacobian(&self, t: f64, (sigma, dsigma): (f64, f64)) -> f64 {
         let ratio = if t > 0.0 { sigma / t } else { self.k_small };
         ratio * dsigma * ((1.0 + t * t) / (1.0 + sigma * sigma)).powf(1.5)
     }
@@ -91,7 +91,8 @@ impl RadialMap {
         }
         let rho = s.truncate().length();
         let t = rho / s.z;
-        let (sigma, _) = self.slope(t);
+        let slope = self.slope(t);
+        let sigma = slope.0;
         let e = if rho > 0.0 {
             s.truncate() / rho
         } else {
@@ -107,7 +108,7 @@ impl RadialMap {
             return None;
         }
         let wi = (2.0 * c * h - wo).try_normalize()?;
-        let jac = 4.0 * c * self.radial_jacobian(t) * self.aniso / (len * len * len);
+        let jac = 4.0 * c * self.radial_jacobian(t, slope) * self.aniso / (len * len * len);
         (wi.z > 0.0 && jac.is_finite() && jac > 0.0).then_some((wi, jac))
     }
 
@@ -133,7 +134,8 @@ impl RadialMap {
             DVec2::X
         };
         let s = DVec3::new(t * e.x, t * e.y, 1.0).normalize();
-        let jac = 4.0 * c * self.radial_jacobian(t) * self.aniso * back * back * back;
+        let jac =
+            4.0 * c * self.radial_jacobian(t, self.slope(t)) * self.aniso * back * back * back;
         jac.is_finite().then(|| (hemisphere_to_square(s), jac))
     }
 }
