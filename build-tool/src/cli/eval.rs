@@ -133,7 +133,12 @@ pub struct EvalArgs {
     /// blob's prior does), `half-vector:P` (slopes divided by roughness^(P/100)) and
     /// `radial:A_B_C_Q:A_B_C_Q` (shared square, metal layer: slopes stretched by
     /// roughness^(A/100) near the pole and roughness^(B/100) beyond the table
-    /// slope C/100, the in-plane slope further by max(cos θo, 0.05)^(Q/100)).
+    /// slope C/100, the in-plane slope further by max(cos θo, 0.05)^(Q/100)), and
+    /// for the metal layer on a disc whose rim is the horizon (the shared square
+    /// the blob's): `horizon:C_Q_P` (the mirror direction moved to the disc's
+    /// centre, zoom (C/100) alpha / cos^(P/100) θo) and `star:C_E_Q`, `starl:C_E_Q`
+    /// (the disc drawn from the mirror direction in slopes or Lambert radii,
+    /// zoom (C/100) roughness^(E/100); Q an anisotropy as radial's).
     #[arg(long, value_delimiter = ',', default_value = "direction,half-vector", value_parser = prior_space)]
     pub spaces: Vec<crate::sphere::brdf_prior::PriorSpace>,
     /// brdf-prior: held-out conditions judged (roughness 0.1 + 0.9 u^2, θo
@@ -299,12 +304,14 @@ fn condition_grid(s: &str) -> Result<[u32; 3], String> {
         .ok_or_else(bad)
 }
 
-/// `direction`, `half-vector`, `half-vector:P` or `radial:A_B_C_Q:A_B_C_Q`.
+/// `direction`, `half-vector`, `half-vector:P`, `radial:A_B_C_Q:A_B_C_Q`,
+/// `horizon:C_Q_P`, `star:C_E_Q` or `starl:C_E_Q`.
 fn prior_space(s: &str) -> Result<crate::sphere::brdf_prior::PriorSpace, String> {
     crate::sphere::brdf_prior::PriorSpace::parse(s).ok_or_else(|| {
         format!(
-            "{s:?} is not a table space: direction, half-vector, half-vector:P (P in 0..=400) \
-             or radial:A_B_C_Q:A_B_C_Q (each in 0..=400, C > 0)"
+            "{s:?} is not a table space: direction, half-vector, half-vector:P (P in 0..=400), \
+             radial:A_B_C_Q:A_B_C_Q (each in 0..=400, C > 0), horizon:C_Q_P, star:C_E_Q or \
+             starl:C_E_Q (C in 1..=10000, the others in 0..=400)"
         )
     })
 }

@@ -28,6 +28,7 @@
 //!   the warp (`build-tool eval brdf-prior`).
 
 use super::envmap_prior::tabulated;
+use super::horizon_disc::{HorizonDisc, StarDisc};
 use super::radial_half_vector::RadialMap;
 use crate::progress::Progress;
 use glam::{DVec2, DVec3};
@@ -92,12 +93,25 @@ pub enum PriorSpace {
         /// The metal layer's.
         metal: [u32; 4],
     },
+    /// The blob's shared square, and the metal layer on a disc whose rim is the
+    /// horizon at every view ([`super::horizon_disc`]); for measurements.
+    /// `horizon:C_Q_P`: the half vector's slope disc moved to put the mirror
+    /// direction at its centre, zoom `k = (C/100) α / cos^(P/100) θo`,
+    /// anisotropy `β = max(cos θo, 0.05)^(Q/100)`
+    /// ([`super::horizon_disc::HorizonDisc`]); `star:C_E_0`: the slope disc
+    /// drawn from the mirror direction, zoom `k = (C/100) roughness^(E/100)`
+    /// ([`super::horizon_disc::StarDisc`]).
+    Horizon {
+        /// The metal layer's three numbers, then 0 for `horizon`, 1 for `star`.
+        metal: [u32; 4],
+    },
 }
 
 impl PriorSpace {
     /// `direction`, `half-vector` (the blob's), `half-vector:P` (the stretch's
-    /// exponent `P` in hundredths) or `radial:A_B_C_Q:A_B_C_Q` (shared square,
-    /// metal layer; [`Self::Radial`]).
+    /// exponent `P` in hundredths), `radial:A_B_C_Q:A_B_C_Q` (shared square,
+    /// metal layer; [`Self::Radial`]), `horizon:C_Q_P` or `star:C_E_0` (the metal
+    /// layer; [`Self::Horizon`]).
     pub fn name(self) -> String {
         match self {
             Self::Direction => "direction".into(),
@@ -110,6 +124,13 @@ impl PriorSpace {
                 "radial:{}_{}_{}_{}:{}_{}_{}_{}",
                 s[0], s[1], s[2], s[3], m[0], m[1], m[2], m[3]
             ),
+            Self::Horizon { metal: m } => format!(
+                "{}:{}_{}_{}",
+                ["horizon", "star", "starl"][m[3] as usize],
+                m[0],
+                m[1],
+                m[2]
+            ),
         }
     }
 
@@ -118,6 +139,27 @@ impl PriorSpace {
         match name.trim() {
             "direction" => Some(Self::Direction),
             "half-vector" => Some(Self::HalfVector),
+            other
+                if other.starts_with("horizon:")
+                    || other.starts_with("star:")
+                    || other.starts_with("starl:") =>
+            {
+                let star = match &other[..other.find(':')?] {
+                    "star" => 1,
+                    "starl" => 2,
+                    _ => 0,
+                };
+                let v: Vec<u32> = other[other.find(':')? + 1..]
+                    .split('_')
+                    .map(|x| x.parse().ok())
+                    .collect::<Option<_>>()?;
+                let v: [u32; 3] = v.try_into().ok()?;
+                (v[0] > 0 && v[0] <= 10_000 && v[1] <= 400 && v[2] <= 400).then_some(
+                    Self::Horizon {
+                        metal: [v[0], v[1], v[2], star],
+                    },
+                )
+            }
             other if other.starts_with("radial:") => {
                 let layer = |text: &str| -> Option<[u32; 4]> {
                     let v: Vec<u32> = text
@@ -146,7 +188,7 @@ impl PriorSpace {
         match self {
             Self::Direction | Self::Radial { .. } => 1.0,
             _ if metal_layer => metal_stretch(roughness),
-            Self::HalfVector => stretch(roughness),
+            Self::HalfVector | Self::Horizon { .. } => stretch(roughness),
             Self::HalfVectorPower { stretch_percent } => {
                 stretch_with(roughness, stretch_percent as f64 / 100.0)
             }
@@ -188,7 +230,11 @@ impl PriorSpace {
                 (d.z > 0.0).then_some((d, 1.0))
             }
             Self::Radial { .. } => self.radial(wo, roughness, metal_layer)?.direction(wo, p),
-            Self::HalfVector | Self::HalfVectorPower { .. } => {
+            Self::Horizon { metal } if metal_layer => match horizon(metal, wo, roughness) {
+                Ok(disc) => disc.direction(wo, p),
+                Err(star) => star.direction(wo, p),
+            },
+            Self::HalfVector | Self::HalfVectorPower { .. } | Self::Horizon { .. } => {
                 let k = self.stretch(roughness, metal_layer);
                 half_vector_direction(wo.to_array(), p.to_array(), k)
                     .map(|(wi, jac)| (DVec3::from_array(wi), jac))
@@ -207,12 +253,32 @@ impl PriorSpace {
         match self {
             Self::Direction => (wi.z > 0.0).then(|| (hemisphere_to_square(wi), 1.0)),
             Self::Radial { .. } => self.radial(wo, roughness, metal_layer)?.point(wo, wi),
-            Self::HalfVector | Self::HalfVectorPower { .. } => {
+            Self::Horizon { metal } if metal_layer => match horizon(metal, wo, roughness) {
+                Ok(disc) => disc.point(wo, wi),
+                Err(star) => star.point(wo, wi),
+            },
+            Self::HalfVector | Self::HalfVectorPower { .. } | Self::Horizon { .. } => {
                 let k = self.stretch(roughness, metal_layer);
                 half_vector_point(wo.to_array(), wi.to_array(), k)
                     .map(|(p, jac)| (DVec2::from_array(p), jac))
             }
         }
+    }
+}
+
+/// The metal layer's map of [`PriorSpace::Horizon`] at `roughness` for the view
+/// `wo`: `horizon:C_Q_P`'s disc, or the star disc of `star:C_E_Q` and
+/// `starl:C_E_Q` (`k = (C/100) roughness^(E/100)`, `β = max(cos θo,
+/// 0.05)^(Q/100)`).
+fn horizon(metal: [u32; 4], wo: DVec3, roughness: f64) -> Result<HorizonDisc, StarDisc> {
+    let [a, b, c] = [metal[0], metal[1], metal[2]].map(|x| x as f64 / 100.0);
+    match metal[3] {
+        0 => Ok(HorizonDisc::at(wo, roughness, a, b, c)),
+        kind => Err(StarDisc {
+            zoom: a * roughness.powf(b),
+            lambert: kind == 2,
+            aniso: wo.z.max(0.05).powf(c),
+        }),
     }
 }
 
@@ -460,6 +526,33 @@ mod tests {
     use crate::sphere::brdf_albedo::directional_albedo_metallic;
     use rand::Rng;
 
+    /// Every space's name parses back to it; malformed names are refused.
+    #[test]
+    fn space_names_parse_back() {
+        for name in [
+            "direction",
+            "half-vector",
+            "half-vector:35",
+            "radial:100_25_25_0:100_100_50_100",
+            "horizon:50_0_100",
+            "star:100_200_0",
+            "starl:70_150_50",
+        ] {
+            let space = PriorSpace::parse(name).unwrap();
+            assert_eq!(space.name(), name);
+        }
+        for bad in [
+            "horizon:0_0_100",
+            "star:100_200",
+            "starl:100_200_0_1",
+            "star:100_500_0",
+            "stars:100_200_0",
+            "radial:1_1_0_1:1_1_1_1",
+        ] {
+            assert_eq!(PriorSpace::parse(bad), None, "{bad}");
+        }
+    }
+
     /// `(1/M) Σ f cos / pdf` over the prior's samples is the albedo of the
     /// independent quadrature (`directional_albedo_metallic`), on and between the
     /// nodes, in both spaces: the pdf is the samples' density, whatever the
@@ -467,8 +560,22 @@ mod tests {
     #[test]
     fn the_estimate_with_the_priors_pdf_is_the_albedo() {
         let radial = PriorSpace::parse("radial:100_25_50_0:150_100_50_100").unwrap();
-        for space in [PriorSpace::Direction, PriorSpace::HalfVector, radial] {
-            let grid = [3, 4, 2 + (space == radial) as u32];
+        let horizon = PriorSpace::parse("horizon:100_100_100").unwrap();
+        let star = PriorSpace::parse("star:100_100_0").unwrap();
+        let starl = PriorSpace::parse("starl:100_200_100").unwrap();
+        for space in [
+            PriorSpace::Direction,
+            PriorSpace::HalfVector,
+            radial,
+            horizon,
+            star,
+            starl,
+        ] {
+            let grid = [
+                3,
+                4,
+                2 + !matches!(space, PriorSpace::Direction | PriorSpace::HalfVector) as u32,
+            ];
             let prior = BrdfPrior::new(grid, 32, space).unwrap();
             let nodes = grid.iter().product::<u32>() as usize;
             assert_eq!(prior.state_bytes(), 4 * nodes * (2 * 32 * 32 + 32 + 1));

@@ -17,6 +17,8 @@
 //!   `bake --envmap` and `render`) and its exact tabulation on half pixels;
 //! * [`radial_half_vector`]: a candidate square of the BRDF prior's tables, the
 //!   half vector's slopes stretched by their own size and along the view's plane;
+//! * [`horizon_disc`]: candidate squares of the BRDF prior's metal layer whose
+//!   rim is the horizon at every view;
 //! * [`brdf_albedo`]: the BRDF's directional albedo (the `brdf` normalizer and the
 //!   per-condition sample weight) and tables of it;
 //! * [`geometry`]: closed-form cap measures (uniform sphere and hemisphere, cosine);
@@ -42,9 +44,12 @@ pub mod envmap_tree;
 pub mod equirect;
 pub mod filtered_luminance;
 pub mod geometry;
+pub mod horizon_disc;
 pub mod metrics;
 pub mod radial_half_vector;
 pub mod spec;
+#[cfg(test)]
+mod table_map_checks;
 pub mod tabulated_warp;
 pub mod target;
 

@@ -29,6 +29,7 @@
 //! t^2) / (1 + σ^2))^(3/2)` (`σ/t -> k_s` at the pole), the anisotropy's `β /
 //! |(β h1.x, h1.y, h1.z)|^3`, the reflection's `4 (wo.h)`.
 
+use super::horizon_disc::{half_vector_of, reflect};
 use glam::{DVec2, DVec3};
 use nuld_core::sphere::{hemisphere_to_square, square_to_hemisphere};
 
@@ -102,12 +103,7 @@ impl RadialMap {
         let v = DVec3::new(self.aniso * h1.x, h1.y, h1.z);
         let len = v.length();
         let h = v / len;
-        let c = wo.dot(h);
-        // NaN fails the comparison too.
-        if c.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-            return None;
-        }
-        let wi = (2.0 * c * h - wo).try_normalize()?;
+        let (wi, c) = reflect(wo, h)?;
         let jac = 4.0 * c * self.radial_jacobian(t, slope) * self.aniso / (len * len * len);
         (wi.z > 0.0 && jac.is_finite() && jac > 0.0).then_some((wi, jac))
     }
@@ -115,14 +111,7 @@ impl RadialMap {
     /// The inverse of [`Self::direction`]: the table point of `wi` and the same
     /// Jacobian; `None` where no table point maps to `wi`.
     pub fn point(&self, wo: DVec3, wi: DVec3) -> Option<(DVec2, f64)> {
-        if wi.z.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-            return None;
-        }
-        let h = (wo + wi).try_normalize()?;
-        let c = wo.dot(h);
-        if !(h.z > 0.0 && c > 0.0) {
-            return None;
-        }
+        let (h, c) = half_vector_of(wo, wi)?;
         let v = DVec3::new(h.x / self.aniso, h.y, h.z);
         let back = v.length();
         let h1 = v / back;
@@ -143,6 +132,7 @@ impl RadialMap {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sphere::table_map_checks::check_inverse_and_jacobian;
     use nuld_core::brdf::view_direction;
     use nuld_core::brdf_prior::half_vector_direction;
 
@@ -184,38 +174,7 @@ mod tests {
             aniso: 0.2,
         };
         let wo = view_direction(78.0);
-        let mut checked = 0;
-        for i in 1..24 {
-            for j in 1..24 {
-                let p = DVec2::new(i as f64 / 24.0, j as f64 / 24.0);
-                let Some((wi, jac)) = map.direction(wo, p) else {
-                    continue;
-                };
-                let (q, back) = map.point(wo, wi).unwrap();
-                assert!((q - p).length() < 1e-9, "{q} {p}");
-                assert!((back - jac).abs() < 1e-6 * jac);
-                // The equal-area square's map has seams on its diagonals, where a
-                // difference across them measures no derivative.
-                if i == j || i + j == 24 {
-                    continue;
-                }
-                let h = 1e-6;
-                let at = |d: DVec2| map.direction(wo, p + d).map(|x| x.0);
-                let (Some(xp), Some(xm), Some(yp), Some(ym)) = (
-                    at(DVec2::new(h, 0.0)),
-                    at(DVec2::new(-h, 0.0)),
-                    at(DVec2::new(0.0, h)),
-                    at(DVec2::new(0.0, -h)),
-                ) else {
-                    continue;
-                };
-                // Solid angle of the image over the table's (2π per unit area).
-                let area = (xp - xm).cross(yp - ym).length() / (4.0 * h * h);
-                let want = area / (2.0 * std::f64::consts::PI);
-                assert!((want - jac).abs() < 1e-4 * jac, "{want} {jac} at {p}");
-                checked += 1;
-            }
-        }
+        let checked = check_inverse_and_jacobian(|p| map.direction(wo, p), |wi| map.point(wo, wi));
         assert!(checked > 200, "{checked}");
     }
 }
