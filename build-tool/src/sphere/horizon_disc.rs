@@ -10,8 +10,8 @@
 //!
 //! * In the half vector's slope plane `s = (h.x, h.y) / h.z`, for the view `wo =
 //!   (sin θo, 0, cos θo)`, the light `wi = 2 (wo.h) h - wo` lies above the
-//!   horizon exactly on the disc `|s - (tan θo, 0)| <= 1 / cos θo` (expand `wi.z
-//!   >= 0` with `h = (s, 1) / |(s, 1)|`). Its point `z = cos θo s - (sin θo, 0)`
+//!   horizon exactly on the disc `|s - (tan θo, 0)| <= 1 / cos θo` (expand
+//!   `wi.z >= 0` with `h = (s, 1) / |(s, 1)|`). Its point `z = cos θo s - (sin θo, 0)`
 //!   on the unit disc takes the mirror direction (`s = 0`) to `-sin θo`.
 //! * The disc automorphism `w = (z + sin θo) / (1 + sin θo z)` (complex numbers)
 //!   takes the mirror direction to the centre and keeps the unit circle, the
