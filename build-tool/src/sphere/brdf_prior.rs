@@ -28,7 +28,7 @@
 //!   the warp (`build-tool eval brdf-prior`).
 
 use super::envmap_prior::tabulated;
-use super::horizon_disc::{HorizonDisc, StarDisc};
+use super::horizon_disc::{HorizonDisc, HorizonMap, StarDisc};
 use super::radial_half_vector::RadialMap;
 use crate::progress::Progress;
 use glam::{DVec2, DVec3};
@@ -98,11 +98,13 @@ pub enum PriorSpace {
     /// `horizon:C_Q_P`: the half vector's slope disc moved to put the mirror
     /// direction at its centre, zoom `k = (C/100) α / cos^(P/100) θo`,
     /// anisotropy `β = max(cos θo, 0.05)^(Q/100)`
-    /// ([`super::horizon_disc::HorizonDisc`]); `star:C_E_0`: the slope disc
-    /// drawn from the mirror direction, zoom `k = (C/100) roughness^(E/100)`
-    /// ([`super::horizon_disc::StarDisc`]).
+    /// ([`super::horizon_disc::HorizonDisc`]); `star:C_E_Q`: the slope disc
+    /// drawn from the mirror direction, zoom `k = (C/100) roughness^(E/100)`,
+    /// anisotropy as above ([`super::horizon_disc::StarDisc`]); `starl:C_E_Q`
+    /// the same in the half vector's Lambert radius.
     Horizon {
-        /// The metal layer's three numbers, then 0 for `horizon`, 1 for `star`.
+        /// The metal layer's three numbers, then 0 for `horizon`, 1 for `star`,
+        /// 2 for `starl`.
         metal: [u32; 4],
     },
 }
@@ -110,8 +112,8 @@ pub enum PriorSpace {
 impl PriorSpace {
     /// `direction`, `half-vector` (the blob's), `half-vector:P` (the stretch's
     /// exponent `P` in hundredths), `radial:A_B_C_Q:A_B_C_Q` (shared square,
-    /// metal layer; [`Self::Radial`]), `horizon:C_Q_P` or `star:C_E_0` (the metal
-    /// layer; [`Self::Horizon`]).
+    /// metal layer; [`Self::Radial`]), `horizon:C_Q_P`, `star:C_E_Q` or `starl:C_E_Q`
+    /// (the metal layer; [`Self::Horizon`]).
     pub fn name(self) -> String {
         match self {
             Self::Direction => "direction".into(),
@@ -230,10 +232,9 @@ impl PriorSpace {
                 (d.z > 0.0).then_some((d, 1.0))
             }
             Self::Radial { .. } => self.radial(wo, roughness, metal_layer)?.direction(wo, p),
-            Self::Horizon { metal } if metal_layer => match horizon(metal, wo, roughness) {
-                Ok(disc) => disc.direction(wo, p),
-                Err(star) => star.direction(wo, p),
-            },
+            Self::Horizon { metal } if metal_layer => {
+                horizon(metal, wo, roughness).direction(wo, p)
+            }
             Self::HalfVector | Self::HalfVectorPower { .. } | Self::Horizon { .. } => {
                 let k = self.stretch(roughness, metal_layer);
                 half_vector_direction(wo.to_array(), p.to_array(), k)
@@ -253,10 +254,7 @@ impl PriorSpace {
         match self {
             Self::Direction => (wi.z > 0.0).then(|| (hemisphere_to_square(wi), 1.0)),
             Self::Radial { .. } => self.radial(wo, roughness, metal_layer)?.point(wo, wi),
-            Self::Horizon { metal } if metal_layer => match horizon(metal, wo, roughness) {
-                Ok(disc) => disc.point(wo, wi),
-                Err(star) => star.point(wo, wi),
-            },
+            Self::Horizon { metal } if metal_layer => horizon(metal, wo, roughness).point(wo, wi),
             Self::HalfVector | Self::HalfVectorPower { .. } | Self::Horizon { .. } => {
                 let k = self.stretch(roughness, metal_layer);
                 half_vector_point(wo.to_array(), wi.to_array(), k)
@@ -270,11 +268,11 @@ impl PriorSpace {
 /// `wo`: `horizon:C_Q_P`'s disc, or the star disc of `star:C_E_Q` and
 /// `starl:C_E_Q` (`k = (C/100) roughness^(E/100)`, `β = max(cos θo,
 /// 0.05)^(Q/100)`).
-fn horizon(metal: [u32; 4], wo: DVec3, roughness: f64) -> Result<HorizonDisc, StarDisc> {
+fn horizon(metal: [u32; 4], wo: DVec3, roughness: f64) -> HorizonMap {
     let [a, b, c] = [metal[0], metal[1], metal[2]].map(|x| x as f64 / 100.0);
     match metal[3] {
-        0 => Ok(HorizonDisc::at(wo, roughness, a, b, c)),
-        kind => Err(StarDisc {
+        0 => HorizonMap::Moved(HorizonDisc::at(wo, roughness, a, b, c)),
+        kind => HorizonMap::Star(StarDisc {
             zoom: a * roughness.powf(b),
             lambert: kind == 2,
             aniso: wo.z.max(0.05).powf(c),

@@ -229,6 +229,33 @@ impl StarDisc {
     }
 }
 
+/// One of the module's two maps, for a caller that chooses at run time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum HorizonMap {
+    /// The slope disc moved by the automorphism ([`HorizonDisc`]).
+    Moved(HorizonDisc),
+    /// The slope disc drawn from the mirror direction ([`StarDisc`]).
+    Star(StarDisc),
+}
+
+impl HorizonMap {
+    /// The map's `direction` ([`HorizonDisc::direction`], [`StarDisc::direction`]).
+    pub fn direction(&self, wo: DVec3, p: DVec2) -> Option<(DVec3, f64)> {
+        match self {
+            Self::Moved(m) => m.direction(wo, p),
+            Self::Star(m) => m.direction(wo, p),
+        }
+    }
+
+    /// The map's `point` ([`HorizonDisc::point`], [`StarDisc::point`]).
+    pub fn point(&self, wo: DVec3, wi: DVec3) -> Option<(DVec2, f64)> {
+        match self {
+            Self::Moved(m) => m.point(wo, wi),
+            Self::Star(m) => m.point(wo, wi),
+        }
+    }
+}
+
 /// The light `wi = 2 (wo.h) h - wo` of the half vector `h` for the view `wo`, and
 /// `wo.h`; `None` where `wo.h <= 0` (or NaN).
 pub fn reflect(wo: DVec3, h: DVec3) -> Option<(DVec3, f64)> {
