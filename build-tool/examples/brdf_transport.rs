@@ -65,9 +65,7 @@ use nuld_build_tool::sphere::{BrdfTarget, TabulatedWarp};
 use nuld_build_tool::train::lattice_generator;
 use nuld_core::blob::Domain;
 use nuld_core::brdf::{alpha, gltf_metallic, view_direction, view_direction_real};
-use nuld_core::brdf_prior::{
-    half_vector_direction, query_stretch, reads_metal_layer, unit_condition,
-};
+use nuld_core::brdf_prior::{query_square, reads_metal_layer, unit_condition};
 use nuld_core::marginal2d::{Blend, Marginal2D};
 use nuld_core::warp::{brdf_mixture_pdf, brdf_mixture_real};
 use nuld_runtime::ConditionalSampler;
@@ -288,9 +286,10 @@ fn map_blend(prior: &BrdfPrior, layers: u32, c: [f32; 3]) -> Blend<f32> {
 /// The light direction of the square point `p` at condition `c`.
 fn direction(c: [f64; 3], p: [f32; 2]) -> DVec3 {
     let wo = view_direction(c[1]).to_array();
-    let k = query_stretch(PRIOR_GRID, c);
     let p = [p[0] as f64, p[1] as f64];
-    half_vector_direction(wo, p, k).map_or(DVec3::Z, |(wi, _)| DVec3::from_array(wi))
+    query_square(PRIOR_GRID, c)
+        .direction(wo, p)
+        .map_or(DVec3::Z, |(wi, _)| DVec3::from_array(wi))
 }
 
 /// The transport prior's whole sample: direction, solid-angle pdf and weight
@@ -303,7 +302,7 @@ fn sample_weighted(
 ) -> ([f32; 3], f32, f32) {
     let wo = view_direction_real(c[1]);
     let (p, pdf) = map.sample(u, &map_blend(prior, PROPOSAL.layers, c));
-    match half_vector_direction(wo, p, query_stretch(prior.grid, c)) {
+    match query_square(prior.grid, c).direction(wo, p) {
         Some((wi, jac)) => {
             let pdf = pdf / (2.0 * std::f32::consts::PI * jac);
             (wi, pdf, gltf_metallic(wo, wi, c[0], c[2]) * wi[2] / pdf)

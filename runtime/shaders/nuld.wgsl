@@ -66,7 +66,7 @@ const NULD_TAG_ENVMAP_TREE_CORNERS: u32 = 19u;
 const NULD_TAG_ENVMAP_TREE_DETAIL_INDEX: u32 = 20u;
 const NULD_TAG_ENVMAP_TREE_DETAIL: u32 = 21u;
 const NULD_TAG_ENVMAP_TREE_FINE_DETAIL: u32 = 22u;
-const NULD_TAG_BRDF_PRIOR_INFO: u32 = 15u;
+const NULD_TAG_BRDF_PRIOR_INFO: u32 = 23u;
 const NULD_TAG_BRDF_PRIOR_DATA: u32 = 11u;
 const NULD_TAG_BRDF_PRIOR_MARGINAL: u32 = 12u;
 const NULD_TAG_BRDF_PRIOR_CONDITIONAL: u32 = 13u;
@@ -1601,15 +1601,6 @@ fn nuld_reads_metal_layer(pr: NuldBrdfPrior, metallic: f32) -> bool {
     return pr.grid.z == 3u && nuld_clamp01(metallic) >= 1.0;
 }
 
-// Rust: `query_stretch`: the metal layer's stretch `k = roughness` where a query
-// reads it, else the shared square's `roughness^(1/4)`.
-fn nuld_prior_stretch(pr: NuldBrdfPrior, cond: vec3<f32>) -> f32 {
-    if nuld_reads_metal_layer(pr, cond.z) {
-        return nuld_clamp_roughness(cond.x);
-    }
-    return nuld_stretch(cond.x);
-}
-
 // Rust: `BrdfPrior::blend` (`mass_weighted_blend`, with `unit_condition`,
 // `Blend::multilinear` and `Blend::from_pairs`): the nodes around `cond =
 // (roughness, theta_o in degrees, metallic)`, clamped (NaN to the lower ends)
@@ -2027,6 +2018,126 @@ fn nuld_half_vector_point(wo: vec3<f32>, wi: vec3<f32>, k: f32) -> NuldHalfVecto
     return NuldHalfVector(vec3<f32>(nuld_hemisphere_to_square(s), 0.0), jac);
 }
 
+// Rust: `horizon_reach`: how far the half vector's slope plane reaches above
+// the horizon along the unit direction `e` from the mirror direction (towards
+// the viewer without the cancellation).
+fn nuld_horizon_reach(wo: vec3<f32>, e: vec2<f32>) -> f32 {
+    let t = wo.x / max(wo.z, 1e-6);
+    let te = t * e.x;
+    let root = sqrt(1.0 + te * te);
+    if te < 0.0 {
+        return 1.0 / (root - te);
+    }
+    return te + root;
+}
+
+// Rust: `star_jacobian`: `2 (wo.h) k^2 / ((1 + rho^2)^(3/2) den^3)`.
+fn nuld_star_jacobian(c: f32, rho: f32, k: f32, den: f32) -> f32 {
+    let len2 = 1.0 + rho * rho;
+    return 2.0 * c * k * k / (len2 * sqrt(len2) * den * den * den);
+}
+
+// Rust: `star_direction`: the light direction of the metal layer's star-disc
+// point `p` at the zoom `k`: the square's hemisphere direction to the unit disc
+// (Lambert), its radius `r` to the slope `rho = k r / (1 - (1 - k / R(e)) r)`
+// along its direction `e`, the half vector `(rho e, 1) / L` and its mirror.
+fn nuld_star_direction(wo: vec3<f32>, p: vec2<f32>, k: f32) -> NuldHalfVector {
+    let missing = NuldHalfVector(vec3<f32>(0.0, 0.0, 1.0), 0.0);
+    let d = nuld_square_to_hemisphere(p);
+    let z = max(d.z, 0.0);
+    let f = sqrt(1.0 + z);
+    let q = vec2<f32>(d.x / f, d.y / f);
+    let r = min(sqrt(q.x * q.x + q.y * q.y), 1.0);
+    var e = vec2<f32>(1.0, 0.0);
+    if r > 0.0 {
+        e = vec2<f32>(q.x / r, q.y / r);
+    }
+    // `1 - (1 - k / R) r` with `1 - r = z / (1 + r)`: no cancellation.
+    let den = z / (1.0 + r) + k / nuld_horizon_reach(wo, e) * r;
+    let rho = k * r / den;
+    let l = sqrt(1.0 + rho * rho);
+    let h = vec3<f32>(rho * e.x / l, rho * e.y / l, 1.0 / l);
+    let c = wo.x * h.x + wo.y * h.y + wo.z * h.z;
+    if !(c > 0.0) {
+        return missing;
+    }
+    let two_c = 2.0 * c;
+    let v = vec3<f32>(two_c * h.x - wo.x, two_c * h.y - wo.y, two_c * h.z - wo.z);
+    let len = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+    if !(len > 0.0 && nuld_is_finite(len)) {
+        return missing;
+    }
+    let wi = vec3<f32>(v.x / len, v.y / len, v.z / len);
+    let jac = nuld_star_jacobian(c, rho, k, den);
+    if !(wi.z > 0.0 && nuld_is_finite(jac) && jac > 0.0) {
+        return missing;
+    }
+    return NuldHalfVector(wi, jac);
+}
+
+// Rust: `star_point`: the star-disc point (in `w.xy`) of `wi`: the slope
+// `rho e` of `h = (wo + wi) / |wo + wi|` at disc radius `r = rho / g`, `g = k +
+// (1 - k / R(e)) rho`, lifted to the hemisphere; none where `wi.z <= 0`, `h.z <= 0`,
+// `wo.h <= 0` or the slope is past the horizon's reach.
+fn nuld_star_point(wo: vec3<f32>, wi: vec3<f32>, k: f32) -> NuldHalfVector {
+    let missing = NuldHalfVector(vec3<f32>(0.5, 0.5, 0.0), 0.0);
+    if !(wi.z > 0.0) {
+        return missing;
+    }
+    let v = vec3<f32>(wo.x + wi.x, wo.y + wi.y, wo.z + wi.z);
+    let len = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+    if !(len > 0.0 && nuld_is_finite(len)) {
+        return missing;
+    }
+    let h = vec3<f32>(v.x / len, v.y / len, v.z / len);
+    let c = wo.x * h.x + wo.y * h.y + wo.z * h.z;
+    if !(h.z > 0.0 && c > 0.0) {
+        return missing;
+    }
+    let s = vec2<f32>(h.x / h.z, h.y / h.z);
+    let rho = sqrt(s.x * s.x + s.y * s.y);
+    var e = vec2<f32>(1.0, 0.0);
+    if rho > 0.0 {
+        e = vec2<f32>(s.x / rho, s.y / rho);
+    }
+    let reach = nuld_horizon_reach(wo, e);
+    if !(rho < reach && nuld_is_finite(rho)) {
+        return missing;
+    }
+    let g = k + (1.0 - k / reach) * rho;
+    let r = rho / g;
+    let den = k / g;
+    let z = k * (reach - rho) / (reach * g) * (1.0 + r);
+    let jac = nuld_star_jacobian(c, rho, k, den);
+    if !(nuld_is_finite(jac) && jac > 0.0) {
+        return missing;
+    }
+    let lift = sqrt(1.0 + z);
+    let dir = vec3<f32>(r * e.x * lift, r * e.y * lift, z);
+    return NuldHalfVector(vec3<f32>(nuld_hemisphere_to_square(dir), 0.0), jac);
+}
+
+// Rust: `query_square`'s `PriorSquare::direction`: the metal layer's star disc
+// of zoom `roughness^2` where a query reads it, else the shared square of
+// stretch `roughness^(1/4)`.
+fn nuld_prior_direction(pr: NuldBrdfPrior, cond: vec3<f32>, wo: vec3<f32>, p: vec2<f32>) -> NuldHalfVector {
+    if nuld_reads_metal_layer(pr, cond.z) {
+        let r = nuld_clamp_roughness(cond.x);
+        return nuld_star_direction(wo, p, r * r);
+    }
+    return nuld_half_vector_direction(wo, p, nuld_stretch(cond.x));
+}
+
+// Rust: `query_square`'s `PriorSquare::point`: the inverse of
+// `nuld_prior_direction`.
+fn nuld_prior_point(pr: NuldBrdfPrior, cond: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> NuldHalfVector {
+    if nuld_reads_metal_layer(pr, cond.z) {
+        let r = nuld_clamp_roughness(cond.x);
+        return nuld_star_point(wo, wi, r * r);
+    }
+    return nuld_half_vector_point(wo, wi, nuld_stretch(cond.x));
+}
+
 // Rust: `BrdfPrior::sample`: the light direction of primary sample `u` for the
 // xz-plane view of `cond = (roughness, theta_o in degrees, metallic)` and its
 // solid-angle pdf, the square's over `2 pi |dwi/dh|`; `(+z, 0)` for a point without
@@ -2034,7 +2145,7 @@ fn nuld_half_vector_point(wo: vec3<f32>, wi: vec3<f32>, k: f32) -> NuldHalfVecto
 fn nuld_brdf_prior_sample(pr: NuldBrdfPrior, cond: vec3<f32>, u: vec2<f32>) -> NuldTreeSample {
     let wo = nuld_view_direction(cond.y);
     let s = nuld_marginal_sample(pr, nuld_brdf_blend(pr, cond), u);
-    let hv = nuld_half_vector_direction(wo, s.p, nuld_prior_stretch(pr, cond));
+    let hv = nuld_prior_direction(pr, cond, wo, s.p);
     if hv.jac > 0.0 {
         let pdf = s.pdf / (2.0 * NULD_PI * hv.jac);
         // Only tables near the float range (a hostile blob's) overflow.
@@ -2050,7 +2161,7 @@ fn nuld_brdf_prior_sample(pr: NuldBrdfPrior, cond: vec3<f32>, u: vec2<f32>) -> N
 // nothing.
 fn nuld_brdf_prior_pdf(pr: NuldBrdfPrior, cond: vec3<f32>, wi: vec3<f32>) -> f32 {
     let wo = nuld_view_direction(cond.y);
-    let hv = nuld_half_vector_point(wo, wi, nuld_prior_stretch(pr, cond));
+    let hv = nuld_prior_point(pr, cond, wo, wi);
     if hv.jac > 0.0 {
         let pdf = nuld_marginal_pdf(pr, nuld_brdf_blend(pr, cond), hv.w.xy) / (2.0 * NULD_PI * hv.jac);
         if nuld_is_finite(pdf) {

@@ -505,32 +505,37 @@ mod tests {
         assert!(s.pdf > 0.0 && s.weight > 0.0);
     }
 
-    /// A blob of the earlier, unstretched prior (its info under tag 10, the
-    /// checksum sound) is refused with the advice to bake it again.
+    /// A blob of an earlier prior (its info under tag 10, the unstretched
+    /// square, or tag 15, the stretched metal square; the checksum sound) is
+    /// refused with the advice to bake it again.
     #[test]
-    fn a_brdf_blob_of_the_unstretched_prior_is_refused() {
+    fn a_brdf_blob_of_an_earlier_prior_is_refused() {
         use nuld_core::blob::{
-            checksum, SectionTag, CHECKSUM_OFFSET, HEADER_LEN, SECTION_ENTRY_LEN,
+            checksum, ConditionalError, SectionTag, CHECKSUM_OFFSET, HEADER_LEN, SECTION_ENTRY_LEN,
         };
-        let mut bytes = doc_example_brdf_blob();
-        let b = &mut bytes.0;
-        let count = u32::from_le_bytes(b[40..44].try_into().unwrap()) as usize;
-        let row = (0..count)
-            .map(|k| HEADER_LEN + k * SECTION_ENTRY_LEN)
-            .find(|&at| {
-                u32::from_le_bytes(b[at..at + 4].try_into().unwrap())
-                    == SectionTag::BrdfPriorInfo as u32
-            })
-            .unwrap();
-        b[row..row + 4].copy_from_slice(&10u32.to_le_bytes());
-        let sum = checksum(b);
-        b[CHECKSUM_OFFSET..CHECKSUM_OFFSET + 8].copy_from_slice(&sum.to_le_bytes());
-        let err = Blob::parse(b).unwrap_err();
-        assert_eq!(
-            err,
-            BlobError::Conditional(nuld_core::blob::ConditionalError::BrdfPriorUnstretched)
-        );
-        assert!(std::format!("{err}").contains("bake it again with `build-tool bake --brdf`"));
+        for (tag, what) in [(10u32, "unstretched"), (15, "metal layer in a stretched")] {
+            let mut bytes = doc_example_brdf_blob();
+            let b = &mut bytes.0;
+            let count = u32::from_le_bytes(b[40..44].try_into().unwrap()) as usize;
+            let row = (0..count)
+                .map(|k| HEADER_LEN + k * SECTION_ENTRY_LEN)
+                .find(|&at| {
+                    u32::from_le_bytes(b[at..at + 4].try_into().unwrap())
+                        == SectionTag::BrdfPriorInfo as u32
+                })
+                .unwrap();
+            b[row..row + 4].copy_from_slice(&tag.to_le_bytes());
+            let sum = checksum(b);
+            b[CHECKSUM_OFFSET..CHECKSUM_OFFSET + 8].copy_from_slice(&sum.to_le_bytes());
+            let err = Blob::parse(b).unwrap_err();
+            assert_eq!(
+                err,
+                BlobError::Conditional(ConditionalError::BrdfPriorEarlier { tag })
+            );
+            let message = std::format!("{err}");
+            assert!(message.contains("bake it again with `build-tool bake --brdf`"));
+            assert!(message.contains(what), "{message}");
+        }
     }
 
     #[test]

@@ -48,9 +48,7 @@ mod shader_sample;
 
 use nuld_core::blob::{Domain, Layout, SectionTag};
 use nuld_core::brdf::{alpha, gltf_metallic_parts, view_direction_real};
-use nuld_core::brdf_prior::{
-    half_vector_direction, half_vector_point, stretch, BrdfPrior, BrdfPriorInfo,
-};
+use nuld_core::brdf_prior::{query_square, BrdfPrior, BrdfPriorInfo};
 use nuld_core::conditional::randomized_point;
 use nuld_core::conditional::PointWarp;
 use nuld_core::network::{Activation, OffsetHash};
@@ -384,6 +382,8 @@ fn brdf_table_gain(prior: &BrdfPrior<'_, f64>, cond: [f64; 3], u: [f64; 2]) -> G
     let h = 1.0 / 1_048_576.0;
     let wo = view_direction_real(cond[1]);
     let wo3 = DVec3::from_array(wo);
+    // The square the query reads (the metal layer's star disc at metallic 1).
+    let square = query_square(prior.grid(), cond);
     let clamped = |q: [f64; 2]| q.map(|x| x.clamp(0.0, 1.0));
     // What a sample of the light direction `wi` with pdf `pdf` holds, and its
     // square point.
@@ -394,14 +394,14 @@ fn brdf_table_gain(prior: &BrdfPrior<'_, f64>, cond: [f64; 3], u: [f64; 2]) -> G
         } else {
             0.0
         };
-        let p = half_vector_point(wo, wi, stretch(cond[0])).map_or([0.5; 2], |(p, _)| p);
+        let p = square.point(wo, wi).map_or([0.5; 2], |(p, _)| p);
         (DVec3::from_array(wi), weight, pdf, f, DVec2::from_array(p))
     };
     let by_u = |q: [f64; 2]| {
         let (wi, pdf) = prior.sample(cond, clamped(q));
         sample(wi, pdf)
     };
-    let by_p = |q: [f64; 2]| match half_vector_direction(wo, clamped(q), stretch(cond[0])) {
+    let by_p = |q: [f64; 2]| match square.direction(wo, clamped(q)) {
         Some((wi, _)) => sample(wi, prior.pdf(cond, wi)),
         None => sample([0.0, 0.0, 1.0], 0.0),
     };
@@ -457,12 +457,11 @@ fn brdf_table_gain(prior: &BrdfPrior<'_, f64>, cond: [f64; 3], u: [f64; 2]) -> G
                 let h2 = DVec3::new(hv.x * k, hv.y * k, z);
                 let c = wo3.dot(h2);
                 let wi2 = (2.0 * c * h2 - wo3).to_array();
-                let jac = half_vector_point(wo, wi2, stretch(cond[0])).map_or(0.0, |(_, j)| j);
+                let jac = square.point(wo, wi2).map_or(0.0, |(_, j)| j);
                 prior.pdf(cond, wi2) * jac
             };
             let d = (square_pdf_at(1.0) - square_pdf_at(-1.0)).abs() / (2.0 * eta);
-            let jac =
-                half_vector_point(wo, wi.to_array(), stretch(cond[0])).map_or(0.0, |(_, j)| j);
+            let jac = square.point(wo, wi.to_array()).map_or(0.0, |(_, j)| j);
             dpdf = dpdf.max(relative(d / jac.max(f64::MIN_POSITIVE)));
         }
         // GGX's conditioning in `c = n.h`.

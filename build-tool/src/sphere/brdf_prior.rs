@@ -34,8 +34,8 @@ use crate::progress::Progress;
 use glam::{DVec2, DVec3};
 use nuld_core::brdf::{gltf_metallic, gltf_metallic_ends, view_direction};
 use nuld_core::brdf_prior::{
-    half_vector_direction, half_vector_point, is_metal_layer_node, mass_weighted_blend,
-    metal_stretch, node_condition, reads_metal_layer, stretch, stretch_with, BrdfPriorInfo,
+    is_metal_layer_node, mass_weighted_blend, metal_zoom, node_condition, reads_metal_layer,
+    stretch, stretch_with, BrdfPriorInfo, PriorSquare,
 };
 use nuld_core::marginal2d::{Blend, Marginal2D, Marginal2DError, Marginal2DShape};
 use nuld_core::sphere::{hemisphere_to_square, square_to_hemisphere};
@@ -73,7 +73,9 @@ pub enum PriorSpace {
     /// The equal-area square of the half vector `h`, its slopes divided by the
     /// blob's stretch at the condition's roughness
     /// ([`nuld_core::brdf_prior::stretch`],
-    /// [`nuld_core::brdf_prior::half_vector_direction`]): the blob's prior.
+    /// [`nuld_core::brdf_prior::half_vector_direction`]), the metal layer's in
+    /// the star disc ([`nuld_core::brdf_prior::star_direction`]): the blob's
+    /// prior.
     HalfVector,
     /// The half vector's square with the slopes divided by `roughness^p`, `p`
     /// the hundredths held here (0: the plain half vector); for measurements.
@@ -184,17 +186,19 @@ impl PriorSpace {
         }
     }
 
-    /// The stretch `k` at `roughness` (1 for [`Self::Direction`] and
-    /// [`Self::Radial`], whose [`Self::radial`] stretches instead).
-    fn stretch(self, roughness: f64, metal_layer: bool) -> f64 {
-        match self {
+    /// The half-vector square at `roughness`: the metal layer's star disc (the
+    /// blob's, [`metal_zoom`]) if `metal_layer`, else the shared square of this
+    /// space's stretch (1 for [`Self::Direction`] and [`Self::Radial`], whose
+    /// [`Self::radial`] stretches instead).
+    fn square(self, roughness: f64, metal_layer: bool) -> PriorSquare<f64> {
+        PriorSquare::Stretched(match self {
             Self::Direction | Self::Radial { .. } => 1.0,
-            _ if metal_layer => metal_stretch(roughness),
+            _ if metal_layer => return PriorSquare::Star(metal_zoom(roughness)),
             Self::HalfVector | Self::Horizon { .. } => stretch(roughness),
             Self::HalfVectorPower { stretch_percent } => {
                 stretch_with(roughness, stretch_percent as f64 / 100.0)
             }
-        }
+        })
     }
 
     /// The radial map of [`Self::Radial`] at `roughness` for the view `wo` (in
@@ -236,8 +240,9 @@ impl PriorSpace {
                 horizon(metal, wo, roughness).direction(wo, p)
             }
             Self::HalfVector | Self::HalfVectorPower { .. } | Self::Horizon { .. } => {
-                let k = self.stretch(roughness, metal_layer);
-                half_vector_direction(wo.to_array(), p.to_array(), k)
+                let square = self.square(roughness, metal_layer);
+                square
+                    .direction(wo.to_array(), p.to_array())
                     .map(|(wi, jac)| (DVec3::from_array(wi), jac))
             }
         }
@@ -256,8 +261,9 @@ impl PriorSpace {
             Self::Radial { .. } => self.radial(wo, roughness, metal_layer)?.point(wo, wi),
             Self::Horizon { metal } if metal_layer => horizon(metal, wo, roughness).point(wo, wi),
             Self::HalfVector | Self::HalfVectorPower { .. } | Self::Horizon { .. } => {
-                let k = self.stretch(roughness, metal_layer);
-                half_vector_point(wo.to_array(), wi.to_array(), k)
+                let square = self.square(roughness, metal_layer);
+                square
+                    .point(wo.to_array(), wi.to_array())
                     .map(|(p, jac)| (DVec2::from_array(p), jac))
             }
         }

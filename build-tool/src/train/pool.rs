@@ -32,7 +32,7 @@ use anyhow::Result;
 use glam::{DVec2, DVec3};
 use nuld_core::blob::Domain;
 use nuld_core::brdf::{gltf_metallic, view_direction, view_direction_real};
-use nuld_core::brdf_prior::{half_vector_direction, query_stretch};
+use nuld_core::brdf_prior::query_square;
 use nuld_core::conditional::{ConditionalTarget, PointWarp};
 use nuld_core::network::{shifted_lattice_point, Shape};
 use nuld_core::sphere::{hemisphere_to_square, sphere_to_square, square_to_sphere};
@@ -226,12 +226,15 @@ pub fn brdf_table_direction(prior: &BrdfPrior, cond: [f64; 3], p: DVec2) -> (DVe
         .core_f64()
         .expect("the BRDF sampler's prior is half-vector");
     let (q, pdf, [dx_dux, dx_duy, dy_duy]) = core.square_with_slopes(cond, p.to_array());
-    let (wo, k) = (
+    let (wo, square) = (
         view_direction_real(cond[1]),
-        query_stretch(core.grid(), cond),
+        query_square(core.grid(), cond),
     );
-    let at =
-        |q: DVec2| half_vector_direction(wo, q.to_array(), k).map(|(wi, _)| DVec3::from_array(wi));
+    let at = |q: DVec2| {
+        square
+            .direction(wo, q.to_array())
+            .map(|(wi, _)| DVec3::from_array(wi))
+    };
     let q = DVec2::from(q);
     let Some(d) = at(q).filter(|_| pdf > 0.0) else {
         return (DVec3::Z, DVec3::ZERO, DVec3::ZERO);

@@ -517,9 +517,14 @@ pub enum ConditionalError {
     /// The tree's levels, counts or values are refused
     /// ([`crate::envmap_tree::EnvmapTree::new`]).
     Tree(crate::quadtree::QuadtreeError),
-    /// A BRDF sampler whose prior's tables are of an earlier format (the plain
-    /// half-vector square, [`SectionTag::BrdfPriorInfoUnstretched`]).
-    BrdfPriorUnstretched,
+    /// A BRDF sampler whose prior's tables are of an earlier format: its info
+    /// under `tag`, [`SectionTag::BrdfPriorInfoUnstretched`] (the plain
+    /// half-vector square) or [`SectionTag::BrdfPriorInfoStretchedMetal`] (the
+    /// metal layer in a stretched square), and no [`SectionTag::BrdfPriorInfo`].
+    BrdfPriorEarlier {
+        /// The section tag its info is under.
+        tag: u32,
+    },
     /// The [`SectionTag::BrdfPriorInfo`] section is not one
     /// [`crate::brdf_prior::BrdfPriorInfo`] long.
     BrdfPriorInfoSize {
@@ -688,9 +693,13 @@ impl core::fmt::Display for ConditionalError {
                 "blob environment tree has one of its detail sections (tags 20, 21) without the other, or fine tables (tag 22) without them"
             ),
             Self::Tree(e) => write!(f, "blob environment tree: {e}"),
-            Self::BrdfPriorUnstretched => write!(
+            Self::BrdfPriorEarlier { tag } => write!(
                 f,
-                "BRDF sampler of an earlier format (its prior's tables unstretched): bake it again with `build-tool bake --brdf`"
+                "BRDF sampler of an earlier format (its prior's {}): bake it again with `build-tool bake --brdf`",
+                match tag {
+                    10 => "tables unstretched",
+                    _ => "metal layer in a stretched square",
+                }
             ),
             Self::BrdfPriorInfoSize { got, expected } => write!(
                 f,

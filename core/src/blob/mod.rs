@@ -152,11 +152,11 @@ pub enum SectionTag {
     BrdfPriorConditional = 13,
     /// The BRDF prior's node masses before normalization, `f32`, one per node.
     BrdfPriorMasses = 14,
-    /// One [`crate::brdf_prior::BrdfPriorInfo`] (16 bytes): the BRDF prior's
-    /// condition grid and table size (samplers with
-    /// [`crate::conditional::PointWarp::BrdfTable`]); its tables live in the
-    /// stretched half-vector square ([`crate::brdf_prior::stretch`]).
-    BrdfPriorInfo = 15,
+    /// The info of an earlier BRDF prior, whose metal layer lived in a
+    /// stretched half-vector square (`k = roughness`): no longer read; a blob
+    /// with it and without [`Self::BrdfPriorInfo`] is refused with the advice
+    /// to bake it again.
+    BrdfPriorInfoStretchedMetal = 15,
     /// The metal layer's network ([`crate::brdf_prior::has_metal_layer`]): f16
     /// bits in the order of [`Self::NetworkParams`], the same shape; read by a
     /// query at metallic 1 instead of [`Self::NetworkParams`]. Optional, with
@@ -195,6 +195,12 @@ pub enum SectionTag {
     /// as [`Self::EnvmapTreeDetail`]'s), named by the detail-index entries with
     /// [`crate::envmap_tree::FINE_BIT`] set. Optional, with the detail sections.
     EnvmapTreeFineDetail = 22,
+    /// One [`crate::brdf_prior::BrdfPriorInfo`] (16 bytes): the BRDF prior's
+    /// condition grid and table size (samplers with
+    /// [`crate::conditional::PointWarp::BrdfTable`]); its shared layers' tables
+    /// live in the stretched half-vector square ([`crate::brdf_prior::stretch`]),
+    /// its metal layer's in the star disc ([`crate::brdf_prior::star_direction`]).
+    BrdfPriorInfo = 23,
 }
 
 /// Contents of the [`SectionTag::PointSetInfo`] section.

@@ -1,9 +1,10 @@
 extern crate std;
 
+use super::square::{dot, normalized};
 use super::*;
 use crate::brdf::{gltf_metallic, view_direction_real};
 use crate::marginal2d::tabulate_with_masses;
-use crate::sphere::hemisphere_to_square;
+use crate::sphere::{hemisphere_to_square, hemisphere_to_square_real, square_to_hemisphere_real};
 use crate::test_rng::Rng;
 use std::vec;
 use std::vec::Vec;
@@ -52,12 +53,10 @@ impl Tables {
             for j in 0..s {
                 for i in 0..s {
                     let p = [i as f64 / (s - 1) as f64, j as f64 / (s - 1) as f64];
-                    data.push(
-                        match half_vector_direction(wo, p, node_stretch(grid, node)) {
-                            Some((wi, jac)) => gltf_metallic(wo, wi, r, m) * wi[2] * jac,
-                            None => 0.0,
-                        },
-                    );
+                    data.push(match node_square(grid, node).direction(wo, p) {
+                        Some((wi, jac)) => gltf_metallic(wo, wi, r, m) * wi[2] * jac,
+                        None => 0.0,
+                    });
                 }
             }
         }
@@ -185,6 +184,102 @@ fn the_stretched_jacobian_integrates_the_hemisphere() {
     assert!((stretch_with(0.3f64, 0.25) - stretch(0.3f64)).abs() < 1e-15);
 }
 
+/// The star disc: the square's centre is the mirror direction, its rim (the
+/// unit disc's, the square's edge) the horizon for every view; `star_point`
+/// inverts `star_direction` with the same Jacobian; the Jacobian matches the
+/// map's own central differences (`|dwi/dp| / |dω_d/dp|`, the square being
+/// `2π` steradians of `d` per unit area), and over uniform square points `2π
+/// |dwi/dω_d| cos` averages `π`, the cosine's integral over the whole
+/// hemisphere (every direction is reached once).
+#[test]
+fn the_star_disc_centres_the_mirror_and_rims_the_horizon() {
+    let pi = core::f64::consts::PI;
+    let mut g = Rng(29);
+    for (k, theta) in [
+        (0.01, 85.0),
+        (0.0169, 30.0),
+        (0.25, 70.0),
+        (1.0, 0.0),
+        (0.5, 89.0),
+    ] {
+        let wo = view_direction_real(theta);
+        let (mirror, _) = star_direction(wo, [0.5, 0.5], k).unwrap();
+        let expect = [-wo[0], -wo[1], wo[2]];
+        assert!(
+            (0..3).all(|a| (mirror[a] - expect[a]).abs() < 1e-12),
+            "{mirror:?}"
+        );
+        for t in 0..64 {
+            // A point of the square's edge maps onto the unit circle, the rim.
+            let v = t as f64 / 64.0;
+            let edge = [[v, 0.0], [1.0, v], [1.0 - v, 1.0], [0.0, 1.0 - v]][t % 4];
+            let inner = edge.map(|x| 0.5 + (x - 0.5) * (1.0 - 1e-9));
+            if let Some((wi, _)) = star_direction(wo, inner, k) {
+                assert!(wi[2] < 1e-4, "k {k}, θo {theta}, {edge:?}: {wi:?}");
+            }
+        }
+        let count = 1 << 17;
+        let (mut sum, mut sum2, mut hits) = (0.0, 0.0, 0);
+        for i in 0..count {
+            let p = [g.next(), g.next()];
+            let Some((wi, jac)) = star_direction(wo, p, k) else {
+                continue;
+            };
+            hits += 1;
+            let y = 2.0 * pi * jac * wi[2];
+            sum += y;
+            sum2 += y * y;
+            let (q, back) = star_point(wo, wi, k).unwrap();
+            assert!(
+                (q[0] - p[0]).abs() < 1e-7 && (q[1] - p[1]).abs() < 1e-7,
+                "{p:?} {q:?}"
+            );
+            assert!((back - jac).abs() < 1e-7 * jac, "{back} {jac}");
+            if i % 64 == 0 && (0.02..0.98).contains(&p[0]) && (0.02..0.98).contains(&p[1]) {
+                let h = 1e-6;
+                // The solid angle swept by `map` over the step, per unit area.
+                let area = |map: &dyn Fn([f64; 2]) -> [f64; 3]| {
+                    let d = |dx: f64, dy: f64| map([p[0] + dx, p[1] + dy]);
+                    let du: Vec<f64> = (0..3).map(|a| d(h, 0.0)[a] - d(-h, 0.0)[a]).collect();
+                    let dv: Vec<f64> = (0..3).map(|a| d(0.0, h)[a] - d(0.0, -h)[a]).collect();
+                    let c = [
+                        du[1] * dv[2] - du[2] * dv[1],
+                        du[2] * dv[0] - du[0] * dv[2],
+                        du[0] * dv[1] - du[1] * dv[0],
+                    ];
+                    dot(c, c).sqrt() / (4.0 * h * h)
+                };
+                let light = |q: [f64; 2]| star_direction(wo, q, k).unwrap().0;
+                let numeric = area(&light) / area(&square_to_hemisphere_real);
+                assert!((numeric / jac - 1.0).abs() < 1e-3, "{p:?}: {numeric} {jac}");
+            }
+        }
+        assert!(hits > count * 99 / 100, "{hits}");
+        let mean = sum / count as f64;
+        let se = ((sum2 / count as f64 - mean * mean) / count as f64).sqrt();
+        assert!(
+            (mean - pi).abs() < 4.0 * se + 1e-3,
+            "k {k}, θo {theta}: {mean} (se {se})"
+        );
+        assert!(star_point(wo, [0.0, 0.0, -1.0], k).is_none());
+        // f32 agrees with f64.
+        let p = [0.3, 0.71];
+        let (w64, j64) = star_direction(wo, p, k).unwrap();
+        let wo32 = wo.map(|x| x as f32);
+        let (w32, j32) = star_direction(wo32, p.map(|x| x as f32), k as f32).unwrap();
+        assert!((0..3).all(|a| (w32[a] as f64 - w64[a]).abs() < 1e-4));
+        assert!((j32 as f64 / j64 - 1.0).abs() < 1e-3);
+    }
+    // The reach towards the viewer, away from it and across (module docs).
+    let wo = view_direction_real(60.0f64);
+    let (s, c) = (60f64.to_radians().sin(), 60f64.to_radians().cos());
+    assert!((horizon_reach(wo, [-1.0, 0.0]) - (1.0 - s) / c).abs() < 1e-12);
+    assert!((horizon_reach(wo, [1.0, 0.0]) - (1.0 + s) / c).abs() < 1e-12);
+    assert!((horizon_reach(wo, [0.0, 1.0]) - 1.0).abs() < 1e-12);
+    assert_eq!(metal_zoom(0.5f64), 0.25);
+    assert_eq!(metal_zoom(0.0f64), metal_zoom(0.1));
+}
+
 /// Over the prior's own samples, `(1/M) Σ f cos / pdf` is the albedo of the
 /// independent reference table at a reference condition (`A_m = (1 - m) A_0 +
 /// m A_1`), at metallic 0, 0.5 and 1 between nodes in roughness and `θo`; and
@@ -238,11 +333,11 @@ fn estimate_is_the_reference_albedo(grid: [u32; 3], metallics: &[f64]) {
     }
 }
 
-/// The metal layer: its nodes hold metallic 1 in the metal's square
-/// (`node_stretch`), a query at metallic 1 blends its four nodes around
-/// `(roughness, θo)` alone with the metal's stretch, a query below metallic 1
-/// the first two layers with the shared stretch; at a metal-layer node the
-/// density is proportional to the metal's `f cos |dwi/dh|` in its square.
+/// The metal layer: its nodes hold metallic 1 in the metal's star disc
+/// (`node_square`), a query at metallic 1 blends its four nodes around
+/// `(roughness, θo)` alone in the star disc, a query below metallic 1 the
+/// first two layers in the shared square; at a metal-layer node the density is
+/// proportional to the metal's `f cos |dwi/dω_p|` in its disc.
 #[test]
 fn the_metal_layer_serves_metallic_one_alone() {
     let (grid, size) = ([3, 4, 3], 32);
@@ -253,12 +348,11 @@ fn the_metal_layer_serves_metallic_one_alone() {
         let two = node_condition([3, 4, 2], node % (2 * layer));
         assert_eq!([r, t], [two[0], two[1]]);
         assert_eq!(m, if node < layer { 0.0 } else { 1.0 });
-        let k = if node < 2 * layer {
-            stretch(r)
-        } else {
-            metal_stretch(r)
+        let square = match node < 2 * layer {
+            true => PriorSquare::Stretched(stretch(r)),
+            false => PriorSquare::Star(r * r),
         };
-        assert_eq!(node_stretch(grid, node), k);
+        assert_eq!(node_square(grid, node), square);
         assert_eq!(is_metal_layer_node(grid, node), node >= 2 * layer);
     }
     let tables = Tables::new(grid, size);
@@ -272,17 +366,19 @@ fn the_metal_layer_serves_metallic_one_alone() {
         .pairs()
         .all(|(n, _)| n < 2 * layer));
     assert!(prior.blend([r, t, 0.5]).pairs().all(|(n, _)| n < 2 * layer));
-    assert_eq!(query_stretch(grid, [r, t, 1.0]), metal_stretch(r));
-    assert_eq!(query_stretch(grid, [r, t, 2.0]), metal_stretch(r));
-    assert_eq!(query_stretch(grid, [r, t, 0.999]), stretch(r));
-    assert_eq!(query_stretch([3, 4, 2], [r, t, 1.0]), stretch(r));
+    let star = PriorSquare::Star(r * r);
+    let shared = PriorSquare::Stretched(stretch(r));
+    assert_eq!(query_square(grid, [r, t, 1.0]), star);
+    assert_eq!(query_square(grid, [r, t, 2.0]), star);
+    assert_eq!(query_square(grid, [r, t, 0.999]), shared);
+    assert_eq!(query_square([3, 4, 2], [r, t, 1.0]), shared);
     let node = 2 * layer + 1 + 3 * 2;
     let [r, t, _] = node_condition(grid, node);
     let wo = view_direction_real(t);
     let mut ratios = Vec::new();
     for (i, j) in [(16, 16), (18, 16), (21, 17), (17, 13), (19, 19)] {
         let p = [i as f64 / (size - 1) as f64, j as f64 / (size - 1) as f64];
-        let Some((wi, jac)) = half_vector_direction(wo, p, metal_stretch(r)) else {
+        let Some((wi, jac)) = star_direction(wo, p, metal_zoom(r)) else {
             continue;
         };
         let target = gltf_metallic(wo, wi, r, 1.0) * wi[2] * jac;

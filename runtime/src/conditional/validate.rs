@@ -400,10 +400,14 @@ fn detail_tables<'a>(layout: &Layout<'a>, tag: SectionTag) -> Result<&'a [f32], 
 /// The BRDF prior's five sections: with `check`, every value read once
 /// ([`BrdfPrior::new`], `O(nodes size^2)`); without, counts only (`O(1)`).
 fn brdf_prior<'a>(layout: &Layout<'a>, check: bool) -> Result<BrdfPrior<'a, f32>, BlobError> {
-    if layout.section(SectionTag::BrdfPriorInfo).is_err()
-        && layout.section(SectionTag::BrdfPriorInfoUnstretched).is_ok()
-    {
-        return Err(ConditionalError::BrdfPriorUnstretched.into());
+    if layout.section(SectionTag::BrdfPriorInfo).is_err() {
+        let earlier = [
+            SectionTag::BrdfPriorInfoUnstretched,
+            SectionTag::BrdfPriorInfoStretchedMetal,
+        ];
+        if let Some(tag) = earlier.into_iter().find(|&t| layout.section(t).is_ok()) {
+            return Err(ConditionalError::BrdfPriorEarlier { tag: tag as u32 }.into());
+        }
     }
     let info: BrdfPriorInfo = record(layout, SectionTag::BrdfPriorInfo, |got, expected| {
         ConditionalError::BrdfPriorInfoSize { got, expected }
