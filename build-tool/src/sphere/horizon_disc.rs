@@ -40,7 +40,10 @@
 //! smooth ones seen at grazing views nearer their exact warp and takes the rough
 //! ones far from it (its conformal factor spans eleven orders of magnitude at 85°);
 //! the star disc with `k = α` serves both, 1.18 of Owen-Sobol through the exact
-//! inverse CDF where the blob's metal square reads 1.66.
+//! inverse CDF where the stretched metal square (`k = roughness`) read 1.66. The
+//! blob's metal layer is now `star:100_200_0`, written in core
+//! ([`nuld_core::brdf_prior::star_direction`]; the test below holds the two
+//! together).
 
 use glam::{DVec2, DVec3};
 use nuld_core::sphere::{hemisphere_to_square, square_to_hemisphere};
@@ -376,5 +379,50 @@ mod tests {
             checked += check_inverse_and_jacobian(|p| map.direction(wo, p), |wi| map.point(wo, wi));
         }
         assert!(checked > 1500, "{checked}");
+    }
+
+    /// The blob's metal layer (core's star disc, [`nuld_core::brdf_prior::star_direction`],
+    /// written apart in `f32`-ready form) is this module's `star:100_200_0`:
+    /// the same directions and Jacobians both ways.
+    #[test]
+    fn core_star_disc_is_the_lab_star_100_200_0() {
+        use nuld_core::brdf_prior::{metal_zoom, PriorSquare};
+        let mut checked = 0;
+        for (t, rough) in [
+            (0.0, 0.5),
+            (45.0, 0.13),
+            (85.0, 0.1),
+            (89.0, 0.7),
+            (70.0, 1.0),
+        ] {
+            let wo = view_direction(t);
+            let alpha = metal_zoom(rough);
+            let lab = StarDisc {
+                zoom: alpha,
+                lambert: false,
+                aniso: 1.0,
+            };
+            let core = PriorSquare::Star(alpha);
+            // Inside the rim, which is the horizon itself.
+            for i in 1..40 {
+                for j in 1..40 {
+                    let p = DVec2::new(i as f64, j as f64) / 40.0;
+                    let (Some((a, ja)), Some((b, jb))) = (
+                        lab.direction(wo, p),
+                        core.direction(wo.to_array(), p.to_array()),
+                    ) else {
+                        continue;
+                    };
+                    let b = DVec3::from_array(b);
+                    assert!((a - b).length() < 1e-9, "{a} {b} at {p}, θo {t}");
+                    assert!((ja / jb - 1.0).abs() < 1e-6, "{ja} {jb} at {p}, θo {t}");
+                    let (q, _) = core.point(wo.to_array(), b.to_array()).unwrap();
+                    let (r, _) = lab.point(wo, a).unwrap();
+                    assert!((DVec2::from_array(q) - r).length() < 1e-6, "{q:?} {r}");
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 7000, "{checked}");
     }
 }
