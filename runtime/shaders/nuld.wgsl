@@ -1941,10 +1941,11 @@ fn nuld_hemisphere_to_square(d: vec3<f32>) -> vec2<f32> {
     return vec2<f32>(0.5 * (a + 1.0), 0.5 * (b + 1.0));
 }
 
-// Rust: `half_vector_direction` and `half_vector_point` (core/src/brdf_prior.rs):
-// a light direction `w` (or a square point `w.xy`) and the Jacobian
-// `jac = |dwi/dh'| = 4 (wo.h) k^2 / L^3` of the stretched half vector `h'`;
-// `jac = 0` where Rust has `None`.
+// Rust: the maps of core/src/brdf_prior/square.rs (`half_vector_direction`,
+// `half_vector_point`, `star_direction`, `star_point`): a light direction `w`
+// (or a square point `w.xy`) and the Jacobian `jac`, the solid angle of `wi`
+// per solid angle of the table's hemisphere direction; `jac = 0` where Rust has
+// `None`. `nuld_mirror` and `nuld_half_vector_of` hold a direction and `wo.h`.
 struct NuldHalfVector {
     w: vec3<f32>,
     jac: f32,
@@ -1954,6 +1955,44 @@ struct NuldHalfVector {
 // clamped roughness.
 fn nuld_stretch(roughness: f32) -> f32 {
     return sqrt(sqrt(nuld_clamp_roughness(roughness)));
+}
+
+// Rust: `mirror`: the mirror `wi = 2 (wo.h) h - wo` (normalized, in `w`) of
+// the unit view about the unit half vector and `wo.h` (in `jac`); `jac` 0 where
+// `wo.h <= 0` or `wi` has no length.
+fn nuld_mirror(wo: vec3<f32>, h: vec3<f32>) -> NuldHalfVector {
+    let missing = NuldHalfVector(vec3<f32>(0.0, 0.0, 1.0), 0.0);
+    let c = wo.x * h.x + wo.y * h.y + wo.z * h.z;
+    if !(c > 0.0) {
+        return missing;
+    }
+    let two_c = 2.0 * c;
+    let v = vec3<f32>(two_c * h.x - wo.x, two_c * h.y - wo.y, two_c * h.z - wo.z);
+    let len = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+    if !(len > 0.0 && nuld_is_finite(len)) {
+        return missing;
+    }
+    return NuldHalfVector(vec3<f32>(v.x / len, v.y / len, v.z / len), c);
+}
+
+// Rust: `half_vector_of`: the half vector `h = (wo + wi) / |wo + wi|` (in `w`)
+// and `wo.h` (in `jac`); `jac` 0 where `wi.z <= 0`, `h.z <= 0` or `wo.h <= 0`.
+fn nuld_half_vector_of(wo: vec3<f32>, wi: vec3<f32>) -> NuldHalfVector {
+    let missing = NuldHalfVector(vec3<f32>(0.0, 0.0, 1.0), 0.0);
+    if !(wi.z > 0.0) {
+        return missing;
+    }
+    let v = vec3<f32>(wo.x + wi.x, wo.y + wi.y, wo.z + wi.z);
+    let len = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+    if !(len > 0.0 && nuld_is_finite(len)) {
+        return missing;
+    }
+    let h = vec3<f32>(v.x / len, v.y / len, v.z / len);
+    let c = wo.x * h.x + wo.y * h.y + wo.z * h.z;
+    if !(h.z > 0.0 && c > 0.0) {
+        return missing;
+    }
+    return NuldHalfVector(h, c);
 }
 
 // Rust: `half_vector_direction`: the light direction `wi = 2 (wo.h) h - wo` of
@@ -1969,17 +2008,12 @@ fn nuld_half_vector_direction(wo: vec3<f32>, p: vec2<f32>, k: f32) -> NuldHalfVe
         return missing;
     }
     let h = vec3<f32>(sv.x / sl, sv.y / sl, sv.z / sl);
-    let c = wo.x * h.x + wo.y * h.y + wo.z * h.z;
-    if !(c > 0.0) {
+    let m = nuld_mirror(wo, h);
+    if !(m.jac > 0.0) {
         return missing;
     }
-    let two_c = 2.0 * c;
-    let v = vec3<f32>(two_c * h.x - wo.x, two_c * h.y - wo.y, two_c * h.z - wo.z);
-    let len = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
-    if !(len > 0.0 && nuld_is_finite(len)) {
-        return missing;
-    }
-    let wi = vec3<f32>(v.x / len, v.y / len, v.z / len);
+    let wi = m.w;
+    let c = m.jac;
     let jac = 4.0 * c * k * k / (sl * sl * sl);
     if !(wi.z > 0.0 && nuld_is_finite(jac)) {
         return missing;
@@ -1992,19 +2026,12 @@ fn nuld_half_vector_direction(wo: vec3<f32>, p: vec2<f32>, k: f32) -> NuldHalfVe
 // none where `wi.z <= 0`, `h.z <= 0` or `wo.h <= 0`.
 fn nuld_half_vector_point(wo: vec3<f32>, wi: vec3<f32>, k: f32) -> NuldHalfVector {
     let missing = NuldHalfVector(vec3<f32>(0.5, 0.5, 0.0), 0.0);
-    if !(wi.z > 0.0) {
+    let hc = nuld_half_vector_of(wo, wi);
+    if !(hc.jac > 0.0) {
         return missing;
     }
-    let v = vec3<f32>(wo.x + wi.x, wo.y + wi.y, wo.z + wi.z);
-    let len = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
-    if !(len > 0.0 && nuld_is_finite(len)) {
-        return missing;
-    }
-    let h = vec3<f32>(v.x / len, v.y / len, v.z / len);
-    let c = wo.x * h.x + wo.y * h.y + wo.z * h.z;
-    if !(h.z > 0.0 && c > 0.0) {
-        return missing;
-    }
+    let h = hc.w;
+    let c = hc.jac;
     let sv = vec3<f32>(h.x / k, h.y / k, h.z);
     let sl = sqrt(sv.x * sv.x + sv.y * sv.y + sv.z * sv.z);
     if !(sl > 0.0 && nuld_is_finite(sl)) {
@@ -2057,17 +2084,12 @@ fn nuld_star_direction(wo: vec3<f32>, p: vec2<f32>, k: f32) -> NuldHalfVector {
     let rho = k * r / den;
     let l = sqrt(1.0 + rho * rho);
     let h = vec3<f32>(rho * e.x / l, rho * e.y / l, 1.0 / l);
-    let c = wo.x * h.x + wo.y * h.y + wo.z * h.z;
-    if !(c > 0.0) {
+    let m = nuld_mirror(wo, h);
+    if !(m.jac > 0.0) {
         return missing;
     }
-    let two_c = 2.0 * c;
-    let v = vec3<f32>(two_c * h.x - wo.x, two_c * h.y - wo.y, two_c * h.z - wo.z);
-    let len = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
-    if !(len > 0.0 && nuld_is_finite(len)) {
-        return missing;
-    }
-    let wi = vec3<f32>(v.x / len, v.y / len, v.z / len);
+    let wi = m.w;
+    let c = m.jac;
     let jac = nuld_star_jacobian(c, rho, k, den);
     if !(wi.z > 0.0 && nuld_is_finite(jac) && jac > 0.0) {
         return missing;
@@ -2081,19 +2103,12 @@ fn nuld_star_direction(wo: vec3<f32>, p: vec2<f32>, k: f32) -> NuldHalfVector {
 // `wo.h <= 0` or the slope is past the horizon's reach.
 fn nuld_star_point(wo: vec3<f32>, wi: vec3<f32>, k: f32) -> NuldHalfVector {
     let missing = NuldHalfVector(vec3<f32>(0.5, 0.5, 0.0), 0.0);
-    if !(wi.z > 0.0) {
+    let hc = nuld_half_vector_of(wo, wi);
+    if !(hc.jac > 0.0) {
         return missing;
     }
-    let v = vec3<f32>(wo.x + wi.x, wo.y + wi.y, wo.z + wi.z);
-    let len = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
-    if !(len > 0.0 && nuld_is_finite(len)) {
-        return missing;
-    }
-    let h = vec3<f32>(v.x / len, v.y / len, v.z / len);
-    let c = wo.x * h.x + wo.y * h.y + wo.z * h.z;
-    if !(h.z > 0.0 && c > 0.0) {
-        return missing;
-    }
+    let h = hc.w;
+    let c = hc.jac;
     let s = vec2<f32>(h.x / h.z, h.y / h.z);
     let rho = sqrt(s.x * s.x + s.y * s.y);
     var e = vec2<f32>(1.0, 0.0);

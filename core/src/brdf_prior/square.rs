@@ -84,6 +84,30 @@ pub(super) fn normalized<T: Real>(v: [T; 3]) -> Option<[T; 3]> {
     (len > T::ZERO && len.is_finite()).then(|| v.map(|c| c / len))
 }
 
+/// The mirror of the unit view `wo` about the unit half vector `h`, `wi = 2
+/// (wo.h) h - wo` (normalized), and `wo.h`; `None` where `wo.h <= 0` (or NaN).
+fn mirror<T: Real>(wo: [T; 3], h: [T; 3]) -> Option<([T; 3], T)> {
+    let c = dot(wo, h);
+    // NaN fails the comparison too.
+    if c.partial_cmp(&T::ZERO) != Some(core::cmp::Ordering::Greater) {
+        return None;
+    }
+    let two_c = T::of(2.0) * c;
+    let wi = normalized([0, 1, 2].map(|a| two_c * h[a] - wo[a]))?;
+    Some((wi, c))
+}
+
+/// The half vector `h = (wo + wi) / |wo + wi|` of the unit view and light
+/// directions and `wo.h`; `None` where `wi.z <= 0`, `h.z <= 0` or `wo.h <= 0`.
+fn half_vector_of<T: Real>(wo: [T; 3], wi: [T; 3]) -> Option<([T; 3], T)> {
+    if wi[2].partial_cmp(&T::ZERO) != Some(core::cmp::Ordering::Greater) {
+        return None;
+    }
+    let h = normalized([0, 1, 2].map(|a| wo[a] + wi[a]))?;
+    let c = dot(wo, h);
+    (h[2] > T::ZERO && c > T::ZERO).then_some((h, c))
+}
+
 /// The light direction of the half-vector square point `p` for the unit view
 /// `wo` under the stretch `k` (module docs), `wi = 2 (wo.h) h - wo` with
 /// `h = normalize(k h'.x, k h'.y, h'.z)`, `h' = square_to_hemisphere(p)`, and
@@ -99,13 +123,7 @@ pub fn half_vector_direction<T: Real>(wo: [T; 3], p: [T; 2], k: T) -> Option<([T
         return None;
     }
     let h = v.map(|c| c / len);
-    let c = dot(wo, h);
-    // NaN fails the comparison too.
-    if c.partial_cmp(&T::ZERO) != Some(core::cmp::Ordering::Greater) {
-        return None;
-    }
-    let two_c = T::of(2.0) * c;
-    let wi = normalized([0, 1, 2].map(|a| two_c * h[a] - wo[a]))?;
+    let (wi, c) = mirror(wo, h)?;
     let jac = T::of(4.0) * c * k * k / (len * len * len);
     (wi[2] > T::ZERO && jac.is_finite()).then_some((wi, jac))
 }
@@ -116,14 +134,7 @@ pub fn half_vector_direction<T: Real>(wo: [T; 3], p: [T; 2], k: T) -> Option<([T
 /// (`wi.z <= 0`, `h.z <= 0` or `wo.h <= 0`).
 #[inline]
 pub fn half_vector_point<T: Real>(wo: [T; 3], wi: [T; 3], k: T) -> Option<([T; 2], T)> {
-    if wi[2].partial_cmp(&T::ZERO) != Some(core::cmp::Ordering::Greater) {
-        return None;
-    }
-    let h = normalized([0, 1, 2].map(|a| wo[a] + wi[a]))?;
-    let c = dot(wo, h);
-    if !(h[2] > T::ZERO && c > T::ZERO) {
-        return None;
-    }
+    let (h, c) = half_vector_of(wo, wi)?;
     let v = [h[0] / k, h[1] / k, h[2]];
     let len = dot(v, v).sqrt();
     if !(len > T::ZERO && len.is_finite()) {
@@ -188,13 +199,7 @@ pub fn star_direction<T: Real>(wo: [T; 3], p: [T; 2], k: T) -> Option<([T; 3], T
     let rho = k * r / den;
     let l = (T::ONE + rho * rho).sqrt();
     let h = [rho * e[0] / l, rho * e[1] / l, T::ONE / l];
-    let c = dot(wo, h);
-    // NaN fails the comparison too.
-    if c.partial_cmp(&T::ZERO) != Some(core::cmp::Ordering::Greater) {
-        return None;
-    }
-    let two_c = T::of(2.0) * c;
-    let wi = normalized([0, 1, 2].map(|a| two_c * h[a] - wo[a]))?;
+    let (wi, c) = mirror(wo, h)?;
     let jac = star_jacobian(c, rho, k, den);
     (wi[2] > T::ZERO && jac.is_finite() && jac > T::ZERO).then_some((wi, jac))
 }
@@ -205,14 +210,7 @@ pub fn star_direction<T: Real>(wo: [T; 3], p: [T; 2], k: T) -> Option<([T; 3], T
 /// `h.z <= 0`, `wo.h <= 0`, or a slope past the horizon's reach by rounding).
 #[inline]
 pub fn star_point<T: Real>(wo: [T; 3], wi: [T; 3], k: T) -> Option<([T; 2], T)> {
-    if wi[2].partial_cmp(&T::ZERO) != Some(core::cmp::Ordering::Greater) {
-        return None;
-    }
-    let h = normalized([0, 1, 2].map(|a| wo[a] + wi[a]))?;
-    let c = dot(wo, h);
-    if !(h[2] > T::ZERO && c > T::ZERO) {
-        return None;
-    }
+    let (h, c) = half_vector_of(wo, wi)?;
     let s = [h[0] / h[2], h[1] / h[2]];
     let rho = (s[0] * s[0] + s[1] * s[1]).sqrt();
     let e = unit_or_x(s, rho);
