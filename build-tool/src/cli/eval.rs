@@ -129,8 +129,9 @@ pub struct EvalArgs {
     #[arg(long, value_delimiter = ',', default_value = "10x12x3", value_parser = condition_grid)]
     pub brdf_grids: Vec<[u32; 3]>,
     /// brdf-prior: table spaces, `direction` (the light direction's equal-area
-    /// square), `half-vector` (the half vector's, its slopes stretched as the
-    /// blob's prior does), `half-vector:P` (slopes divided by roughness^(P/100)) and
+    /// square), `half-vector` (the blob's prior: the half vector's, its slopes
+    /// stretched, the metal layer's on the star disc), `half-vector:P` (slopes
+    /// divided by roughness^(P/100), the metal layer the blob's) and
     /// `radial:A_B_C_Q:A_B_C_Q` (shared square, metal layer: slopes stretched by
     /// roughness^(A/100) near the pole and roughness^(B/100) beyond the table
     /// slope C/100, the in-plane slope further by max(cos θo, 0.05)^(Q/100)), and

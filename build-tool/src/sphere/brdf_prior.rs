@@ -78,7 +78,8 @@ pub enum PriorSpace {
     /// prior.
     HalfVector,
     /// The half vector's square with the slopes divided by `roughness^p`, `p`
-    /// the hundredths held here (0: the plain half vector); for measurements.
+    /// the hundredths held here (0: the plain half vector), the metal layer's
+    /// in the star disc as [`Self::HalfVector`]'s; for measurements.
     HalfVectorPower {
         /// The stretch's exponent in hundredths.
         stretch_percent: u32,
