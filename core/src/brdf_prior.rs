@@ -72,8 +72,8 @@ use bytemuck::{Pod, Zeroable};
 
 mod square;
 pub use square::{
-    half_vector_direction, half_vector_point, horizon_reach, metal_zoom, star_direction,
-    star_point, PriorSquare,
+    half_vector_direction, half_vector_of, half_vector_point, horizon_reach, metal_zoom, mirror,
+    star_direction, star_point, PriorSquare,
 };
 
 /// The prior's info section (16 bytes, `#[repr(C)]`, little-endian): the

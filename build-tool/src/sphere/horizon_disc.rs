@@ -46,6 +46,7 @@
 //! together).
 
 use glam::{DVec2, DVec3};
+use nuld_core::brdf_prior::{half_vector_of as core_half_vector_of, horizon_reach, mirror};
 use nuld_core::sphere::{hemisphere_to_square, square_to_hemisphere};
 
 /// The map's constants at one condition (module docs).
@@ -163,8 +164,7 @@ impl StarDisc {
 
     /// `ρ_max(e)`: the horizon's radius along `e`.
     fn reach(&self, wo: DVec3, e: DVec2) -> f64 {
-        let t = wo.x / wo.z.max(1e-6);
-        let slope = t * e.x + (1.0 + t * t * e.x * e.x).sqrt();
+        let slope = horizon_reach(wo.to_array(), e.to_array());
         if self.lambert {
             // 1 - 1 / sqrt(1 + x^2) without cancellation.
             let root = (1.0 + slope * slope).sqrt();
@@ -260,25 +260,17 @@ impl HorizonMap {
 }
 
 /// The light `wi = 2 (wo.h) h - wo` of the half vector `h` for the view `wo`, and
-/// `wo.h`; `None` where `wo.h <= 0` (or NaN).
+/// `wo.h`; `None` where `wo.h <= 0` (or NaN): core's [`mirror`] on `glam` vectors.
 pub fn reflect(wo: DVec3, h: DVec3) -> Option<(DVec3, f64)> {
-    let c = wo.dot(h);
-    if c.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-        return None;
-    }
-    Some(((2.0 * c * h - wo).try_normalize()?, c))
+    mirror(wo.to_array(), h.to_array()).map(|(wi, c)| (DVec3::from_array(wi), c))
 }
 
 /// The half vector `h = (wo + wi) / |wo + wi|` of the light `wi` for the view
 /// `wo`, and `wo.h`: the inverse of [`reflect`]; `None` where `wi` is not above
-/// the horizon, `h.z <= 0` or `wo.h <= 0`.
+/// the horizon, `h.z <= 0` or `wo.h <= 0`: core's [`core_half_vector_of`] on
+/// `glam` vectors.
 pub fn half_vector_of(wo: DVec3, wi: DVec3) -> Option<(DVec3, f64)> {
-    if wi.z.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-        return None;
-    }
-    let h = (wo + wi).try_normalize()?;
-    let c = wo.dot(h);
-    (h.z > 0.0 && c > 0.0).then_some((h, c))
+    core_half_vector_of(wo.to_array(), wi.to_array()).map(|(h, c)| (DVec3::from_array(h), c))
 }
 
 /// The table point `p`'s place on the unit disc, Lambert's flattening `q = d.xy /

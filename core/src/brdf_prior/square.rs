@@ -86,7 +86,8 @@ pub(super) fn normalized<T: Real>(v: [T; 3]) -> Option<[T; 3]> {
 
 /// The mirror of the unit view `wo` about the unit half vector `h`, `wi = 2
 /// (wo.h) h - wo` (normalized), and `wo.h`; `None` where `wo.h <= 0` (or NaN).
-fn mirror<T: Real>(wo: [T; 3], h: [T; 3]) -> Option<([T; 3], T)> {
+#[inline]
+pub fn mirror<T: Real>(wo: [T; 3], h: [T; 3]) -> Option<([T; 3], T)> {
     let c = dot(wo, h);
     // NaN fails the comparison too.
     if c.partial_cmp(&T::ZERO) != Some(core::cmp::Ordering::Greater) {
@@ -99,7 +100,8 @@ fn mirror<T: Real>(wo: [T; 3], h: [T; 3]) -> Option<([T; 3], T)> {
 
 /// The half vector `h = (wo + wi) / |wo + wi|` of the unit view and light
 /// directions and `wo.h`; `None` where `wi.z <= 0`, `h.z <= 0` or `wo.h <= 0`.
-fn half_vector_of<T: Real>(wo: [T; 3], wi: [T; 3]) -> Option<([T; 3], T)> {
+#[inline]
+pub fn half_vector_of<T: Real>(wo: [T; 3], wi: [T; 3]) -> Option<([T; 3], T)> {
     if wi[2].partial_cmp(&T::ZERO) != Some(core::cmp::Ordering::Greater) {
         return None;
     }
