@@ -66,7 +66,7 @@ const NULD_TAG_ENVMAP_TREE_CORNERS: u32 = 19u;
 const NULD_TAG_ENVMAP_TREE_DETAIL_INDEX: u32 = 20u;
 const NULD_TAG_ENVMAP_TREE_DETAIL: u32 = 21u;
 const NULD_TAG_ENVMAP_TREE_FINE_DETAIL: u32 = 22u;
-const NULD_TAG_BRDF_PRIOR_INFO: u32 = 23u;
+const NULD_TAG_BRDF_PRIOR_INFO: u32 = 24u;
 const NULD_TAG_BRDF_PRIOR_DATA: u32 = 11u;
 const NULD_TAG_BRDF_PRIOR_MARGINAL: u32 = 12u;
 const NULD_TAG_BRDF_PRIOR_CONDITIONAL: u32 = 13u;
@@ -1995,53 +1995,111 @@ fn nuld_half_vector_of(wo: vec3<f32>, wi: vec3<f32>) -> NuldHalfVector {
     return NuldHalfVector(h, c);
 }
 
-// Rust: `half_vector_direction`: the light direction `wi = 2 (wo.h) h - wo` of
-// the half vector `h = (k h'.x, k h'.y, h'.z) / L` of the square point `p`
-// (`h'` its hemisphere direction), for the unit view `wo`; none where
-// `wo.h <= 0` or `wi.z <= 0`.
-fn nuld_half_vector_direction(wo: vec3<f32>, p: vec2<f32>, k: f32) -> NuldHalfVector {
+// Rust: `RADIAL_CROSSOVER`, `RADIAL_INVERSE_STEPS`: the radial square's table
+// slope where its stretch turns from `k_s` to `k_b`, and the most steps of its
+// inverse.
+const NULD_RADIAL_CROSSOVER: f32 = 0.25;
+const NULD_RADIAL_INVERSE_STEPS: u32 = 64u;
+
+// Rust: `radial_stretch`: the radial square's stretch `g = sigma / t` (in `x`)
+// and slope derivative `sigma'(t)` (in `y`) at a unit table direction of
+// `rho^2` and `z^2`.
+fn nuld_radial_stretch(ks: f32, kb: f32, rho2: f32, z2: f32) -> vec2<f32> {
+    let az2 = NULD_RADIAL_CROSSOVER * NULD_RADIAL_CROSSOVER * z2;
+    let d = rho2 + az2;
+    let g = (kb * rho2 + ks * az2) / d;
+    return vec2<f32>(g, g + 2.0 * (kb - ks) * rho2 * az2 / (d * d));
+}
+
+// Rust: `radial_direction`: the light direction `wi = 2 (wo.h) h - wo` of the
+// half vector `h = (g s.x, g s.y, s.z) / L` of the square point `p` (`s` its
+// hemisphere direction, `g` the radial stretch), and `4 (wo.h) g sigma' / L^3`;
+// none where `wo.h <= 0` or `wi.z <= 0`.
+fn nuld_radial_direction(wo: vec3<f32>, p: vec2<f32>, ks: f32, kb: f32) -> NuldHalfVector {
     let missing = NuldHalfVector(vec3<f32>(0.0, 0.0, 1.0), 0.0);
     let s = nuld_square_to_hemisphere(p);
-    let sv = vec3<f32>(k * s.x, k * s.y, s.z);
-    let sl = sqrt(sv.x * sv.x + sv.y * sv.y + sv.z * sv.z);
-    if !(sl > 0.0) {
+    let rs = nuld_radial_stretch(ks, kb, s.x * s.x + s.y * s.y, s.z * s.z);
+    let g = rs.x;
+    let v = vec3<f32>(g * s.x, g * s.y, s.z);
+    let len = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+    if !(len > 0.0) {
         return missing;
     }
-    let h = vec3<f32>(sv.x / sl, sv.y / sl, sv.z / sl);
-    let m = nuld_mirror(wo, h);
+    let m = nuld_mirror(wo, vec3<f32>(v.x / len, v.y / len, v.z / len));
     if !(m.jac > 0.0) {
         return missing;
     }
-    let wi = m.w;
-    let c = m.jac;
-    let jac = 4.0 * c * k * k / (sl * sl * sl);
-    if !(wi.z > 0.0 && nuld_is_finite(jac)) {
+    let jac = 4.0 * m.jac * g * rs.y / (len * len * len);
+    if !(m.w.z > 0.0 && nuld_is_finite(jac) && jac > 0.0) {
         return missing;
     }
-    return NuldHalfVector(wi, jac);
+    return NuldHalfVector(m.w, jac);
 }
 
-// Rust: `half_vector_point`: the square point (in `w.xy`) of the stretched half
-// vector `h' = (h.x / k, h.y / k, h.z) / L'` of `h = (wo + wi) / |wo + wi|`;
-// none where `wi.z <= 0`, `h.z <= 0` or `wo.h <= 0`.
-fn nuld_half_vector_point(wo: vec3<f32>, wi: vec3<f32>, k: f32) -> NuldHalfVector {
+// Rust: `radial_table_slope`: the table slope `t` with `t g(t) = sigma`, by
+// Newton steps kept inside a shrinking bracket (bisection where a step leaves
+// it).
+fn nuld_radial_table_slope(ks: f32, kb: f32, sigma: f32) -> f32 {
+    if !(sigma > 0.0) {
+        return 0.0;
+    }
+    let a2 = NULD_RADIAL_CROSSOVER * NULD_RADIAL_CROSSOVER;
+    var lo = sigma / max(kb, ks);
+    var hi = sigma / min(kb, ks);
+    var t = lo;
+    for (var i = 0u; i < NULD_RADIAL_INVERSE_STEPS; i++) {
+        let t2 = t * t;
+        let d = t2 + a2;
+        let g = (kb * t2 + ks * a2) / d;
+        let miss = t * g - sigma;
+        if miss > 0.0 {
+            hi = t;
+        } else {
+            lo = t;
+        }
+        let step = t - miss / (g + 2.0 * (kb - ks) * t2 * a2 / (d * d));
+        var next = 0.5 * (lo + hi);
+        if step > lo && step < hi {
+            next = step;
+        }
+        if !(next > lo && next < hi) || next == t {
+            break;
+        }
+        t = next;
+    }
+    return t;
+}
+
+// Rust: `radial_point`: the square point (in `w.xy`) of the half vector of
+// `wo` and `wi` under the radial square, and the same Jacobian; none where
+// `wi.z <= 0`, `h.z <= 0`, `wo.h <= 0` or the slope passes `10^18`.
+fn nuld_radial_point(wo: vec3<f32>, wi: vec3<f32>, ks: f32, kb: f32) -> NuldHalfVector {
     let missing = NuldHalfVector(vec3<f32>(0.5, 0.5, 0.0), 0.0);
     let hc = nuld_half_vector_of(wo, wi);
     if !(hc.jac > 0.0) {
         return missing;
     }
     let h = hc.w;
-    let c = hc.jac;
-    let sv = vec3<f32>(h.x / k, h.y / k, h.z);
-    let sl = sqrt(sv.x * sv.x + sv.y * sv.y + sv.z * sv.z);
-    if !(sl > 0.0 && nuld_is_finite(sl)) {
+    let hxy = sqrt(h.x * h.x + h.y * h.y);
+    let sigma = hxy / h.z;
+    if !(sigma < 1e18) {
         return missing;
     }
-    let s = vec3<f32>(sv.x / sl, sv.y / sl, sv.z / sl);
-    let jac = 4.0 * c * k * k * sl * sl * sl;
-    if !nuld_is_finite(jac) {
+    var e = vec2<f32>(1.0, 0.0);
+    if hxy > 0.0 {
+        e = vec2<f32>(h.x / hxy, h.y / hxy);
+    }
+    let t = nuld_radial_table_slope(ks, kb, sigma);
+    let z = 1.0 / sqrt(1.0 + t * t);
+    let rho = t * z;
+    let rs = nuld_radial_stretch(ks, kb, rho * rho, z * z);
+    let g = rs.x;
+    let len = sqrt(g * g * rho * rho + z * z);
+    let jac = 4.0 * hc.jac * g * rs.y / (len * len * len);
+    if !(nuld_is_finite(jac) && jac > 0.0) {
         return missing;
     }
+    let s = vec3<f32>(rho * e.x, rho * e.y, z);
     return NuldHalfVector(vec3<f32>(nuld_hemisphere_to_square(s), 0.0), jac);
 }
 
@@ -2133,14 +2191,14 @@ fn nuld_star_point(wo: vec3<f32>, wi: vec3<f32>, k: f32) -> NuldHalfVector {
 }
 
 // Rust: `query_square`'s `PriorSquare::direction`: the metal layer's star disc
-// of zoom `roughness^2` where a query reads it, else the shared square of
-// stretch `roughness^(1/4)`.
+// of zoom `roughness^2` where a query reads it, else the shared layers' radial
+// square (`k_s = roughness`, `k_b = roughness^(1/4)`).
 fn nuld_prior_direction(pr: NuldBrdfPrior, cond: vec3<f32>, wo: vec3<f32>, p: vec2<f32>) -> NuldHalfVector {
     if nuld_reads_metal_layer(pr, cond.z) {
         let r = nuld_clamp_roughness(cond.x);
         return nuld_star_direction(wo, p, r * r);
     }
-    return nuld_half_vector_direction(wo, p, nuld_stretch(cond.x));
+    return nuld_radial_direction(wo, p, nuld_clamp_roughness(cond.x), nuld_stretch(cond.x));
 }
 
 // Rust: `query_square`'s `PriorSquare::point`: the inverse of
@@ -2150,7 +2208,7 @@ fn nuld_prior_point(pr: NuldBrdfPrior, cond: vec3<f32>, wo: vec3<f32>, wi: vec3<
         let r = nuld_clamp_roughness(cond.x);
         return nuld_star_point(wo, wi, r * r);
     }
-    return nuld_half_vector_point(wo, wi, nuld_stretch(cond.x));
+    return nuld_radial_point(wo, wi, nuld_clamp_roughness(cond.x), nuld_stretch(cond.x));
 }
 
 // Rust: `BrdfPrior::sample`: the light direction of primary sample `u` for the

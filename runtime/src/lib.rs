@@ -313,7 +313,7 @@ pub fn doc_example_conditional_blob() -> Aligned<[u8; 400]> {
 #[doc(hidden)]
 pub fn doc_example_brdf_blob() -> Aligned<[u8; 1776]> {
     use nuld_core::brdf::{gltf_metallic, view_direction_real};
-    use nuld_core::brdf_prior::{half_vector_direction, node_condition, stretch, BrdfPriorInfo};
+    use nuld_core::brdf_prior::{node_condition, radial_square, BrdfPriorInfo};
     use nuld_core::marginal2d::tabulate_with_masses;
     let (info, params, table, _) =
         doc_example_parts(ConditionalTarget::GltfBrdf, [0.1, 0.0], [1.0, 89.0]);
@@ -332,7 +332,7 @@ pub fn doc_example_brdf_blob() -> Aligned<[u8; 1776]> {
         let wo = view_direction_real(t);
         for (v, value) in table.iter_mut().enumerate() {
             let p = [(v % 4) as f32 / 3.0, (v / 4) as f32 / 3.0];
-            if let Some((wi, jac)) = half_vector_direction(wo, p, stretch(r)) {
+            if let Some((wi, jac)) = radial_square(r).direction(wo, p) {
                 *value = gltf_metallic(wo, wi, r, m) * wi[2] * jac;
             }
         }
@@ -506,14 +506,20 @@ mod tests {
     }
 
     /// A blob of an earlier prior (its info under tag 10, the unstretched
-    /// square, or tag 15, the stretched metal square; the checksum sound) is
-    /// refused with the advice to bake it again.
+    /// square, tag 15, the stretched metal square, or tag 23, the shared
+    /// square of one stretch; the checksum sound) is refused with the advice
+    /// to bake it again.
     #[test]
     fn a_brdf_blob_of_an_earlier_prior_is_refused() {
         use nuld_core::blob::{
             checksum, ConditionalError, SectionTag, CHECKSUM_OFFSET, HEADER_LEN, SECTION_ENTRY_LEN,
         };
-        for (tag, what) in [(10u32, "unstretched"), (15, "metal layer in a stretched")] {
+        let earlier = [
+            (10u32, "unstretched"),
+            (15, "metal layer in a stretched"),
+            (23, "shared layers in a square of one stretch"),
+        ];
+        for (tag, what) in earlier {
             let mut bytes = doc_example_brdf_blob();
             let b = &mut bytes.0;
             let count = u32::from_le_bytes(b[40..44].try_into().unwrap()) as usize;

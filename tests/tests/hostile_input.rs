@@ -801,7 +801,7 @@ fn conditional_semantics_hold(bytes: &[u8]) -> bool {
         })
 }
 
-/// The BRDF prior's sections (core/FORMAT.md, tags 11-14 and 23), checked from
+/// The BRDF prior's sections (core/FORMAT.md, tags 11-14 and 24), checked from
 /// the raw bytes: a 16-byte info of grid counts `G_r, G_t` of 2 to 256 and `G_m` of 2
 /// or 3 (the metal layer), and a size `S` of 2 to 4096; `nodes S^2` data and conditional CDF values and `nodes S` marginal CDF
 /// values, all finite `f32 >= 0`, each row of `S` CDF values non-decreasing,

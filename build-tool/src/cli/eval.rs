@@ -130,7 +130,8 @@ pub struct EvalArgs {
     pub brdf_grids: Vec<[u32; 3]>,
     /// brdf-prior: table spaces, `direction` (the light direction's equal-area
     /// square), `half-vector` (the blob's prior: the half vector's, its slopes
-    /// stretched, the metal layer's on the star disc), `half-vector:P` (slopes
+    /// divided by roughness near the pole and roughness^(1/4) beyond 0.25, the
+    /// radial square, the metal layer's on the star disc), `half-vector:P` (slopes
     /// divided by roughness^(P/100), the metal layer the blob's) and
     /// `radial:A_B_C_Q:A_B_C_Q` (shared square, metal layer: slopes stretched by
     /// roughness^(A/100) near the pole and roughness^(B/100) beyond the table

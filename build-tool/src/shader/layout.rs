@@ -12,7 +12,7 @@ use nuld_core::blob::{
     SECTION_ENTRY_LEN,
 };
 use nuld_core::brdf::{F0, MAX_ROUGHNESS, MAX_THETA_O_DEG, MIN_ROUGHNESS};
-use nuld_core::brdf_prior::BrdfPriorInfo;
+use nuld_core::brdf_prior::{BrdfPriorInfo, RADIAL_CROSSOVER, RADIAL_INVERSE_STEPS};
 use nuld_core::conditional::{ConditionalInfo, PointWarp, MAX_METALLIC_NODES, RANDOMIZE_SALTS};
 use nuld_core::envmap_tree::{
     TreeInfo, DETAIL_LEN, DETAIL_SIDE, FINE_BIT, FINE_LEN, FINE_SIDE, LEGACY_TOP_LEVELS,
@@ -247,6 +247,8 @@ fn rust_constants() -> Vec<(&'static str, u64)> {
         ("NULD_MIN_ROUGHNESS", f(MIN_ROUGHNESS as f32)),
         ("NULD_MAX_ROUGHNESS", f(MAX_ROUGHNESS as f32)),
         ("NULD_MAX_THETA_O_DEG", f(MAX_THETA_O_DEG as f32)),
+        ("NULD_RADIAL_CROSSOVER", f(RADIAL_CROSSOVER as f32)),
+        ("NULD_RADIAL_INVERSE_STEPS", RADIAL_INVERSE_STEPS as u64),
         (
             "NULD_ROUGHNESS_SPAN",
             f((MAX_ROUGHNESS - MIN_ROUGHNESS) as f32),

@@ -13,8 +13,9 @@
 //! * **Space** ([`PriorSpace`]): the square of the tables is the hemisphere's
 //!   equal-area square of either the light direction `wi` itself, or of the half
 //!   vector `h`, with `wi = reflect(wo, h) = 2 (wo.h) h - wo`, its slopes
-//!   stretched by a power of the roughness (the blob's: `roughness^(1/4)`,
-//!   [`nuld_core::brdf_prior::stretch`]). In half-vector space the specular peak
+//!   stretched by powers of the roughness (the blob's: `roughness` near the
+//!   pole and `roughness^(1/4)` beyond, [`nuld_core::brdf_prior::radial_square`];
+//!   the metal layer's star disc, [`nuld_core::brdf_prior::star_direction`]). In half-vector space the specular peak
 //!   sits at `h = n` for every view, so tables of neighbouring `θo` agree where
 //!   the lobe is; the density there is the direction's times the Jacobian
 //!   `|dwi/dω_h'|` (0 where `wo.h <= 0` or `wi` is below the horizon).
@@ -34,8 +35,8 @@ use crate::progress::Progress;
 use glam::{DVec2, DVec3};
 use nuld_core::brdf::{gltf_metallic, gltf_metallic_ends, view_direction};
 use nuld_core::brdf_prior::{
-    is_metal_layer_node, mass_weighted_blend, metal_zoom, node_condition, reads_metal_layer,
-    stretch, stretch_with, BrdfPriorInfo, PriorSquare,
+    is_metal_layer_node, mass_weighted_blend, metal_zoom, node_condition, radial_square,
+    reads_metal_layer, stretch_with, BrdfPriorInfo, PriorSquare,
 };
 use nuld_core::marginal2d::{Blend, Marginal2D, Marginal2DError, Marginal2DShape};
 use nuld_core::sphere::{hemisphere_to_square, square_to_hemisphere};
@@ -71,11 +72,9 @@ pub enum PriorSpace {
     /// The equal-area square of the light direction `wi`.
     Direction,
     /// The equal-area square of the half vector `h`, its slopes divided by the
-    /// blob's stretch at the condition's roughness
-    /// ([`nuld_core::brdf_prior::stretch`],
-    /// [`nuld_core::brdf_prior::half_vector_direction`]), the metal layer's in
-    /// the star disc ([`nuld_core::brdf_prior::star_direction`]): the blob's
-    /// prior.
+    /// blob's radial stretch at the condition's roughness
+    /// ([`nuld_core::brdf_prior::radial_square`]), the metal layer's in the
+    /// star disc ([`nuld_core::brdf_prior::star_direction`]): the blob's prior.
     HalfVector,
     /// The half vector's square with the slopes divided by `roughness^p`, `p`
     /// the hundredths held here (0: the plain half vector), the metal layer's
@@ -88,8 +87,10 @@ pub enum PriorSpace {
     /// anisotropy ([`super::radial_half_vector`]); for measurements. Each layer
     /// holds `[A, B, C, Q]` in hundredths: `k_s = roughness^(A/100)`, `k_b =
     /// roughness^(B/100)`, the crossover `a = C/100` (> 0) and `β = max(cos θo,
-    /// 0.05)^(Q/100)`. `[25, 25, C, 0]` is the blob's shared square,
-    /// `[100, 100, C, 0]` its metal layer's.
+    /// 0.05)^(Q/100)`. `[100, 25, 25, 0]` is the blob's shared square
+    /// ([`nuld_core::brdf_prior::radial_square`]), `[25, 25, C, 0]` the one
+    /// stretch of blobs before it; `[100, 100, C, 0]` the stretched metal
+    /// square of blobs before the star disc.
     Radial {
         /// The shared square's (metallic 0 and 1).
         shared: [u32; 4],
@@ -192,14 +193,14 @@ impl PriorSpace {
     /// space's stretch (1 for [`Self::Direction`] and [`Self::Radial`], whose
     /// [`Self::radial`] stretches instead).
     fn square(self, roughness: f64, metal_layer: bool) -> PriorSquare<f64> {
-        PriorSquare::Stretched(match self {
-            Self::Direction | Self::Radial { .. } => 1.0,
-            _ if metal_layer => return PriorSquare::Star(metal_zoom(roughness)),
-            Self::HalfVector | Self::Horizon { .. } => stretch(roughness),
+        match self {
+            Self::Direction | Self::Radial { .. } => PriorSquare::Stretched(1.0),
+            _ if metal_layer => PriorSquare::Star(metal_zoom(roughness)),
+            Self::HalfVector | Self::Horizon { .. } => radial_square(roughness),
             Self::HalfVectorPower { stretch_percent } => {
-                stretch_with(roughness, stretch_percent as f64 / 100.0)
+                PriorSquare::Stretched(stretch_with(roughness, stretch_percent as f64 / 100.0))
             }
-        })
+        }
     }
 
     /// The radial map of [`Self::Radial`] at `roughness` for the view `wo` (in

@@ -163,6 +163,48 @@ mod tests {
         }
     }
 
+    /// At the blob's numbers (`k_s = roughness`, `k_b = roughness^(1/4)`, `a =
+    /// 0.25`, no anisotropy) the map is core's radial square
+    /// ([`nuld_core::brdf_prior::radial_square`], written apart there), both ways.
+    #[test]
+    fn the_blobs_numbers_are_cores_radial_square() {
+        use nuld_core::brdf_prior::{radial_square, stretch, RADIAL_CROSSOVER};
+        let mut checked = 0;
+        for (r, t) in [(0.1, 85.0), (0.13, 40.0), (0.5, 70.0), (1.0, 5.0)] {
+            let map = RadialMap {
+                k_small: r,
+                k_big: stretch(r),
+                crossover: RADIAL_CROSSOVER,
+                aniso: 1.0,
+            };
+            let wo = view_direction(t);
+            let core = radial_square(r);
+            for p in [
+                [0.5, 0.5],
+                [0.52, 0.47],
+                [0.3, 0.8],
+                [0.9, 0.15],
+                [0.61, 0.44],
+            ] {
+                let got = map.direction(wo, DVec2::from_array(p));
+                match (got, core.direction(wo.to_array(), p)) {
+                    (Some((wi, jac)), Some((w, j))) => {
+                        assert!((wi - DVec3::from_array(w)).length() < 1e-12);
+                        assert!((jac - j).abs() < 1e-9 * j, "{jac} {j}");
+                        let (q, back) = core.point(wo.to_array(), w).unwrap();
+                        let (lab, lab_jac) = map.point(wo, wi).unwrap();
+                        assert!((lab - DVec2::from_array(q)).length() < 1e-9);
+                        assert!((lab_jac - back).abs() < 1e-9 * back);
+                        checked += 1;
+                    }
+                    (None, None) => {}
+                    other => panic!("{other:?} at {p:?}"),
+                }
+            }
+        }
+        assert!(checked >= 12, "{checked}");
+    }
+
     /// `point` inverts `direction`, and the Jacobian is the area ratio of a small
     /// table square's image (central differences).
     #[test]

@@ -519,8 +519,10 @@ pub enum ConditionalError {
     Tree(crate::quadtree::QuadtreeError),
     /// A BRDF sampler whose prior's tables are of an earlier format: its info
     /// under `tag`, [`SectionTag::BrdfPriorInfoUnstretched`] (the plain
-    /// half-vector square) or [`SectionTag::BrdfPriorInfoStretchedMetal`] (the
-    /// metal layer in a stretched square), and no [`SectionTag::BrdfPriorInfo`].
+    /// half-vector square), [`SectionTag::BrdfPriorInfoStretchedMetal`] (the
+    /// metal layer in a stretched square) or
+    /// [`SectionTag::BrdfPriorInfoStretchedShared`] (the shared layers in a
+    /// square of one stretch), and no [`SectionTag::BrdfPriorInfo`].
     BrdfPriorEarlier {
         /// The section tag its info is under.
         tag: u32,
@@ -698,7 +700,8 @@ impl core::fmt::Display for ConditionalError {
                 "BRDF sampler of an earlier format (its prior's {}): bake it again with `build-tool bake --brdf`",
                 match tag {
                     10 => "tables unstretched",
-                    _ => "metal layer in a stretched square",
+                    15 => "metal layer in a stretched square",
+                    _ => "shared layers in a square of one stretch",
                 }
             ),
             Self::BrdfPriorInfoSize { got, expected } => write!(

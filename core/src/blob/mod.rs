@@ -195,12 +195,18 @@ pub enum SectionTag {
     /// as [`Self::EnvmapTreeDetail`]'s), named by the detail-index entries with
     /// [`crate::envmap_tree::FINE_BIT`] set. Optional, with the detail sections.
     EnvmapTreeFineDetail = 22,
+    /// The info of an earlier BRDF prior, whose shared layers lived in the
+    /// half-vector square of one stretch (`roughness^(1/4)`): no longer read;
+    /// a blob with it and without [`Self::BrdfPriorInfo`] is refused with the
+    /// advice to bake it again.
+    BrdfPriorInfoStretchedShared = 23,
     /// One [`crate::brdf_prior::BrdfPriorInfo`] (16 bytes): the BRDF prior's
     /// condition grid and table size (samplers with
     /// [`crate::conditional::PointWarp::BrdfTable`]); its shared layers' tables
-    /// live in the stretched half-vector square ([`crate::brdf_prior::stretch`]),
-    /// its metal layer's in the star disc ([`crate::brdf_prior::star_direction`]).
-    BrdfPriorInfo = 23,
+    /// live in the radial half-vector square
+    /// ([`crate::brdf_prior::radial_square`]), its metal layer's in the star
+    /// disc ([`crate::brdf_prior::star_direction`]).
+    BrdfPriorInfo = 24,
 }
 
 /// Contents of the [`SectionTag::PointSetInfo`] section.

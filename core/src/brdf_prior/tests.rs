@@ -184,6 +184,21 @@ fn the_stretched_jacobian_integrates_the_hemisphere() {
     assert!((stretch_with(0.3f64, 0.25) - stretch(0.3f64)).abs() < 1e-15);
 }
 
+/// The solid angle that `map` sweeps over a step of `10^-6` about the square
+/// point `p`, per unit area of the square (central differences).
+fn swept_area(map: &dyn Fn([f64; 2]) -> [f64; 3], p: [f64; 2]) -> f64 {
+    let h = 1e-6;
+    let d = |dx: f64, dy: f64| map([p[0] + dx, p[1] + dy]);
+    let du: Vec<f64> = (0..3).map(|a| d(h, 0.0)[a] - d(-h, 0.0)[a]).collect();
+    let dv: Vec<f64> = (0..3).map(|a| d(0.0, h)[a] - d(0.0, -h)[a]).collect();
+    let c = [
+        du[1] * dv[2] - du[2] * dv[1],
+        du[2] * dv[0] - du[0] * dv[2],
+        du[0] * dv[1] - du[1] * dv[0],
+    ];
+    dot(c, c).sqrt() / (4.0 * h * h)
+}
+
 /// The star disc: the square's centre is the mirror direction, its rim (the
 /// unit disc's, the square's edge) the horizon for every view; `star_point`
 /// inverts `star_direction` with the same Jacobian; the Jacobian matches the
@@ -236,21 +251,8 @@ fn the_star_disc_centres_the_mirror_and_rims_the_horizon() {
             );
             assert!((back - jac).abs() < 1e-7 * jac, "{back} {jac}");
             if i % 64 == 0 && (0.02..0.98).contains(&p[0]) && (0.02..0.98).contains(&p[1]) {
-                let h = 1e-6;
-                // The solid angle swept by `map` over the step, per unit area.
-                let area = |map: &dyn Fn([f64; 2]) -> [f64; 3]| {
-                    let d = |dx: f64, dy: f64| map([p[0] + dx, p[1] + dy]);
-                    let du: Vec<f64> = (0..3).map(|a| d(h, 0.0)[a] - d(-h, 0.0)[a]).collect();
-                    let dv: Vec<f64> = (0..3).map(|a| d(0.0, h)[a] - d(0.0, -h)[a]).collect();
-                    let c = [
-                        du[1] * dv[2] - du[2] * dv[1],
-                        du[2] * dv[0] - du[0] * dv[2],
-                        du[0] * dv[1] - du[1] * dv[0],
-                    ];
-                    dot(c, c).sqrt() / (4.0 * h * h)
-                };
                 let light = |q: [f64; 2]| star_direction(wo, q, k).unwrap().0;
-                let numeric = area(&light) / area(&square_to_hemisphere_real);
+                let numeric = swept_area(&light, p) / swept_area(&square_to_hemisphere_real, p);
                 assert!((numeric / jac - 1.0).abs() < 1e-3, "{p:?}: {numeric} {jac}");
             }
         }
@@ -278,6 +280,105 @@ fn the_star_disc_centres_the_mirror_and_rims_the_horizon() {
     assert!((horizon_reach(wo, [0.0, 1.0]) - 1.0).abs() < 1e-12);
     assert_eq!(metal_zoom(0.5f64), 0.25);
     assert_eq!(metal_zoom(0.0f64), metal_zoom(0.1));
+}
+
+/// The radial square (module docs of `square`): `σ(t) = t g(t)` against its
+/// closed form `t (k_b t^2 + k_s a^2) / (t^2 + a^2)` at the point's own slope;
+/// `k_s = k_b = k` is the stretched square; `radial_point` inverts
+/// `radial_direction` with the same Jacobian (in `f64` and `f32`); the
+/// Jacobian matches the map's central differences, and over uniform square
+/// points `2π |dwi/dω_s| cos` averages `π` (every direction is reached once).
+#[test]
+fn the_radial_square_inverts_and_its_jacobian_is_the_solid_angle() {
+    let pi = core::f64::consts::PI;
+    let a = RADIAL_CROSSOVER;
+    let mut g = Rng(31);
+    for (r, theta) in [
+        (0.1, 85.0),
+        (0.13, 40.0),
+        (0.3, 70.0),
+        (1.0, 0.0),
+        (0.5, 89.0),
+    ] {
+        let (ks, kb) = match radial_square(r) {
+            PriorSquare::Radial(ks, kb) => (ks, kb),
+            other => panic!("{other:?}"),
+        };
+        assert!((ks - r).abs() < 1e-15 && (kb - stretch(r)).abs() < 1e-15);
+        let wo = view_direction_real(theta);
+        let (count, mut sum, mut sum2, mut hits) = (1 << 17, 0.0, 0.0, 0);
+        for i in 0..count {
+            let p = [g.next(), g.next()];
+            let Some((wi, jac)) = radial_direction(wo, p, ks, kb) else {
+                continue;
+            };
+            hits += 1;
+            let y = 2.0 * pi * jac * wi[2];
+            sum += y;
+            sum2 += y * y;
+            let (q, back) = radial_point(wo, wi, ks, kb).unwrap();
+            assert!(
+                (q[0] - p[0]).abs() < 1e-7 && (q[1] - p[1]).abs() < 1e-7,
+                "{p:?} {q:?}"
+            );
+            assert!((back - jac).abs() < 1e-7 * jac, "{back} {jac}");
+            if i % 256 != 0 {
+                continue;
+            }
+            // The half vector's slope is σ(t) of the table direction's.
+            let s = square_to_hemisphere_real(p);
+            let t = (s[0] * s[0] + s[1] * s[1]).sqrt() / s[2];
+            let sigma = t * (kb * t * t + ks * a * a) / (t * t + a * a);
+            let h = normalized([wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]]).unwrap();
+            let got = (h[0] * h[0] + h[1] * h[1]).sqrt() / h[2];
+            assert!((got - sigma).abs() < 1e-9 * (1.0 + sigma), "{got} {sigma}");
+            if (0.02..0.98).contains(&p[0]) && (0.02..0.98).contains(&p[1]) {
+                let light = |q: [f64; 2]| radial_direction(wo, q, ks, kb).map_or([0.0; 3], |x| x.0);
+                let numeric = swept_area(&light, p) / swept_area(&square_to_hemisphere_real, p);
+                assert!((numeric / jac - 1.0).abs() < 1e-3, "{p:?}: {numeric} {jac}");
+            }
+        }
+        assert!(hits > count / 4, "{hits}");
+        let mean = sum / count as f64;
+        let se = ((sum2 / count as f64 - mean * mean) / count as f64).sqrt();
+        assert!(
+            (mean - pi).abs() < 4.0 * se + 1e-3,
+            "roughness {r}, θo {theta}: {mean} (se {se})"
+        );
+        assert!(radial_point(wo, [0.0, 0.0, -1.0], ks, kb).is_none());
+        // f32 agrees with f64, both ways.
+        for p in [[0.3, 0.71], [0.5, 0.52], [0.93, 0.4]] {
+            let Some((w64, j64)) = radial_direction(wo, p, ks, kb) else {
+                continue;
+            };
+            let wo32 = wo.map(|x| x as f32);
+            let (k32, b32) = (ks as f32, kb as f32);
+            let (w32, j32) = radial_direction(wo32, p.map(|x| x as f32), k32, b32).unwrap();
+            assert!((0..3).all(|c| (w32[c] as f64 - w64[c]).abs() < 1e-4));
+            assert!((j32 as f64 / j64 - 1.0).abs() < 1e-3);
+            let (q32, back32) = radial_point(wo32, w32, k32, b32).unwrap();
+            assert!(
+                (0..2).all(|c| (q32[c] as f64 - p[c]).abs() < 1e-3),
+                "{q32:?} {p:?}"
+            );
+            assert!((back32 / j32 - 1.0).abs() < 1e-2, "{back32} {j32}");
+        }
+    }
+    // One stretch everywhere is the stretched square.
+    let wo = view_direction_real(50.0f64);
+    for p in [[0.5, 0.5], [0.52, 0.47], [0.3, 0.8], [0.9, 0.15]] {
+        match (
+            radial_direction(wo, p, 0.6, 0.6),
+            half_vector_direction(wo, p, 0.6),
+        ) {
+            (Some((w1, j1)), Some((w2, j2))) => {
+                assert!((0..3).all(|c| (w1[c] - w2[c]).abs() < 1e-12));
+                assert!((j1 / j2 - 1.0).abs() < 1e-12);
+            }
+            (None, None) => {}
+            other => panic!("{p:?}: {other:?}"),
+        }
+    }
 }
 
 /// Over the prior's own samples, `(1/M) Σ f cos / pdf` is the albedo of the
@@ -349,7 +450,7 @@ fn the_metal_layer_serves_metallic_one_alone() {
         assert_eq!([r, t], [two[0], two[1]]);
         assert_eq!(m, if node < layer { 0.0 } else { 1.0 });
         let square = match node < 2 * layer {
-            true => PriorSquare::Stretched(stretch(r)),
+            true => PriorSquare::Radial(r, stretch(r)),
             false => PriorSquare::Star(r * r),
         };
         assert_eq!(node_square(grid, node), square);
@@ -367,7 +468,8 @@ fn the_metal_layer_serves_metallic_one_alone() {
         .all(|(n, _)| n < 2 * layer));
     assert!(prior.blend([r, t, 0.5]).pairs().all(|(n, _)| n < 2 * layer));
     let star = PriorSquare::Star(r * r);
-    let shared = PriorSquare::Stretched(stretch(r));
+    let shared = PriorSquare::Radial(r, stretch(r));
+    assert_eq!(radial_square(r), shared);
     assert_eq!(query_square(grid, [r, t, 1.0]), star);
     assert_eq!(query_square(grid, [r, t, 2.0]), star);
     assert_eq!(query_square(grid, [r, t, 0.999]), shared);
@@ -405,7 +507,7 @@ fn two_metallic_nodes_blend_into_the_target_at_any_metallic() {
         let mut ratios = Vec::new();
         for (i, j) in [(16, 16), (18, 16), (21, 17), (17, 13), (19, 19)] {
             let p = [i as f64 / (size - 1) as f64, j as f64 / (size - 1) as f64];
-            let Some((wi, jac)) = half_vector_direction(wo, p, stretch(r)) else {
+            let Some((wi, jac)) = radial_square(r).direction(wo, p) else {
                 continue;
             };
             let target = gltf_metallic(wo, wi, r, m) * wi[2] * jac;

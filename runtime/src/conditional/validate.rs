@@ -404,6 +404,7 @@ fn brdf_prior<'a>(layout: &Layout<'a>, check: bool) -> Result<BrdfPrior<'a, f32>
         let earlier = [
             SectionTag::BrdfPriorInfoUnstretched,
             SectionTag::BrdfPriorInfoStretchedMetal,
+            SectionTag::BrdfPriorInfoStretchedShared,
         ];
         if let Some(tag) = earlier.into_iter().find(|&t| layout.section(t).is_ok()) {
             return Err(ConditionalError::BrdfPriorEarlier { tag: tag as u32 }.into());
