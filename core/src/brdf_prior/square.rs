@@ -271,7 +271,7 @@ fn radial_table_slope<T: Real>(ks: T, kb: T, sigma: T) -> T {
 }
 
 /// The inverse of [`radial_direction`]: the table point of `wi` (`h = (wo +
-/// wi) / |wo + wi|`'s slope `σ` inverted by [`radial_table_slope`], azimuth
+/// wi) / |wo + wi|`'s slope `σ` inverted by a bounded Newton iteration, azimuth
 /// kept) and the same Jacobian; `None` where no table point maps to `wi`
 /// (`wi.z <= 0`, `h.z <= 0`, `wo.h <= 0`, or `σ` beyond `10^18`, within
 /// `10^-18` of the horizon).
