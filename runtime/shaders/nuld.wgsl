@@ -2043,21 +2043,19 @@ fn nuld_radial_table_slope(ks: f32, kb: f32, sigma: f32) -> f32 {
     if !(sigma > 0.0) {
         return 0.0;
     }
-    let a2 = NULD_RADIAL_CROSSOVER * NULD_RADIAL_CROSSOVER;
     var lo = sigma / max(kb, ks);
     var hi = sigma / min(kb, ks);
     var t = lo;
     for (var i = 0u; i < NULD_RADIAL_INVERSE_STEPS; i++) {
-        let t2 = t * t;
-        let d = t2 + a2;
-        let g = (kb * t2 + ks * a2) / d;
-        let miss = t * g - sigma;
+        // The unit table direction of slope `t` is `(t, 1)` up to scale.
+        let rs = nuld_radial_stretch(ks, kb, t * t, 1.0);
+        let miss = t * rs.x - sigma;
         if miss > 0.0 {
             hi = t;
         } else {
             lo = t;
         }
-        let step = t - miss / (g + 2.0 * (kb - ks) * t2 * a2 / (d * d));
+        let step = t - miss / rs.y;
         var next = 0.5 * (lo + hi);
         if step > lo && step < hi {
             next = step;

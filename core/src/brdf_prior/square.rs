@@ -245,19 +245,17 @@ fn radial_table_slope<T: Real>(ks: T, kb: T, sigma: T) -> T {
     if sigma.partial_cmp(&T::ZERO) != Some(core::cmp::Ordering::Greater) {
         return T::ZERO;
     }
-    let a2 = T::of(RADIAL_CROSSOVER * RADIAL_CROSSOVER);
     let (mut lo, mut hi) = (sigma / kb.max(ks), sigma / kb.min(ks));
     let mut t = lo;
     for _ in 0..RADIAL_INVERSE_STEPS {
-        let t2 = t * t;
-        let d = t2 + a2;
-        let g = (kb * t2 + ks * a2) / d;
+        // The unit table direction of slope `t` is `(t, 1)` up to scale.
+        let (g, dsigma) = radial_stretch(ks, kb, t * t, T::ONE);
         let miss = t * g - sigma;
         match miss > T::ZERO {
             true => hi = t,
             false => lo = t,
         }
-        let step = t - miss / (g + T::of(2.0) * (kb - ks) * t2 * a2 / (d * d));
+        let step = t - miss / dsigma;
         let next = match step > lo && step < hi {
             true => step,
             false => T::of(0.5) * (lo + hi),
