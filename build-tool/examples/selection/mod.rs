@@ -21,6 +21,7 @@ pub fn candidates(n: u32, g: u32, count: u32) -> Vec<Vec<DVec2>> {
 }
 
 /// Indices of `scores` from best (lowest) to worst.
+#[allow(dead_code)] // the selection examples' (`envmap_curve` only scores)
 pub fn ranking(scores: &[f64]) -> Vec<usize> {
     let mut order: Vec<usize> = (0..scores.len()).collect();
     order.sort_by(|&a, &b| scores[a].total_cmp(&scores[b]));
@@ -50,6 +51,7 @@ pub fn mean_score_through<C: Sync>(
 }
 
 /// Mean of `scores` at the first `count` indices of `order`.
+#[allow(dead_code)] // the selection examples' (`envmap_curve` only scores)
 pub fn mean_of(scores: &[f64], order: &[usize], count: usize) -> f64 {
     order[..count].iter().map(|&k| scores[k]).sum::<f64>() / count as f64
 }
