@@ -19,8 +19,8 @@
 //! shifts of the bake's rank-1 lattice of `N` (default 64) points, through:
 //! the tree (today), the Hilbert descent, the Morton descent. With `SCAN=1` in
 //! the environment it instead scores, through the tree, the lattice of every
-//! odd generator `g < N / 2` (the bake takes the one whose shortest vector on
-//! the torus is longest, `train::lattice_generator`).
+//! odd generator `g < N / 2` (the bake takes the one of the largest Zaremba
+//! index, ties to the longest shortest vector, `train::lattice_generator`).
 mod check;
 mod selection;
 
@@ -42,12 +42,7 @@ fn curve_descent(tree: &impl ChildWeights<f64>, u: [f64; 2], hilbert: bool) -> [
     let mut node = Node::ROOT;
     let (mut swap, mut flip) = (false, false);
     for _ in 0..levels {
-        let raw = tree.children(node);
-        let mut w = raw.map(|x| if x > 0.0 && x.is_finite() { x } else { 0.0 });
-        let sum: f64 = w.iter().sum();
-        if !(sum > 0.0 && sum.is_finite()) {
-            w = [1.0; 4];
-        }
+        let w = quadtree::usable(tree.children(node));
         // Children in curve order: their index `i + 2 j` and their transform.
         let order: [(u32, (bool, bool)); 4] = core::array::from_fn(|k| {
             if hilbert {

@@ -360,10 +360,12 @@ pub fn morton(x: u32, y: u32) -> u64 {
     spread(x) | (spread(y) << 1)
 }
 
-/// The children's weights of a node, made usable: negative, NaN and infinite
-/// weights read as 0, and four zeros as four ones.
+/// The children's weights of a node as every descent reads them
+/// ([`sample`], [`pdf`], [`invert`]): negative, NaN and infinite weights read as
+/// 0, and four zeros (or a sum that is not positive and finite) as four ones.
+/// Never panics.
 #[inline]
-fn usable<T: Real>(w: [T; 4]) -> [T; 4] {
+pub fn usable<T: Real>(w: [T; 4]) -> [T; 4] {
     let w = w.map(positive);
     if is_positive_finite(sum4(w)) {
         w
