@@ -682,6 +682,18 @@ fn envmap_bake_and_sample_reject_bad_input_with_one_line() {
     let e = failure(&["bake", "--envmap", junk.to_str().unwrap()], &out);
     assert_eq!(e.trim().lines().count(), 1, "{e}");
     assert!(!out.exists());
+    // The same from N = 256, where the bake trains nothing and builds no pool:
+    // the map fails as it loads, and the directory goes again.
+    let e = failure(
+        &["bake", "--envmap", junk.to_str().unwrap(), "--n", "256"],
+        &out,
+    );
+    assert_eq!(e.trim().lines().count(), 1, "{e}");
+    assert!(!out.exists());
+    // No training steps leave nothing to resume.
+    let e = failure(&["bake", "--brdf", "--steps", "0", "--resume"], &out);
+    assert!(e.contains("--resume continues a training run"), "{e}");
+    assert_eq!(e.trim().lines().count(), 1, "{e}");
     // An --out that cannot be a directory fails before the pool: its error comes
     // first, not the map's.
     let e = failure(

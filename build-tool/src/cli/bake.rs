@@ -33,9 +33,12 @@ pub struct BakeArgs {
     /// [default: 10,12]; the normal's octahedral square u,v for --envmap [default: 13,13].
     #[arg(long, value_delimiter = ',')]
     pub grid: Option<Vec<u32>>,
-    /// Training steps after the 300 steps of pretraining on the warp [default for
-    /// --brdf, each of its two networks (metallic below 1, and the metal): 20000
-    /// at --n 64 to 127, else 12000; 3000 for --envmap].
+    /// Training steps after the 300 steps of pretraining on the warp; 0 trains
+    /// nothing: the blob serves the prior's shifted lattice at each instance's
+    /// offset, as a bake does where training did not help [default for --brdf,
+    /// each of its two networks (metallic below 1, and the metal): 20000 at --n
+    /// 64 to 127, else 12000; for --envmap 3000 below --n 256, 0 from 256 on,
+    /// where training did not beat the lattice on any map measured].
     #[arg(long, allow_negative_numbers = true, value_parser = super::count)]
     pub steps: Option<usize>,
     /// Seed; fixes the output bit for bit whatever the thread count.
@@ -148,7 +151,10 @@ pub fn run(a: BakeArgs) -> Result<()> {
         "--grid must be two node counts in 2..=256, like 10,12"
     );
     let steps = a.steps.unwrap_or(defaults.train.steps);
-    ensure!(steps >= 1, "--steps must be at least 1");
+    ensure!(
+        !(a.resume && steps == 0),
+        "--resume continues a training run; with no training steps there is none to continue"
+    );
     let instance_slots = a
         .instance_slots
         .unwrap_or(defaults.train.instance_slots as usize);
@@ -217,6 +223,15 @@ pub fn run(a: BakeArgs) -> Result<()> {
         );
     }
     println!("{line}");
+    if steps == 0 {
+        let default = match a.steps {
+            Some(_) => "",
+            None => ", the default for --envmap from --n 256",
+        };
+        eprintln!(
+            "note: no training steps{default}: the blob ships the prior's shifted lattice at each instance's offset (--steps K trains K steps)"
+        );
+    }
     if let (Some(trained), Some(q)) = (&report.trained_quality, &report.quality) {
         eprintln!(
             "note: on this target the trained sets checked worse than the prior's untrained lattice ({:.3} against {:.3}, the unbiased mode): the blob ships the lattice at each instance's offset, which checks at {:.3}",

@@ -4,7 +4,8 @@
 //! Writes into the output directory `brdf.nuld` or `envmap.nuld` (the blob,
 //! [`BakeConfig::blob_name`]), `report.json`
 //! (settings, timings, the loss curve and [`quality`](super::quality) at
-//! held-out conditions), `loss.png` (the loss curve), `sets.png` (instance 0 at a
+//! held-out conditions), `loss.png` (the loss curve; none without training,
+//! `--steps 0`, whose networks are the prior's lattice), `sets.png` (instance 0 at a
 //! few conditions over the target, in the equal-area square; for a map, at a few
 //! normals over the sphere's square), and while training
 //! `checkpoint.bin` (every [`BakeConfig::checkpoint_every`], and at the end), from
@@ -68,7 +69,8 @@ impl Default for BakeConfig {
 /// Seconds spent per phase.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Timings {
-    /// Building the condition pool (cap measures).
+    /// Building the condition pool (cap measures); without training, reading
+    /// the target.
     pub pool_s: f64,
     /// Training.
     pub train_s: f64,
@@ -124,7 +126,8 @@ impl BakeConfig {
     }
 
     /// An environment sampler's sizes before its map is known: [`ENVMAP_GRID`],
-    /// [`ENVMAP_WEIGHT_GRID`], [`ENVMAP_STEPS`], [`ENVMAP_POOL_CONDITIONS`],
+    /// [`ENVMAP_WEIGHT_GRID`], [`ENVMAP_STEPS`] (its recipe at the default N,
+    /// [`envmap_steps`]), [`ENVMAP_POOL_CONDITIONS`],
     /// otherwise [`BakeConfig::default`] (what `render` bakes for each map it
     /// is given, through [`Self::with_envmap`]).
     pub fn envmap_sizes() -> Self {
@@ -132,7 +135,7 @@ impl BakeConfig {
             grid: ENVMAP_GRID,
             weight_grid: ENVMAP_WEIGHT_GRID,
             train: TrainConfig {
-                steps: ENVMAP_STEPS,
+                steps: envmap_steps(TrainConfig::default().n),
                 pool_conditions: ENVMAP_POOL_CONDITIONS,
                 ..TrainConfig::default()
             },
@@ -198,10 +201,7 @@ pub const ENVMAP_INSTANCE_SLOTS: u32 = 64;
 /// -2.14e-3 against -2.49e-3 at 256 spp (docs/results/envmap.md#floor).
 pub const ENVMAP_UNION_WEIGHT: f64 = 1.5;
 
-/// Training steps of an environment sampler: on the tree's primary space 3000
-/// steps scored as 12 000 did (courtyard N = 64: 0.755 and 0.759 of the
-/// baseline), in a quarter of the time.
-pub const ENVMAP_STEPS: usize = 3000;
+pub use crate::train::{envmap_steps, ENVMAP_STEPS, ENVMAP_UNTRAINED_FROM};
 
 /// The cap loss's end sharpness for an environment sampler, in inverse point
 /// spacings: 32 (the BRDF sampler's) gained 0.003 to 0.011 of the baseline on
@@ -293,44 +293,29 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     // Before the pool (seconds to minutes): an unusable --out fails at once, and
     // the directory goes again if the run fails before writing into it.
     let out_dir = crate::output::NewDir::create(out)?;
-    let ckpt_path = checkpoint_path(out);
-    let metal_path = metal_checkpoint_path(out);
-    let resume = resume_from(&ckpt_path, &config.train, config.resume, true)?;
-    let metal_config = config.metal_train();
-    let metal_resume = match &metal_config {
-        Some(c) => resume_from(&metal_path, c, config.resume, false)?,
-        None => None,
-    };
     let mut timings = Timings::default();
-    let t = Instant::now();
-    let mut trainer = Trainer::new(config.train.clone(), resume)?;
-    let mut metal_trainer = metal_config
-        .map(|c| Trainer::new(c, metal_resume))
-        .transpose()?;
-    timings.pool_s = t.elapsed().as_secs_f64();
-    if let LoadedTarget::Envmap(env) = &trainer.pool.target {
-        // As `optimize` does: e.g. the negative pixels of a lossy EXR, set to 0.
-        for note in env.map.notes() {
-            eprintln!("note: {note}");
-        }
-    }
+    let nets = if config.train.steps == 0 {
+        untrained(config, &mut timings)?
+    } else {
+        trained(config, out, &mut timings)?
+    };
+    // A training run's checkpoints stay for `--resume` whatever follows; a bake
+    // that trained nothing leaves no directory if it fails before its blob.
+    let out_dir = if nets.trained {
+        out_dir.keep();
+        None
+    } else {
+        Some(out_dir)
+    };
 
     let t = Instant::now();
-    let every = config.checkpoint_every;
-    train(&mut trainer, &ckpt_path, every, "")?;
-    if let Some(metal) = &mut metal_trainer {
-        train(metal, &metal_path, every, " metal")?;
-    }
-    out_dir.keep();
-    timings.train_s = t.elapsed().as_secs_f64();
-
-    let t = Instant::now();
-    let target = &trainer.pool.target;
+    let target = &nets.target;
     let shipped = ship(
-        trainer.params(),
-        metal_trainer.as_ref().map(Trainer::params),
+        nets.params,
+        nets.metal,
         target,
         config.quality_grid,
+        nets.trained,
     )?;
     timings.quality_s = t.elapsed().as_secs_f64();
     let (params, metal_params) = (&shipped.params, shipped.metal.as_ref());
@@ -352,7 +337,7 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     })?;
     timings.distill_s = t.elapsed().as_secs_f64();
 
-    let losses = &trainer.state.losses;
+    let losses = &nets.losses;
     let loss_block = losses.len().div_ceil(200).max(1);
     let loss_curve: Vec<f64> = losses
         .chunks(loss_block)
@@ -366,19 +351,32 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
             .map(|(j, &l)| (((j + 1) * loss_block) as f64, l))
             .collect(),
     };
-    render_loglog(
-        &out.join("loss.png"),
-        &format!("bake --{}: training loss", config.train.target.name()),
-        "step",
-        "loss",
-        &[series],
-        (800, 500),
-    )?;
+    let loss_png = out.join("loss.png");
+    if losses.is_empty() {
+        // No training, no curve: an earlier bake's in this directory would
+        // describe another blob.
+        if loss_png.is_file() {
+            std::fs::remove_file(&loss_png)
+                .with_context(|| format!("cannot remove {}", loss_png.display()))?;
+        }
+    } else {
+        render_loglog(
+            &loss_png,
+            &format!("bake --{}: training loss", config.train.target.name()),
+            "step",
+            "loss",
+            &[series],
+            (800, 500),
+        )?;
+    }
     match target {
         LoadedTarget::GltfBrdf(_) => render_sets(&out.join("sets.png"), params)?,
         LoadedTarget::Envmap(env) => render_envmap_sets(&out.join("sets.png"), params, env)?,
     }
     crate::output::write_atomic(&out.join(config.blob_name()), blob.as_slice())?;
+    if let Some(dir) = out_dir {
+        dir.keep();
+    }
     timings.total_s = started.elapsed().as_secs_f64();
     let report = BakeReport {
         config: config.clone(),
@@ -394,6 +392,94 @@ pub fn bake(config: &BakeConfig, out: &Path) -> Result<BakeReport> {
     let json = serde_json::to_vec_pretty(&report).context("cannot encode report")?;
     crate::output::write_atomic(&out.join("report.json"), &json)?;
     Ok(report)
+}
+
+/// The networks a bake distills, and what it read to make them.
+struct Networks {
+    /// The target, as the pool (or an untrained bake) loaded it.
+    target: LoadedTarget,
+    /// The first network (a BRDF sampler's below metallic 1).
+    params: Params,
+    /// A BRDF sampler's metal-layer network.
+    metal: Option<Params>,
+    /// The loss of every training step (none without training).
+    losses: Vec<f64>,
+    /// Whether they were trained; else they are the prior's lattice, which a
+    /// bake has nothing to compare with.
+    trained: bool,
+}
+
+/// Trains a bake's networks (from `out`'s checkpoints with `resume`), saving
+/// checkpoints into `out` as it goes.
+fn trained(config: &BakeConfig, out: &Path, timings: &mut Timings) -> Result<Networks> {
+    let ckpt_path = checkpoint_path(out);
+    let metal_path = metal_checkpoint_path(out);
+    let resume = resume_from(&ckpt_path, &config.train, config.resume, true)?;
+    let metal_config = config.metal_train();
+    let metal_resume = match &metal_config {
+        Some(c) => resume_from(&metal_path, c, config.resume, false)?,
+        None => None,
+    };
+    let t = Instant::now();
+    let mut trainer = Trainer::new(config.train.clone(), resume)?;
+    let mut metal_trainer = metal_config
+        .map(|c| Trainer::new(c, metal_resume))
+        .transpose()?;
+    timings.pool_s = t.elapsed().as_secs_f64();
+    print_notes(&trainer.pool.target);
+
+    let t = Instant::now();
+    let every = config.checkpoint_every;
+    train(&mut trainer, &ckpt_path, every, "")?;
+    if let Some(metal) = &mut metal_trainer {
+        train(metal, &metal_path, every, " metal")?;
+    }
+    timings.train_s = t.elapsed().as_secs_f64();
+    Ok(Networks {
+        params: trainer.params(),
+        metal: metal_trainer.as_ref().map(Trainer::params),
+        losses: std::mem::take(&mut trainer.state.losses),
+        target: trainer.pool.target,
+        trained: true,
+    })
+}
+
+/// A bake of no training steps (`--steps 0`): networks whose residual is 0
+/// ([`Params::without_residual`]), so that table and network mode serve the
+/// prior's shifted lattice at each instance's offset, the sets the bake ships
+/// where training did not help ([`ship`]); no pool is built. An error for a
+/// network that refines no prior (`--instance-slots 0` keeps a residual, the
+/// earlier mixture networks do not).
+fn untrained(config: &BakeConfig, timings: &mut Timings) -> Result<Networks> {
+    let t = Instant::now();
+    let target = config.train.target.load()?;
+    let lattice = |c: &TrainConfig| -> Result<Params> {
+        let shape = c.shape().context("network shape out of range")?;
+        Params::init(shape, c.seed).without_residual().context(
+            "--steps 0 ships the prior's lattice: it needs a network on the prior's primary space",
+        )
+    };
+    let params = lattice(&config.train)?;
+    let metal = config.metal_train().map(|c| lattice(&c)).transpose()?;
+    timings.pool_s = t.elapsed().as_secs_f64();
+    print_notes(&target);
+    Ok(Networks {
+        target,
+        params,
+        metal,
+        losses: Vec::new(),
+        trained: false,
+    })
+}
+
+/// Prints what reading a map changed, as `optimize` does: e.g. the negative
+/// pixels of a lossy EXR, set to 0.
+fn print_notes(target: &LoadedTarget) {
+    if let LoadedTarget::Envmap(env) = target {
+        for note in env.map.notes() {
+            eprintln!("note: {note}");
+        }
+    }
 }
 
 /// What a bake ships: the trained networks, or their untrained lattice
@@ -414,11 +500,13 @@ struct Shipped {
 /// sun holds most of its light: docs/results/envmap.md#clear-skies): the
 /// learned residual is dropped, so that table and network mode serve the
 /// untrained lattice at each instance's offset, which is checked again.
+/// Networks that were not `trained` are that lattice already: checked once.
 fn ship(
     params: Params,
     metal: Option<Params>,
     target: &LoadedTarget,
     grid: usize,
+    trained: bool,
 ) -> Result<Shipped> {
     if grid == 0 {
         return Ok(Shipped {
@@ -429,7 +517,16 @@ fn ship(
         });
     }
     let held_out = QualityConfig::held_out(target, grid, 0x9a11);
-    let trained = evaluate(&params, metal.as_ref(), target, &held_out)?;
+    let checked = evaluate(&params, metal.as_ref(), target, &held_out)?;
+    if !trained {
+        return Ok(Shipped {
+            params,
+            metal,
+            quality: Some(checked),
+            trained_quality: None,
+        });
+    }
+    let trained = checked;
     // The metal network's lattice too, where there is one (`None`: no copy).
     let lattice = match &metal {
         None => Some(None),
@@ -534,200 +631,4 @@ fn render_envmap_sets(path: &Path, params: &Params, env: &EnvmapTarget) -> Resul
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use nuld_core::blob::{BlobKind, Layout, SectionTag};
-
-    /// A bake of a few steps of a tiny network: checks the files, not quality.
-    fn tiny() -> BakeConfig {
-        BakeConfig {
-            train: TrainConfig {
-                n: 8,
-                hidden: vec![6],
-                steps: 3,
-                pretrain_steps: 2,
-                conditions_per_step: 2,
-                instances_per_condition: 2,
-                pool_conditions: 3,
-                pool_caps: 32,
-                caps_per_step: 16,
-                ..TrainConfig::default()
-            },
-            instances: 3,
-            quality_grid: 0,
-            ..BakeConfig::default()
-        }
-    }
-
-    #[test]
-    fn a_tiny_bake_writes_a_blob_whose_sections_match_its_counts() {
-        let dir = std::env::temp_dir().join(format!("nuld-bake-tiny-{}", std::process::id()));
-        let config = BakeConfig {
-            grid: [2, 3],
-            weight_grid: [4, 2],
-            ..tiny()
-        };
-        let report = bake(&config, &dir).unwrap();
-        let blob = crate::pointset::AlignedBytes::read(&dir.join("brdf.nuld")).unwrap();
-        let bytes = blob.as_slice();
-        assert_eq!(bytes.len(), report.blob_bytes);
-        let layout = Layout::read(bytes).unwrap();
-        assert_eq!(layout.header().kind, BlobKind::Conditional as u32);
-        let len = |tag: SectionTag| layout.section(tag).unwrap().1.len();
-        let shape = config.train.shape().unwrap();
-        assert_eq!(len(SectionTag::NetworkParams), 2 * shape.param_len());
-        // A layer per metallic node (the default axis: 0, 0.5, 0.95).
-        assert_eq!(len(SectionTag::MetallicNodes), 4 * 3);
-        assert_eq!(len(SectionTag::PointTable), 3 * 4 * 2 * 3 * 3 * 8);
-        // The dielectric's albedo, then the metal's.
-        assert_eq!(len(SectionTag::WeightTable), 4 * 8 * 2);
-        // The metal layer's network and point table, as long as the shared
-        // network and one layer of its table.
-        assert_eq!(len(SectionTag::MetalNetworkParams), 2 * shape.param_len());
-        assert_eq!(len(SectionTag::MetalPointTable), 4 * 2 * 3 * 3 * 8);
-        // The tabulated prior's five sections.
-        let prior = crate::sphere::brdf_prior::BrdfPrior::shared();
-        assert_eq!(len(SectionTag::BrdfPriorData), 4 * prior.data.len());
-        assert_eq!(len(SectionTag::BrdfPriorMasses), 4 * prior.masses.len());
-        for f in [
-            "report.json",
-            "loss.png",
-            "sets.png",
-            "checkpoint.bin",
-            "checkpoint-metal.bin",
-        ] {
-            assert!(dir.join(f).is_file(), "{f}");
-        }
-        // Instance 0's first point is served at every condition, metallic 0
-        // and 1, both modes: under the plain offset hash its offset is (0, y),
-        // the square's edge, which the prior sends below the horizon (pdf 0).
-        let cs = nuld_runtime::Blob::parse(bytes)
-            .unwrap()
-            .conditional()
-            .unwrap();
-        for (r, t, m) in (0..16).map(|j| (0.1 + 0.06 * j as f32, 5.6 * j as f32, (j % 2) as f32)) {
-            let c = glam::Vec2::new(r, t);
-            for s in [
-                cs.sample_metallic(c, m, 0, 0),
-                cs.network().sample_metallic(c, m, 0, 0),
-            ] {
-                assert!(s.pdf > 0.0 && s.weight > 0.0, "({r}, {t}, {m}): {s:?}");
-            }
-        }
-        // Resuming a finished run trains nothing and writes the same blob.
-        let again = bake(
-            &BakeConfig {
-                resume: true,
-                ..config
-            },
-            &dir,
-        )
-        .unwrap();
-        assert_eq!(again.blob_bytes, report.blob_bytes);
-        assert_eq!(
-            std::fs::read(dir.join("brdf.nuld")).unwrap(),
-            bytes.to_vec()
-        );
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    /// Sets that check worse than the unbiased mode do not ship: untrained
-    /// weights (a random residual over the lattice) on a constant sky give way
-    /// to the lattice itself, whose check is what the report keeps.
-    #[test]
-    fn sets_worse_than_the_lattice_ship_as_the_lattice() {
-        let dir = std::env::temp_dir().join(format!("nuld-bake-ship-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let map = dir.join("grey.hdr");
-        let img = image::Rgb32FImage::from_pixel(64, 32, image::Rgb([0.5f32; 3]));
-        image::DynamicImage::ImageRgb32F(img).save(&map).unwrap();
-        let config = tiny().with_envmap(TrainTarget::envmap(&map).unwrap());
-        let target = config.train.target.load().unwrap();
-        let random = Params::init(config.train.shape().unwrap(), 11);
-        let shipped = ship(random.clone(), None, &target, 2).unwrap();
-        let trained = shipped.trained_quality.expect("a random residual is worse");
-        assert!(!trained.training_helps());
-        assert_eq!(shipped.params, random.without_residual().unwrap());
-        assert!(shipped.metal.is_none());
-        let lattice = shipped.quality.unwrap();
-        assert!(lattice.mean_ratio < trained.mean_ratio);
-        // The same lattice at fixed offsets and at random shifts: alike.
-        assert!((lattice.mean_ratio - lattice.mean_randomized_ratio).abs() < 0.25);
-        // Without a check nothing is judged and the trained weights ship.
-        let unchecked = ship(random.clone(), None, &target, 0).unwrap();
-        assert_eq!(unchecked.params, random);
-        assert!(unchecked.quality.is_none() && unchecked.trained_quality.is_none());
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    /// An environment bake of a constant sky: its weight table is the irradiance
-    /// of a constant map, `pi L` at every normal (the closed form; the pixel-centre
-    /// cosine sum is within 1e-3 of it), sets serve through `EnvmapSampler::sample`, and a
-    /// resumed finished run writes the same blob.
-    #[test]
-    fn an_envmap_bake_tabulates_pi_l_for_a_constant_sky_and_resumes() {
-        let dir = std::env::temp_dir().join(format!("nuld-bake-envmap-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let map = dir.join("grey.hdr");
-        let lum = 0.75f32;
-        let img = image::Rgb32FImage::from_pixel(128, 64, image::Rgb([lum; 3]));
-        image::DynamicImage::ImageRgb32F(img).save(&map).unwrap();
-        let config = BakeConfig {
-            grid: [3, 3],
-            weight_grid: [5, 4],
-            ..tiny()
-        }
-        .with_envmap(TrainTarget::envmap(&map).unwrap());
-        assert_eq!(config.blob_name(), "envmap.nuld");
-        let out = dir.join("out");
-        let report = bake(&config, &out).unwrap();
-        let blob = crate::pointset::AlignedBytes::read(&out.join("envmap.nuld")).unwrap();
-        assert_eq!(blob.as_slice().len(), report.blob_bytes);
-        let cs = nuld_runtime::Blob::parse(blob.as_slice())
-            .unwrap()
-            .envmap()
-            .unwrap();
-        assert_eq!(cs.conditional().domain(), Domain::Sphere);
-        let pi_l = std::f64::consts::PI * lum as f64;
-        for n in [
-            DVec3::Z,
-            DVec3::NEG_Z,
-            DVec3::new(0.3, -0.8, 0.1).normalize(),
-        ] {
-            let s = cs.sample(n.as_vec3(), 1, 2);
-            assert!(
-                (s.weight as f64 / pi_l - 1.0).abs() < 1e-3,
-                "{n}: {}",
-                s.weight
-            );
-            assert!((s.direction.length() - 1.0).abs() < 1e-5);
-        }
-        for f in ["report.json", "loss.png", "sets.png", "checkpoint.bin"] {
-            assert!(out.join(f).is_file(), "{f}");
-        }
-        let again = bake(
-            &BakeConfig {
-                resume: true,
-                ..config
-            },
-            &out,
-        )
-        .unwrap();
-        assert_eq!(again.blob_bytes, report.blob_bytes);
-        assert_eq!(
-            std::fs::read(out.join("envmap.nuld")).unwrap(),
-            blob.as_slice().to_vec()
-        );
-        // Another map under the same directory is refused on resume.
-        std::fs::write(&map, b"not a map any more").unwrap();
-        let other = BakeConfig {
-            resume: true,
-            ..BakeConfig::default().with_envmap(TrainTarget::Envmap {
-                path: map.clone(),
-                content_hash: 1,
-            })
-        };
-        assert!(bake(&other, &out).is_err());
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-}
+mod tests;

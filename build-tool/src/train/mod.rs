@@ -225,18 +225,47 @@ pub fn brdf_recipe(n: u32) -> (usize, f64) {
     }
 }
 
+/// Training steps of an environment sampler below [`ENVMAP_UNTRAINED_FROM`]
+/// points per set: on the tree's primary space 3000 steps scored as 12 000 did
+/// (courtyard N = 64: 0.755 and 0.759 of the baseline), in a quarter of the
+/// time.
+pub const ENVMAP_STEPS: usize = 3000;
+
+/// Points per set from which an environment sampler trains nothing by default
+/// ([`envmap_steps`]).
+pub const ENVMAP_UNTRAINED_FROM: u32 = 256;
+
+/// An environment sampler's training steps at `n` points per set, chosen by
+/// measurement (docs/results/envmap.md#untrained): [`ENVMAP_STEPS`] below
+/// [`ENVMAP_UNTRAINED_FROM`], else 0. At N = 256 the trained sets checked
+/// worse than the prior's shifted lattice on both shared maps (courtyard 0.767
+/// against 0.707, studio 0.941 against 0.858; nor did a smaller step or a pool
+/// four times as large make them better), so the bake shipped the lattice
+/// after minutes of training: with no steps it ships the same sets without
+/// them.
+pub fn envmap_steps(n: u32) -> usize {
+    if n >= ENVMAP_UNTRAINED_FROM {
+        0
+    } else {
+        ENVMAP_STEPS
+    }
+}
+
 impl TrainConfig {
-    /// These settings at `n` points per set; a BRDF sampler on [`brdf_recipe`]
-    /// (its steps and union weight those of the recipe at its own `n`) moves to
-    /// the recipe's at `n`, any other keeps its own (an environment sampler's, a
-    /// caller's explicit ones).
+    /// These settings at `n` points per set; a sampler on its recipe (a BRDF
+    /// sampler's steps and union weight those of [`brdf_recipe`] at its own `n`,
+    /// an environment sampler's steps those of [`envmap_steps`]) moves to the
+    /// recipe's at `n`, any other keeps its own (a caller's explicit ones).
     pub fn with_points(self, n: u32) -> Self {
-        let on_recipe = self.target == TrainTarget::GltfBrdf
-            && (self.steps, self.union_weight) == brdf_recipe(self.n);
-        let (steps, union_weight) = if on_recipe {
-            brdf_recipe(n)
-        } else {
-            (self.steps, self.union_weight)
+        let brdf = self.target == TrainTarget::GltfBrdf;
+        let on_recipe = match brdf {
+            true => (self.steps, self.union_weight) == brdf_recipe(self.n),
+            false => self.steps == envmap_steps(self.n),
+        };
+        let (steps, union_weight) = match (on_recipe, brdf) {
+            (true, true) => brdf_recipe(n),
+            (true, false) => (envmap_steps(n), self.union_weight),
+            (false, _) => (self.steps, self.union_weight),
         };
         Self {
             n,
@@ -491,11 +520,12 @@ mod tests {
     use super::*;
     use crate::seeding::rng;
 
-    /// The recipe at the three sizes a renderer bakes, and who follows it: a
-    /// configuration on the recipe moves with `n`, an explicit one or an
-    /// environment sampler's keeps its steps and union weight.
+    /// The recipes at the three sizes a renderer bakes, and who follows them: a
+    /// configuration on its recipe moves with `n`, an explicit one keeps its
+    /// steps and union weight; an environment sampler trains below 256 points
+    /// and not from there on, whatever its union weight.
     #[test]
-    fn the_brdf_recipe_follows_the_points_per_set() {
+    fn the_recipes_follow_the_points_per_set() {
         let d = TrainConfig::default();
         assert_eq!((d.n, d.steps, d.union_weight), (64, 20_000, 0.0));
         let at = |c: &TrainConfig, n| {
@@ -520,6 +550,17 @@ mod tests {
             ..d
         };
         assert_eq!(at(&env, 16), (16, 3000, 1.5));
+        assert_eq!(at(&env, 255), (255, 3000, 1.5));
+        assert_eq!(at(&env, 256), (256, 0, 1.5));
+        assert_eq!(at(&env, 1024), (1024, 0, 1.5));
+        assert_eq!(at(&env.clone().with_points(256), 64), (64, 3000, 1.5));
+        let explicit_env = TrainConfig {
+            steps: 500,
+            ..env.clone()
+        };
+        assert_eq!(at(&explicit_env, 256), (256, 500, 1.5));
+        let untrained_env = TrainConfig { steps: 0, ..env };
+        assert_eq!(at(&untrained_env, 16), (16, 0, 1.5));
     }
 
     fn tiny() -> TrainConfig {
