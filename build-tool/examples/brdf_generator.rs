@@ -20,17 +20,9 @@ mod selection;
 use nuld_build_tool::lab::eval::brdf_prior::{self, judging, BrdfPriorSettings};
 use nuld_build_tool::sphere::brdf_prior::BrdfPrior;
 use nuld_build_tool::sphere::{BrdfTarget, TabulatedWarp};
-use nuld_build_tool::train::{lattice_generator, zaremba_index};
+use nuld_build_tool::train::{gcd, lattice_generator, zaremba_index};
 use nuld_core::blob::Domain;
 use rayon::prelude::*;
-
-fn gcd(a: u32, b: u32) -> u32 {
-    if b == 0 {
-        a
-    } else {
-        gcd(b, a % b)
-    }
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -45,7 +37,9 @@ fn main() {
         Some(s) => (s.split(','))
             .map(|x| x.parse().expect("a generator"))
             .collect(),
-        None => (1..n / 2).filter(|&g| gcd(g, n) == 1).collect(),
+        None => (1..n / 2)
+            .filter(|&g| gcd(g as u64, n as u64) == 1)
+            .collect(),
     };
     let prior = BrdfPrior::shared();
     let warp = prior.warp();

@@ -20,7 +20,7 @@ use crate::plot::{render_loglog, render_square_panels, Series, SquarePanel};
 use crate::progress::Progress;
 use crate::sphere::{BrdfTarget, DirectionDensity, EnvmapDensity};
 use crate::train::target::{EnvmapTarget, LoadedTarget};
-use crate::train::{BrdfLayer, Checkpoint, TrainConfig, TrainTarget, Trainer};
+use crate::train::{envmap_steps, BrdfLayer, Checkpoint, TrainConfig, TrainTarget, Trainer};
 use anyhow::{bail, Context, Result};
 use glam::{DVec2, DVec3};
 use nuld_core::blob::{Domain, Metadata};
@@ -126,8 +126,8 @@ impl BakeConfig {
     }
 
     /// An environment sampler's sizes before its map is known: [`ENVMAP_GRID`],
-    /// [`ENVMAP_WEIGHT_GRID`], [`ENVMAP_STEPS`] (its recipe at the default N,
-    /// [`envmap_steps`]), [`ENVMAP_POOL_CONDITIONS`],
+    /// [`ENVMAP_WEIGHT_GRID`], the steps of [`envmap_steps`] at the default N
+    /// ([`crate::train::ENVMAP_STEPS`]), [`ENVMAP_POOL_CONDITIONS`],
     /// otherwise [`BakeConfig::default`] (what `render` bakes for each map it
     /// is given, through [`Self::with_envmap`]).
     pub fn envmap_sizes() -> Self {
@@ -200,8 +200,6 @@ pub const ENVMAP_INSTANCE_SLOTS: u32 = 64;
 /// at an RMSE of 2.188e-2 against 2.299e-2 at 64 spp and a fixed-instance bias of
 /// -2.14e-3 against -2.49e-3 at 256 spp (docs/results/envmap.md#floor).
 pub const ENVMAP_UNION_WEIGHT: f64 = 1.5;
-
-pub use crate::train::{envmap_steps, ENVMAP_STEPS, ENVMAP_UNTRAINED_FROM};
 
 /// The cap loss's end sharpness for an environment sampler, in inverse point
 /// spacings: 32 (the BRDF sampler's) gained 0.003 to 0.011 of the baseline on
