@@ -20,7 +20,13 @@
 //! the tree (today), the Hilbert descent, the Morton descent. With `SCAN=1` in
 //! the environment it instead scores, through the tree, the lattice of every
 //! odd generator `g < N / 2` (the bake takes the one of the largest Zaremba
-//! index, ties to the longest shortest vector, `train::lattice_generator`).
+//! index, ties to the longest shortest vector, `train::lattice_generator`);
+//! with `SETS=net-xor`, `net-shift` or `owen-sobol` as well, it scores `K` sets
+//! of another kind through the tree instead, each as uniform per point as a
+//! shifted lattice (what the unbiased mode needs): the Hammersley net `(i / N,
+//! radical inverse of i)` (a `(0, m, 2)`-net for `N = 2^m`) under a random
+//! digital shift (both coordinates' bits XOR a random word) or a random
+//! toroidal shift, or Owen-scrambled Sobol.
 mod check;
 mod selection;
 
@@ -162,18 +168,53 @@ fn scan_generators(env: &nuld_build_tool::train::target::EnvmapTarget, n: u32, k
             Some((u, check::judge(&lit, u, n, caps as u64)))
         })
         .collect();
-    let all: Vec<u32> = (1..n / 2).step_by(2).collect();
-    for &g in only.as_ref().unwrap_or(&all) {
-        let candidates = selection::candidates(n, g, k_count);
+    let score = |name: &str, candidates: &[Vec<DVec2>]| {
         let v: Vec<f64> = judges
             .par_iter()
             .map(|(u, judge)| {
                 let to = |p: DVec2| DVec3::from(tree.sample_square(*u, p.to_array()).0);
-                selection::mean_score_through(&candidates, judge, &to)
+                selection::mean_score_through(candidates, judge, &to)
             })
             .collect();
         let mean = v.iter().sum::<f64>() / v.len() as f64;
         let worst = v.iter().cloned().fold(0.0, f64::max);
-        println!("g {g:3}: mean {mean:.3} (worst {worst:.3})");
+        println!("{name}: mean {mean:.3} (worst {worst:.3})");
+    };
+    if let Ok(kind) = std::env::var("SETS") {
+        score(&kind, &other_sets(&kind, n, k_count));
+        return;
     }
+    let all: Vec<u32> = (1..n / 2).step_by(2).collect();
+    for &g in only.as_ref().unwrap_or(&all) {
+        score(&format!("g {g:3}"), &selection::candidates(n, g, k_count));
+    }
+}
+
+/// `count` sets of `n` points of `kind` (`net-xor`, `net-shift`, `owen-sobol`;
+/// the module docs), set `k` randomized by hashes of `k`.
+fn other_sets(kind: &str, n: u32, count: u32) -> Vec<Vec<DVec2>> {
+    const WORD: f64 = 4294967296.0;
+    (0..count)
+        .map(|k| {
+            let h = |s: u32| nuld_core::network::hash_u32(k.wrapping_mul(7919).wrapping_add(s));
+            let (xor, shift) = ([h(1), h(2)], [h(3) as f64 / WORD, h(4) as f64 / WORD]);
+            (0..n)
+                .map(|i| {
+                    // The net's coordinates as 32-bit words: `i / n` and the
+                    // radical inverse of `i` in base 2.
+                    let bits = [
+                        ((i as u64) << 32).div_euclid(n as u64) as u32,
+                        i.reverse_bits(),
+                    ];
+                    let [x, y] = match kind {
+                        "net-xor" => [0, 1].map(|a| ((bits[a] ^ xor[a]) as f64 + 0.5) / WORD),
+                        "net-shift" => [0, 1].map(|a| (bits[a] as f64 / WORD + shift[a]).fract()),
+                        "owen-sobol" => [0, 1].map(|a| sobol_burley::sample(i, a, h(5)) as f64),
+                        _ => panic!("SETS: net-xor, net-shift or owen-sobol, not {kind}"),
+                    };
+                    DVec2::new(x, y)
+                })
+                .collect()
+        })
+        .collect()
 }
