@@ -171,8 +171,8 @@ fn point_table(
 /// `instances`) with the untrained lattice: point `i` of `shape`'s rank-1
 /// lattice shifted on the torus by `offset(k)`, as u16 unorm codes. What a bake
 /// whose learned residual is dropped ships (to its network's rounding), for
-/// examples that time or judge the lattice in a blob's place
-/// (`examples/envmap_loop.rs`, `examples/offset_sets.rs`).
+/// the benches and examples that time or judge the lattice in a blob's place
+/// (`lab::bench::runtime::with_lattice_points`, `examples/offset_sets.rs`).
 pub fn fill_lattice_table(
     table: &mut [u32],
     shape: &Shape,

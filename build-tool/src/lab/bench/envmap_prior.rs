@@ -2,7 +2,7 @@
 //! [`nuld_core::envmap_tree`]'s exact product warp of a map's light and a
 //! normal's cosine, in `f32` as the runtime calls it, and the runtime's
 //! [`nuld_runtime::EnvmapSampler`] on it (table, unbiased and network modes; the
-//! default bake's network, random contents: speed does not depend on them),
+//! default bake's network, random weights, each instance's lattice in the table),
 //! against the incumbent a renderer ships, Owen-scrambled Sobol (`sobol_burley`)
 //! through the map's luminance warp in `f32` with its pdf ([`EnvmapLight`],
 //! Mitsuba 3's `envmap`, which ignores the cosine). The earlier incumbent, the
@@ -11,7 +11,7 @@
 //! timed beside it.
 
 use super::rounds::Rounds;
-use super::runtime::{envmap_parts, random_parts, random_shape};
+use super::runtime::{envmap_parts, random_parts, random_shape, with_lattice_points};
 use crate::baselines::EnvmapLight;
 use crate::conditional::blob::ConditionalParts;
 use crate::pointset::AlignedBytes;
@@ -41,8 +41,10 @@ const SHALLOW_LEVELS: u32 = 5;
 
 /// The environment sampler this bench times, on `tree`: the default bake's
 /// shapes ([32, 32] ReLU, [`ENVMAP_INSTANCE_SLOTS`] slots, 64 instances on
-/// [`ENVMAP_GRID`] normals, `N` points) with random contents ([`random_parts`],
-/// seed 3): its speed does not depend on them.
+/// [`ENVMAP_GRID`] normals, `N` points), a network of random weights
+/// ([`random_parts`], seed 3: its speed does not depend on them) and each
+/// instance's shifted lattice in the point table ([`with_lattice_points`]: the
+/// tree's descent follows the points).
 ///
 /// [`ENVMAP_INSTANCE_SLOTS`]: crate::conditional::bake::ENVMAP_INSTANCE_SLOTS
 /// [`ENVMAP_GRID`]: crate::conditional::bake::ENVMAP_GRID
@@ -62,7 +64,7 @@ pub fn sampler_parts(tree: Arc<EnvmapTree>) -> Result<ConditionalParts> {
         crate::conditional::bake::ENVMAP_GRID,
         3,
     )?;
-    Ok(envmap_parts(parts, tree))
+    Ok(envmap_parts(with_lattice_points(parts, &shape), tree))
 }
 
 /// The blob of `parts` ([`sampler_parts`]) as this bench writes it.

@@ -4,12 +4,14 @@
 //! importance-sampling mixture (GGX visible normals with probability
 //! `p_s = A_spec / A`, else cosine; [`BrdfTarget`]'s warp).
 //!
-//! Speed does not depend on the network's or the table's values, so the samplers
-//! are timed on blobs with random contents ([`random_parts`]).
+//! Speed does not depend on the network's values, so the samplers are timed on
+//! blobs with random contents ([`random_parts`]); but the table's points decide
+//! where a data-dependent prior's search goes, so their tables hold what a bake
+//! ships ([`with_lattice_points`]).
 
 use super::rounds::Rounds;
 use crate::conditional::blob::{ConditionalParts, MetalParts, Prior};
-use crate::conditional::distill::info;
+use crate::conditional::distill::{fill_lattice_table, info};
 use crate::pointset::AlignedBytes;
 use crate::sphere::{BrdfTarget, DirectionDensity, EnvmapTree};
 use crate::train::target::LoadedTarget;
@@ -110,6 +112,25 @@ fn random_points(params: usize, table: u64, rng: &mut impl Rng) -> MetalParts {
             .collect(),
         table: (0..table).map(|_| rng.random()).collect(),
     }
+}
+
+/// `parts` with every point-table entry (of every metallic layer, and of the
+/// metal layer's table) replaced by its instance's shifted lattice point, the
+/// same at every node: the points of a bake of no steps (`bake --steps 0`, the
+/// environment sampler's default from N = 256), and a trained bake's up to
+/// their learned residual. A prior's search follows the points, and so does its
+/// speed: random codes blended between four nodes crowd towards the square's
+/// centre, whose descents the caches and the branch predictor favour
+/// (environment table mode 2.03x and 2.05x the incumbent on random codes,
+/// 2.43x on the lattice, the two builds taking turns).
+pub fn with_lattice_points(mut parts: ConditionalParts, shape: &Shape) -> ConditionalParts {
+    let instances = parts.info.instances;
+    let tables =
+        std::iter::once(&mut parts.table).chain(parts.metal.as_mut().map(|m| &mut m.table));
+    for table in tables {
+        fill_lattice_table(table, shape, instances, |k| shape.instance_offset(k));
+    }
+    parts
 }
 
 /// Random metal points for `parts` (a [`PointWarp::BrdfTable`] sampler on a
@@ -234,7 +255,8 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
     let slots = crate::train::TrainConfig::default().instance_slots;
     let blob = |hidden: &[u32], act| -> Result<AlignedBytes> {
         let shape = random_shape(n, hidden, act, PointWarp::BrdfMixture, slots)?;
-        random_parts(shape, PointWarp::BrdfMixture, 16, [10, 9], 2)?.to_blob(&meta)
+        let parts = random_parts(shape, PointWarp::BrdfMixture, 16, [10, 9], 2)?;
+        with_lattice_points(parts, &shape).to_blob(&meta)
     };
     let (relu, silu) = (
         blob(&[32, 32], Activation::Relu)?,
@@ -257,7 +279,7 @@ pub fn measure(samples: u32) -> Result<RuntimeTimings> {
         let mut parts = random_parts(shape, PointWarp::BrdfTable, 16, [10, 9], 2)?;
         parts.metal = Some(random_metal_points(&parts, 3));
         let nodes = crate::train::TrainConfig::default().table_metallic_nodes();
-        with_random_metallic_axis(parts, &nodes, 4).to_blob(&meta)?
+        with_lattice_points(with_random_metallic_axis(parts, &nodes, 4), &shape).to_blob(&meta)?
     };
     let prior = sampler(&table_blob)?;
     let metallic = |s: u32| [0.0, 0.5, 1.0][(s / n) as usize % 3];
