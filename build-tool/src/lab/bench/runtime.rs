@@ -191,8 +191,10 @@ pub struct RuntimeTimings {
 }
 
 /// Conditions cycled through by every method: a renderer's shading points each
-/// have their own.
-const CONDITIONS: usize = 64;
+/// have their own. Many, so that a condition is not paired with one stored
+/// instance over and over (as the environment bench's normals,
+/// [`super::envmap_prior`]).
+const CONDITIONS: usize = 4096;
 
 /// Points of the cap-measure rule of the incumbent's targets: the bench calls only
 /// their warp, its density and the albedo, none of which reads the rule, so a small
