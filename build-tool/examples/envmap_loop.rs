@@ -11,7 +11,8 @@
 //! keeps them where a trained table's would be; the bench's random codes
 //! before, interpolated towards the square's middle, timed 3 to 5 % faster
 //! here). Sample `s` has normal
-//! `s / 64 mod NORMALS` (default 64) of a fixed pseudo-random set, instance `s
+//! `s / 64 mod NORMALS` (default 4096, as the bench: with 64, each normal meets
+//! one stored instance only, which the caches learn) of a fixed pseudo-random set, instance `s
 //! / 64` and index `s mod 64`; `pdf` is asked for pseudo-random directions.
 //! Prints ns per sample, the best of three runs of 4·10^6 samples each, one
 //! thread. (`bench` times every method through one harness, where the sampler
@@ -34,7 +35,7 @@ fn main() {
         Some(path) if path != "lattice" => AlignedBytes::read(std::path::Path::new(path)).unwrap(),
         _ => bench_blob(),
     };
-    let count: usize = args.get(2).map_or(64, |a| a.parse().unwrap());
+    let count: usize = args.get(2).map_or(4096, |a| a.parse().unwrap());
     let env = nuld_runtime::Blob::parse(bytes.as_slice())
         .unwrap()
         .envmap()

@@ -30,12 +30,12 @@ use rand::{Rng, SeedableRng};
 use std::hint::black_box;
 use std::sync::Arc;
 
-/// Normals cycled through: a renderer's shading points each have their own. As
-/// many as there are sets in a round's first 2^18 samples, so that a normal is
-/// not paired with the same stored instance over and over (at 64 normals, one
-/// instance each, table mode served 64 points a normal, which the caches and the
-/// branch predictor learned: 2.01x to 2.05x the incumbent, against 2.76x to
-/// 2.82x here, the two builds taking turns).
+/// Normals cycled through: a renderer's shading points each have their own.
+/// Many, so that a normal is not paired with the same stored instance over and
+/// over: at 64 normals (sample `s`'s normal `s / N mod 64`, its instance `s / N`
+/// of 64 stored) table mode served 64 points a normal, which the caches and the
+/// branch predictor learned (2.01x to 2.05x the incumbent, against 2.76x to
+/// 2.82x at 4096, the two builds taking turns).
 const NORMALS: usize = 4096;
 
 /// Points per set: a set of 64 shares its normal and scramble.
